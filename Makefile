@@ -1,0 +1,80 @@
+# ppbench build. `make` builds ./ppbench, `make test` runs the unit tests and the reduced
+# study's regression gate, `make bench` reproduces the study into results/, `make perf` prints
+# the benchmarks. Every entry point first runs scripts/deps.sh (installs Debian packages as
+# root, otherwise says which command to run).
+CC      ?= gcc
+BUILD   ?= build
+PKGS    := OpenCL lapacke openblas OpenEXR libpng inih cmocka
+OPT     ?= -O2 -g
+WARN    := -Wall -Wextra $(if $(WERROR),-Werror)
+SAN     ?=
+CFLAGS  += -std=c11 $(OPT) $(WARN) $(SAN) -fno-strict-aliasing
+CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc \
+            -DPPB_KERNEL_DIR='"$(CURDIR)/kernels"'
+LDFLAGS += $(SAN)
+
+SRC   := $(filter-out src/main.c,$(wildcard src/*.c))
+OBJ   := $(SRC:src/%.c=$(BUILD)/obj/%.o)
+TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
+LIB   := $(BUILD)/libppbench.a
+
+.PHONY: all deps test unit asan bench perf format format-check clean
+all: ppbench
+
+# Dependencies first: the pkg-config flags are only asked for once the packages are there.
+$(BUILD)/deps.mk: scripts/deps.sh
+	@mkdir -p $(BUILD)
+	@bash scripts/deps.sh
+	@echo "PKG_CFLAGS := $$(pkg-config --cflags $(PKGS))" > $@.tmp
+	@echo "PKG_LIBS := $$(pkg-config --libs $(PKGS)) -lm -lpthread" >> $@.tmp
+	@mv $@.tmp $@
+ifeq ($(filter clean format format-check,$(MAKECMDGOALS)),)
+include $(BUILD)/deps.mk
+endif
+deps: $(BUILD)/deps.mk
+
+$(BUILD)/obj/%.o: src/%.c | $(BUILD)/deps.mk
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(LIB): $(OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+ppbench: $(BUILD)/obj/main.o $(LIB)
+	$(CC) $(LDFLAGS) -o $@ $^ $(PKG_LIBS)
+
+$(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
+# Unit tests: every tests/test_*.c is a cmocka suite; each prints cmocka's own summary.
+unit: ppbench $(TESTS)
+	@mkdir -p $(BUILD)/tmp
+	@fail=0; for t in $(TESTS); do \
+	  echo "== $$t"; PPBENCH=$(CURDIR)/ppbench TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
+	done; exit $$fail
+
+test: unit
+	@bash tests/regress.sh
+
+asan:
+	$(MAKE) BUILD=build-asan SAN="-fsanitize=address,undefined -fno-omit-frame-pointer" \
+	  OPT="-O1 -g" unit
+
+bench: ppbench
+	@bash scripts/bench.sh $(if $(QUICK),--quick)
+
+perf: ppbench
+	@./ppbench perf
+
+format:
+	clang-format -i src/*.c src/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
+
+format-check:
+	clang-format --dry-run --Werror src/*.c src/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
+
+clean:
+	rm -rf build build-asan ppbench
+
+-include $(OBJ:.o=.d) $(BUILD)/obj/main.d

@@ -1,0 +1,113 @@
+/* ppb_conventions.h: the conventions of SPEC.md sections 2-4 coded once, for host and kernels.
+ *
+ * Owns: surface ids and their local frames (n, b = +z, t = n x b), the direction bins (equal
+ * sin^2(theta) theta bins, phi folded to [0, 180] deg), the (surface, segment, bin) cell index
+ * of every radiance array, segment centres, and the piecewise-constant medium. Plain C that is
+ * also OpenCL C: the host includes it from src/, kernels with -I kernels. Nothing here
+ * allocates or keeps state. */
+#ifndef PPB_CONVENTIONS_H
+#define PPB_CONVENTIONS_H
+
+#ifdef __OPENCL_VERSION__
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+#define PPB_FN inline
+#else
+#include <math.h>
+#define PPB_FN static inline
+#endif
+
+#define PPB_PI 3.14159265358979323846
+
+/* Surfaces (SPEC.md section 2). In slab mode only S1 and S2 exist. */
+enum { PPB_S1 = 0, PPB_S2 = 1, PPB_S3 = 2, PPB_S4 = 3, PPB_NSURF = 4 };
+
+/* Step kinds (SPEC.md section 1 and 3). */
+enum { PPB_STEP_NONE = 0, PPB_STEP_DENSITY = 1, PPB_STEP_ALBEDO = 2, PPB_STEP_SHADOW = 3 };
+
+/* Outward normal of a surface, as (x, y); the z component is 0. */
+PPB_FN double ppb_normal_x(int surf) { return surf == PPB_S3 ? -1.0 : surf == PPB_S4 ? 1.0 : 0.0; }
+PPB_FN double ppb_normal_y(int surf) { return surf == PPB_S1 ? 1.0 : surf == PPB_S2 ? -1.0 : 0.0; }
+/* t = n x b with b = +z gives t = (n_y, -n_x, 0): +x on S1, -x on S2, +y on S3, -y on S4. */
+PPB_FN double ppb_tangent_x(int surf) { return ppb_normal_y(surf); }
+PPB_FN double ppb_tangent_y(int surf) { return -ppb_normal_x(surf); }
+
+/* Theta bin of an outgoing direction with mu = cos(theta) = w.n >= 0: edges at
+ * sin^2(theta) = k / ntheta (equal projected solid angle). */
+PPB_FN int ppb_theta_bin(double mu, int ntheta)
+{
+    int k = (int)((1.0 - mu * mu) * ntheta);
+    return k < 0 ? 0 : (k >= ntheta ? ntheta - 1 : k);
+}
+
+/* Phi bin from the direction's components along t and b; phi is folded to [0, pi] because the
+ * set-up is symmetric in z, so the sign of the b component does not matter. */
+PPB_FN int ppb_phi_bin(double wt, double wb, int nphi)
+{
+    double phi = atan2(fabs(wb), wt); /* in [0, pi] */
+    int k = (int)(phi * (1.0 / PPB_PI) * nphi);
+    return k < 0 ? 0 : (k >= nphi ? nphi - 1 : k);
+}
+
+/* Bin of an outgoing direction w = (wx, wy, wz) leaving surface surf. */
+PPB_FN int ppb_dir_bin(int surf, double wx, double wy, double wz, int ntheta, int nphi)
+{
+    double mu = wx * ppb_normal_x(surf) + wy * ppb_normal_y(surf);
+    double wt = wx * ppb_tangent_x(surf) + wy * ppb_tangent_y(surf);
+    return ppb_theta_bin(mu, ntheta) * nphi + ppb_phi_bin(wt, wz, nphi);
+}
+
+/* Projected solid angle of every bin: (1/2) d(sin^2) x 2 d(phi) = pi / (ntheta nphi); the
+ * folded bin counts both phi and -phi. */
+PPB_FN double ppb_bin_proj_solid_angle(int ntheta, int nphi) { return PPB_PI / (ntheta * nphi); }
+
+/* A direction inside bin (itheta, iphi) at fractional position (u, v) in [0,1)^2, uniform in
+ * sin^2(theta) and phi, i.e. uniform in projected solid angle; written in world coordinates
+ * for surface surf. The folded bin's phi > 0 half is used (b = +z component >= 0). */
+PPB_FN void ppb_bin_direction(int surf, int itheta, int iphi, double u, double v, int ntheta,
+                              int nphi, double *wx, double *wy, double *wz)
+{
+    double s2 = (itheta + u) / ntheta;
+    double st = sqrt(s2), ct = sqrt(1.0 - s2);
+    double phi = (iphi + v) * PPB_PI / nphi;
+    double wt = st * cos(phi), wb = st * sin(phi);
+    *wx = ct * ppb_normal_x(surf) + wt * ppb_tangent_x(surf);
+    *wy = ct * ppb_normal_y(surf) + wt * ppb_tangent_y(surf);
+    *wz = wb;
+}
+
+/* Segment centres (SPEC.md section 2): S1/S2 numbered along x from -W/2, S3/S4 along y from -H.
+ * Returns the coordinate s along the surface; (x, y) is the point. Slab mode uses s = 0. */
+PPB_FN double ppb_segment_centre(int surf, int seg, int nseg, double width, double height,
+                                 double *x, double *y)
+{
+    if (surf == PPB_S1 || surf == PPB_S2) {
+        double s = -0.5 * width + (seg + 0.5) * width / nseg;
+        *x = s;
+        *y = surf == PPB_S1 ? 0.0 : -height;
+        return s;
+    }
+    double s = -height + (seg + 0.5) * height / nseg;
+    *x = surf == PPB_S3 ? -0.5 * width : 0.5 * width;
+    *y = s;
+    return s;
+}
+
+/* Segment holding coordinate s along a surface of length len starting at s0. */
+PPB_FN int ppb_segment_of(double s, double s0, double len, int nseg)
+{
+    int k = (int)((s - s0) / len * nseg);
+    return k < 0 ? 0 : (k >= nseg ? nseg - 1 : k);
+}
+
+/* Piecewise-constant medium (SPEC.md section 1): the right value holds for x >= step_x. */
+PPB_FN double ppb_sigma_t_at(double x, int step, double step_x, double sigma_t,
+                             double sigma_t_right)
+{
+    return (step == PPB_STEP_DENSITY && x >= step_x) ? sigma_t_right : sigma_t;
+}
+PPB_FN double ppb_albedo_at(double x, int step, double step_x, double albedo, double albedo_right)
+{
+    return (step == PPB_STEP_ALBEDO && x >= step_x) ? albedo_right : albedo;
+}
+
+#endif

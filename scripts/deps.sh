@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Checks every dependency ppbench needs (Debian 12 packages) and installs the missing ones with
+# apt-get when run as root; otherwise prints the exact command and fails. Writes nothing else.
+set -euo pipefail
+
+# pkg-config module -> Debian package
+declare -A PC=(
+  [OpenCL]=ocl-icd-opencl-dev [lapacke]=liblapacke-dev [openblas]=libopenblas-dev
+  [OpenEXR]=libopenexr-dev [libpng]=libpng-dev [inih]=libinih-dev [cmocka]=libcmocka-dev
+)
+# file or command -> Debian package
+declare -A FILES=(
+  [/usr/include/CL/cl.h]=opencl-headers
+  [/usr/include/Random123/philox.h]=librandom123-dev
+  [/etc/OpenCL/vendors/pocl.icd]=pocl-opencl-icd
+)
+declare -A CMDS=([pkg-config]=pkg-config [gnuplot]=gnuplot-nox [parallel]=parallel [clinfo]=clinfo)
+
+missing=()
+for c in "${!CMDS[@]}"; do command -v "$c" >/dev/null 2>&1 || missing+=("${CMDS[$c]}"); done
+for f in "${!FILES[@]}"; do [ -e "$f" ] || missing+=("${FILES[$f]}"); done
+if command -v pkg-config >/dev/null 2>&1; then
+  for m in "${!PC[@]}"; do pkg-config --exists "$m" || missing+=("${PC[$m]}"); done
+else
+  missing+=("${PC[@]}")
+fi
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+mapfile -t missing < <(printf '%s\n' "${missing[@]}" | sort -u)
+cmd="apt-get install -y --no-install-recommends ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "ppbench: missing packages: ${missing[*]}" >&2
+  echo "ppbench: install them with: sudo apt-get update && sudo $cmd" >&2
+  exit 1
+fi
+echo "ppbench: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq >&2
+$cmd >&2

@@ -1,0 +1,43 @@
+/* method.h: the one interface every method implements, and the registry of method ids.
+ *
+ * A method, given the experiment (scene and settings), fills radiance per (surface, segment,
+ * bin) and its totals. A method may also produce a second result in the same run (mc writes
+ * its once-scattered part as mc1). The runner, metrics and writers never special-case one. */
+#ifndef PPB_METHOD_H
+#define PPB_METHOD_H
+
+#include "config.h"
+#include "ocl.h"
+#include "result.h"
+
+/* What a method gets: the experiment and an OpenCL device opened on first use. */
+typedef struct ppb_run_ctx {
+    const ppb_config *cfg;
+    const char *device_selector; /* --device, or NULL */
+    ppb_ocl ocl;
+    int ocl_open;
+    int quiet;                   /* no progress lines */
+} ppb_run_ctx;
+
+/* The device, opened on first call and shared by every method of the run. */
+int ppb_ctx_ocl(ppb_run_ctx *ctx, ppb_ocl **ocl, ppb_err *err);
+void ppb_ctx_close(ppb_run_ctx *ctx);
+
+/* out[0] is the method's result, out[1] its companion when `also` is set; both are already
+ * initialised to zero with the scene's layout and their ids. */
+typedef int (*ppb_method_fn)(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+typedef struct ppb_method {
+    const char *id;
+    const char *also;      /* id of a companion result, or NULL */
+    int slab_only;         /* ppslab */
+    int reference;         /* the Monte Carlo: metrics compare every other method to it */
+    const char *summary;
+    ppb_method_fn run;
+} ppb_method;
+
+const ppb_method *ppb_method_find(const char *id);
+int ppb_method_count(void);
+const ppb_method *ppb_method_at(int i);
+
+#endif

@@ -1,0 +1,30 @@
+/* progress.h: progress lines on stderr (percent, rate, ETA) and clean interruption.
+ *
+ * Long loops call ppb_progress_update() between units of work and stop when
+ * ppb_interrupted() turns true (SIGINT or SIGTERM caught by ppb_progress_install_signals()),
+ * then write what they have, marked partial. Lines are throttled to a few per second and
+ * suppressed when quiet is set or stderr is not wanted. */
+#ifndef PPB_PROGRESS_H
+#define PPB_PROGRESS_H
+
+typedef struct ppb_progress {
+    const char *label;
+    const char *unit;
+    double total;
+    double t0, last;
+    int quiet;
+} ppb_progress;
+
+void ppb_progress_install_signals(void);
+int ppb_interrupted(void);
+void ppb_interrupt_reset(void);
+
+void ppb_progress_begin(ppb_progress *p, const char *label, const char *unit, double total,
+                        int quiet);
+void ppb_progress_update(ppb_progress *p, double done);
+void ppb_progress_end(ppb_progress *p, double done);
+
+/* Monotonic seconds. */
+double ppb_now(void);
+
+#endif
