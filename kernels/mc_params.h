@@ -1,0 +1,74 @@
+/* mc_params.h: the one definition of what the photon Monte Carlo kernel (mc.cl) receives, shared
+ * by the host (src/method_mc.c) and the kernel, and the fixed-point tally conventions.
+ *
+ * Owns: the parameter struct passed by value, the kernel argument indices, the layout of the
+ * integer tally buffers and their fixed-point scale. Tallies are integers so that their sums do
+ * not depend on the order of accumulation: the result is bit-identical whatever the work-group
+ * size, the chunking or the split into shards (SPEC.md section 10). */
+#ifndef PPB_MC_PARAMS_H
+#define PPB_MC_PARAMS_H
+
+#ifdef __OPENCL_VERSION__
+typedef ulong ppb_u64;
+typedef uint ppb_u32;
+#else
+#include <stdint.h>
+typedef uint64_t ppb_u64;
+typedef uint32_t ppb_u32;
+#endif
+
+/* One exit weight w in [0, 1] is tallied as round(w * 2^32). A per-batch sum stays below 2^64
+ * while a batch holds fewer than 2^31 photons (weights never exceed 1; roulette gains are
+ * bounded by the same sum), which the host checks. */
+#define PPB_MC_FIXED_SCALE 4294967296.0f
+
+/* Russian roulette (unbiased): below this weight a photon survives with probability
+ * 1 / PPB_MC_ROULETTE_M and has its weight multiplied by PPB_MC_ROULETTE_M. */
+#define PPB_MC_ROULETTE_W 1e-3f
+#define PPB_MC_ROULETTE_M 10.0f
+
+/* Per-batch totals (each a fixed-point weight sum unless noted). */
+enum {
+    PPB_MC_T_BALLISTIC = 0, /* unscattered exits, any surface */
+    PPB_MC_T_CAPTURE = 1,   /* weight removed by implicit capture, w (1 - alpha) per scattering */
+    PPB_MC_T_RGAIN = 2,     /* weight added by roulette survivors */
+    PPB_MC_T_RLOSS = 3,     /* weight of photons ended by roulette */
+    PPB_MC_T_EVENTS = 4,    /* scattering events (a plain count) */
+    PPB_MC_NTOT = 8         /* padded: room for more without changing the file format */
+};
+
+/* The two cell tallies of every batch: all scattered exits (mc) and once-scattered exits (mc1).
+ * Buffer layout: cells[(batch * PPB_MC_NTALLY + tally) * ncells + cell]. */
+enum { PPB_MC_TALLY_ALL = 0, PPB_MC_TALLY_ONCE = 1, PPB_MC_NTALLY = 2 };
+
+/* Kernel arguments of ppb_mc_trace_kernel, by index. */
+enum { PPB_MC_ARG_PARAMS = 0, PPB_MC_ARG_CELLS = 1, PPB_MC_ARG_TOTALS = 2, PPB_MC_NARGS = 3 };
+
+/* Parameters of one launch, passed by value. 64-bit members first so host and device agree on
+ * the layout without packing attributes; the host asserts the size. */
+typedef struct ppb_mc_params {
+    ppb_u64 seed;      /* Philox key */
+    ppb_u64 first;     /* photon index of work-item 0 */
+    ppb_u64 count;     /* photons in this launch */
+    ppb_u64 ncells;    /* cells of one tally (layout.ncells) */
+    int batches;       /* batch of photon i is i % batches */
+    int tube;          /* 1 tube, 0 slab (no side walls) */
+    int step;          /* PPB_STEP_* */
+    int ntheta, nphi;  /* direction bins */
+    int nseg[4];       /* segments per surface (slab: 1, 1, 0, 0) */
+    int offset[4];     /* first segment row of each surface, as ppb_layout */
+    float width;       /* W, mfp (tube) */
+    float height;      /* H, mfp */
+    float sigma_t;     /* left of the step (everywhere without a density step) */
+    float sigma_t_right;
+    float albedo;      /* left of the step */
+    float albedo_right;
+    float step_x;
+    float g;           /* Henyey-Greenstein asymmetry */
+    float light_x;     /* w_L = (light_x, light_y, 0) */
+    float light_y;
+    float enter_x0;    /* photons enter S1 uniformly in [enter_x0, enter_x0 + enter_width) */
+    float enter_width;
+} ppb_mc_params;
+
+#endif
