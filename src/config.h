@@ -16,6 +16,7 @@
 #define PPB_MAX_METHODS 16
 #define PPB_MAX_AXES 8
 #define PPB_MAX_LIST 1024
+#define PPB_MAX_KEYS 64
 
 typedef struct ppb_mc_settings {
     long long photons;    /* photon budget */
@@ -61,6 +62,7 @@ typedef struct ppb_config {
     ppb_pp_settings pp;
     ppb_mp_settings mp;
     char out_dir[1024];
+    int key_line[PPB_MAX_KEYS]; /* line of each key in the file, 0 = default */
     int naxes; /* keys holding lists: a sweep */
     ppb_axis axes[PPB_MAX_AXES];
 } ppb_config;
@@ -84,8 +86,8 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out);
 /* The key table as a Markdown table (configs/README.md is generated from it). */
 void ppb_config_write_keys(FILE *out);
 
-/* Name of swept key k ("medium.g"), and its value in cfg. */
-const char *ppb_config_key_name(int key);
+/* Name of swept key k ("medium.g") into buf, and its value in cfg. */
+void ppb_config_key_name(int key, char *buf, size_t cap);
 double ppb_config_key_value(const ppb_config *cfg, int key);
 
 int ppb_config_has_method(const ppb_config *cfg, const char *id);
