@@ -150,8 +150,8 @@ static int parse_list(const key_def *k, const char *text, double *vals, int *cou
     char buf[4096];
     snprintf(buf, sizeof buf, "%s", text);
     *count = 0;
-    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
-         tok = strtok_r(NULL, ",", &save)) {
+    char *rest = buf;
+    for (char *tok = strsep(&rest, ","); tok; tok = strsep(&rest, ",")) {
         tok = trim(tok);
         if (!*tok) {
             snprintf(why, n, "empty value in list '%s'", text);

@@ -14,6 +14,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <math.h>
+
 #include "scene.h"
 
 /* A fresh scratch directory for one test, named after it; returns a static buffer. */
@@ -22,7 +24,7 @@ static inline const char *tu_scratch(const char *name)
     static char dir[1024];
     const char *base = getenv("TMPDIR");
     snprintf(dir, sizeof dir, "%s/ppbench-%s-%d", base ? base : "/tmp", name, (int)getpid());
-    char cmd[1200];
+    char cmd[2200];
     snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
     if (system(cmd) != 0)
         fail_msg("cannot make %s", dir);
