@@ -1,0 +1,89 @@
+/* The command line's error paths and exit codes (documented in `ppbench --help` and the README):
+ * 0 success, 1 run failure, 2 bad command line or config. Runs the built binary ($PPBENCH). */
+#include "testutil.h"
+
+#include <sys/wait.h>
+
+/* Runs ppbench with args, captures stdout+stderr into out, returns the exit code. */
+static int run(const char *args, char *out, size_t cap)
+{
+    const char *bin = getenv("PPBENCH");
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s %s 2>&1", bin ? bin : "./ppbench", args);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(out, 1, cap - 1, p);
+    out[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static char buf[65536];
+
+static void expect(const char *args, int code, const char *needle)
+{
+    int rc = run(args, buf, sizeof buf);
+    if (rc != code || !strstr(buf, needle))
+        fail_msg("ppbench %s: exit %d (want %d), output lacks '%s':\n%s", args, rc, code, needle,
+                 buf);
+}
+
+static const char *config(const char *name, const char *text)
+{
+    static char path[1200];
+    snprintf(path, sizeof path, "%s/%s.ini", tu_scratch(name), name);
+    FILE *f = fopen(path, "w");
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+static void test_help_and_usage(void **state)
+{
+    (void)state;
+    expect("--help", 0, "examples:");
+    expect("--help", 0, "exit codes:");
+    expect("", 2, "usage: ppbench");
+    expect("frobnicate", 2, "frobnicate: unknown command");
+    expect("run", 2, "no config given");
+    expect("run --bogus x.ini", 2, "--bogus: unknown option");
+    expect("sweep --shard 4/3 x.ini", 2, "--shard 4/3: expected I/N");
+}
+
+static void test_config_errors(void **state)
+{
+    (void)state;
+    char args[1400];
+    expect("run /nonexistent/a.ini", 2, "/nonexistent/a.ini: cannot open config");
+    const char *p = config("cli-bad", "[medium]\nalbedo = 2\n");
+    snprintf(args, sizeof args, "run %s", p);
+    expect(args, 2, ":2: [medium] albedo: 2 is out of range [0, 1]");
+    p = config("cli-list", "[medium]\ng = 0, 0.5\n");
+    snprintf(args, sizeof args, "run %s", p);
+    expect(args, 2, "use `ppbench sweep`");
+    p = config("cli-set", "[experiment]\nmethods = mp\n");
+    snprintf(args, sizeof args, "run --set medium.g %s", p);
+    expect(args, 2, "expected SECTION.KEY=VALUE");
+    snprintf(args, sizeof args, "run --set medium.gg=1 %s", p);
+    expect(args, 2, "--set medium.gg: unknown key");
+}
+
+static void test_devices_and_keys(void **state)
+{
+    (void)state;
+    expect("devices", 0, "0: ");
+    expect("keys", 0, "| mc | photons |");
+    expect("run --device no-such-device-xyz --quiet --set experiment.methods=mc "
+           "--set mc.photons=1000 --out /nonexistent-dir/x configs/uniform_g0_normal.ini",
+           1, "no device name contains it");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_help_and_usage),
+        cmocka_unit_test(test_config_errors),
+        cmocka_unit_test(test_devices_and_keys),
+    };
+    return cmocka_run_group_tests_name("cli", tests, NULL, NULL);
+}
