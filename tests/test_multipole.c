@@ -1,0 +1,363 @@
+/* test_multipole.c: the multipole diffusion model (src/multipole.c) against Jensen et al. 2001's
+ * closed-form total diffuse reflectance, its own closed-form plane integrals, pair convergence,
+ * the z-integrated line kernel against brute-force quadrature, and the `mp` method on the tube
+ * (mirror symmetry, the paper's 'bright belt' on the sides, run time) and in slab mode. */
+#include "testutil.h"
+
+#include <math.h>
+#include <time.h>
+
+#include "config.h"
+#include "method_mp.h"
+#include "multipole.h"
+
+/* 2 pi int_0^inf r f(r) dr by 8-point-per-panel midpoint-free Gauss-Legendre on geometric
+ * panels [0, 1e-3], then x1.05 per panel out to r = 2000 (profiles decay like exp(-0.1 r) at
+ * worst here). */
+static double plane_integral(const ppb_multipole *mp, int top)
+{
+    static const double node[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                                   0.8611363115940526};
+    static const double weight[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
+                                     0.3478548451374538};
+    double a = 0, b = 1e-3, sum = 0;
+    while (a < 2000) {
+        double half = 0.5 * (b - a), mid = 0.5 * (a + b);
+        for (int j = 0; j < 4; j++) {
+            double r = mid + half * node[j];
+            sum += half * weight[j] * r * (top ? ppb_multipole_R(mp, r) : ppb_multipole_T(mp, r));
+        }
+        a = b;
+        b = fmax(b * 1.05, b + 1e-3);
+    }
+    return 2 * PPB_PI * sum;
+}
+
+/* Jensen et al. 2001's total diffuse reflectance of the dipole, with A = 1. */
+static double jensen_rd(double albedo_reduced)
+{
+    double s = sqrt(3 * (1 - albedo_reduced));
+    return 0.5 * albedo_reduced * (1 + exp(-4.0 / 3.0 * s)) * exp(-s);
+}
+
+static void test_bessel_k1(void **state)
+{
+    (void)state;
+    /* Reference values: Abramowitz & Stegun Table 9.8 (e^x K1(x)) and the small-argument series
+     * K1(x) = 1/x + ln(x/2) I1(x) - (x/4) sum_k (psi(k+1) + psi(k+2)) (x^2/4)^k / (k!(k+1)!),
+     * evaluated separately in double precision. */
+    assert_true(fabs(ppb_bessel_k1(1.0) / 0.6019072301972346 - 1) < 1e-13);
+    assert_true(fabs(ppb_bessel_k1(2.0) / 0.1398658818165224 - 1) < 1e-13);
+    assert_true(fabs(ppb_bessel_k1(0.1) / 9.853844780870606 - 1) < 1e-13);
+    assert_true(fabs(ppb_bessel_k1(1e-3) / 999.9962381560856 - 1) < 1e-13);
+    assert_true(fabs(ppb_bessel_k1(10.0) / 1.864877345382558e-05 - 1) < 1e-12);
+}
+
+static void test_dipole_matches_jensen_rd(void **state)
+{
+    (void)state;
+    /* One pair, semi-infinite: the numerically integrated R(r) must equal Jensen et al. 2001's
+     * closed form R_d = (alpha'/2)(1 + exp(-(4/3) A sqrt(3(1-alpha')))) exp(-sqrt(3(1-alpha'))).
+     * Tolerance 1e-7: the quadrature's own error (it resolves the 1/r^2-like peak near r = 0). */
+    const double albedo[] = {0.3, 0.8, 0.95, 0.99, 0.999};
+    const double g[] = {0.0, -0.5, 0.5};
+    ppb_err err;
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < 3; j++) {
+            ppb_multipole mp;
+            assert_int_equal(ppb_multipole_init(&mp, 1.0, albedo[i], g[j], INFINITY, 10, &err), 0);
+            assert_int_equal(mp.npairs, 1); /* semi-infinite: the dipole only */
+            double numeric = plane_integral(&mp, 1), closed = jensen_rd(mp.albedo_reduced);
+            if (i == 2 && j == 0)
+                print_message("dipole alpha=0.95 g=0: numeric %.10f  Jensen %.10f  rel %.1e\n",
+                              numeric, closed, numeric / closed - 1);
+            assert_true(fabs(numeric / closed - 1) < 1e-7);
+            assert_true(fabs(ppb_multipole_total_R(&mp) / closed - 1) < 1e-14);
+        }
+}
+
+static void test_slab_totals_match_profiles(void **state)
+{
+    (void)state;
+    /* The closed-form plane integrals (sum of charge sign(z) exp(-sigma_tr |z|) / 2) against
+     * the numerically integrated R(r), T(r) of a finite slab. */
+    ppb_multipole mp;
+    ppb_err err;
+    assert_int_equal(ppb_multipole_init(&mp, 1.0, 0.95, 0.0, 3.0, 10, &err), 0);
+    assert_true(fabs(plane_integral(&mp, 1) / ppb_multipole_total_R(&mp) - 1) < 1e-7);
+    assert_true(fabs(plane_integral(&mp, 0) / ppb_multipole_total_T(&mp) - 1) < 1e-7);
+}
+
+static void test_slab_converges_with_pairs(void **state)
+{
+    (void)state;
+    /* Finite slabs (d = 3 of SPEC.md section 6, and thinner/thicker ones, all with d > z_r where
+     * the model applies): R and T settle as pairs are added (the change from 2n to 2n + 2 extra
+     * pairs shrinks and ends below 1e-6), stay in [0, 1] and R + T <= 1 (energy: alpha' <= 1 of
+     * the power is scattered into the sources). */
+    const double d[] = {1.5, 3.0, 30.0};
+    const double albedo[] = {0.95, 0.475, 0.99};
+    ppb_err err;
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) {
+            double prev_R = 0, prev_T = 0, prev_step = INFINITY;
+            for (int n = 0; n <= 40; n += 2) {
+                ppb_multipole mp;
+                assert_int_equal(ppb_multipole_init(&mp, 1.0, albedo[a], 0.0, d[i], n, &err), 0);
+                double R = ppb_multipole_total_R(&mp), T = ppb_multipole_total_T(&mp);
+                if (d[i] == 3.0 && albedo[a] == 0.95 && n <= 8)
+                    print_message("d=3 alpha=0.95 extra pairs %2d: R %.8f T %.8f\n", n, R, T);
+                assert_true(R >= 0 && R <= 1 && T >= 0 && T <= 1 && R + T <= 1 + 1e-12);
+                double step = fabs(R - prev_R) + fabs(T - prev_T);
+                if (n >= 4)
+                    assert_true(step <= prev_step + 1e-15);
+                prev_step = n >= 2 ? step : INFINITY;
+                prev_R = R;
+                prev_T = T;
+            }
+            assert_true(prev_step < 1e-6);
+        }
+}
+
+/* Brute force: the flux of every point source below the strip, integrated over z and x by the
+ * midpoint rule on a fine grid (x: n_x cells, z: cells of 0.02 out to |z| = 60). */
+static double brute_strip_flux(const ppb_multipole *mp, double xp, double yp, double nx, double ny,
+                               double xa, double xb, int n_x)
+{
+    double sum = 0, hx = (xb - xa) / n_x, hz = 0.02;
+    for (int k = 0; k < ppb_multipole_nsources(mp); k++)
+        for (int i = 0; i < n_x; i++) {
+            double u = xp - (xa + (i + 0.5) * hx), v = yp + mp->depth[k];
+            double along = u * nx + v * ny;
+            for (int j = 0; j < 6000; j++) {
+                double z = -60 + (j + 0.5) * hz, dist = sqrt(u * u + v * v + z * z);
+                double s = mp->sigma_tr;
+                sum += mp->charge[k] * (1 + s * dist) * exp(-s * dist) /
+                       (4 * PPB_PI * dist * dist * dist) * along * hx * hz;
+            }
+        }
+    return mp->albedo_reduced * sum;
+}
+
+static void test_strip_flux_against_brute_force(void **state)
+{
+    (void)state;
+    /* The K1 closed form over z plus the singularity-subtracted x quadrature against the brute
+     * force above, at points away from the sources (where brute force is reliable): S1 at x = 0,
+     * S2 at x = 1, S4 at mid-height. Then its own convergence in nodes per mfp on the side at
+     * the real source's depth neighbourhood (y = -1 + 1/96), where the flux peaks. */
+    ppb_multipole mp;
+    ppb_err err;
+    assert_int_equal(ppb_multipole_init(&mp, 1.0, 0.95, 0.0, 3.0, 2, &err), 0);
+    const double pts[3][4] = {{0, 0, 0, 1}, {1, -3, 0, -1}, {5, -1.5, 1, 0}};
+    for (int i = 0; i < 3; i++) {
+        double exact =
+            ppb_multipole_strip_flux(&mp, pts[i][0], pts[i][1], pts[i][2], pts[i][3], -5, 5, 16);
+        double brute =
+            brute_strip_flux(&mp, pts[i][0], pts[i][1], pts[i][2], pts[i][3], -5, 5, 400);
+        print_message("strip flux at (%g, %g): closed-form z %.8f  brute force %.8f\n", pts[i][0],
+                      pts[i][1], exact, brute);
+        assert_true(fabs(exact / brute - 1) < 1e-3); /* brute force's midpoint error */
+    }
+    double ref = ppb_multipole_strip_flux(&mp, 5, -1 + 1.0 / 96, 1, 0, -5, 5, 256);
+    for (int n = 2; n <= 32; n *= 2) {
+        double f = ppb_multipole_strip_flux(&mp, 5, -1 + 1.0 / 96, 1, 0, -5, 5, n);
+        print_message("side flux at y = -1 + 1/96, %2d nodes/mfp: %.10f (rel %.1e)\n", n, f,
+                      f / ref - 1);
+        if (n >= 16)
+            assert_true(fabs(f / ref - 1) < 1e-5);
+    }
+}
+
+static ppb_config mp_config(ppb_scene sc)
+{
+    ppb_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.scene = sc;
+    cfg.samples_seg = 4; /* config.c defaults */
+    cfg.samples_dir = 4;
+    cfg.mp.pairs = 10;
+    cfg.mp.samples = 16;
+    return cfg;
+}
+
+static double run_mp(ppb_config *cfg, ppb_result *out)
+{
+    ppb_err err;
+    ppb_layout lo = ppb_scene_layout(&cfg->scene);
+    assert_int_equal(ppb_result_init(out, "mp", &lo, &err), 0);
+    ppb_run_ctx ctx = {.cfg = cfg, .quiet = 1};
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    int rc = ppb_method_mp(&ctx, out, &err);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (rc)
+        fail_msg("%s", err.msg);
+    return (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
+}
+
+static double rad(const ppb_result *r, int surf, int seg, int bin)
+{
+    return r->radiance[ppb_cell(&r->layout, surf, seg, bin)];
+}
+
+static void test_tube_mirror_belt_and_time(void **state)
+{
+    (void)state;
+    ppb_config cfg = mp_config(tu_tube());
+    ppb_result out;
+    double seconds = run_mp(&cfg, &out);
+    const ppb_layout *lo = &out.layout;
+    /* SPEC.md section 4 mirror map (g = 0, normal light, no step): S3 <-> S4, S1/S2 segment
+     * i <-> segments-1-i, phi bin k <-> phi_bins-1-k; mp is direction-independent. */
+    for (int surf = 0; surf < PPB_NSURF; surf++) {
+        int mirror = surf == PPB_S3 ? PPB_S4 : surf == PPB_S4 ? PPB_S3 : surf;
+        int nseg = lo->nseg[surf], top = surf <= PPB_S2;
+        for (int seg = 0; seg < nseg; seg++)
+            for (int t = 0; t < 8; t++)
+                for (int p = 0; p < 8; p++) {
+                    double a = rad(&out, surf, seg, t * 8 + p);
+                    double b = rad(&out, mirror, top ? nseg - 1 - seg : seg, t * 8 + 7 - p);
+                    assert_true(fabs(a - b) <= 1e-12 * fabs(a));
+                    assert_true(a == rad(&out, surf, seg, 0)); /* flux / pi in every bin */
+                }
+    }
+    /* The paper's bright belt (Sec. 4.1.1): the sources' field on the sides peaks at the real
+     * source's depth z_r = 1 mfp below S1 (y = -1: segments 23/24 of 36), more than twice the
+     * mid-height value (segments 17/18); the very top (y -> 0) is darker again because the
+     * virtual source, z_r + 2 z_b above S1, cancels there. */
+    int peak = 0;
+    for (int seg = 0; seg < 36; seg++)
+        if (rad(&out, PPB_S3, seg, 0) > rad(&out, PPB_S3, peak, 0))
+            peak = seg;
+    double top = rad(&out, PPB_S3, 35, 0),
+           mid = 0.5 * (rad(&out, PPB_S3, 17, 0) + rad(&out, PPB_S3, 18, 0));
+    print_message("S3 radiance: top seg 35 %.5f, peak seg %d %.5f, mid-height %.5f, bottom %.5f\n",
+                  top, peak, rad(&out, PPB_S3, peak, 0), mid, rad(&out, PPB_S3, 0, 0));
+    print_message("S1(x=0) %.5f S2(x=0) %.5f  totals R %.5f T %.5f sides %.5f ballistic %.5f\n",
+                  0.5 * (rad(&out, PPB_S1, 63, 0) + rad(&out, PPB_S1, 64, 0)),
+                  0.5 * (rad(&out, PPB_S2, 63, 0) + rad(&out, PPB_S2, 64, 0)), out.totals.R,
+                  out.totals.T, out.totals.sides, out.totals.ballistic);
+    print_message("whole tube case: %.3f s\n", seconds);
+    assert_true(peak == 23 || peak == 24);             /* at y = -z_r, the upper third */
+    assert_true(rad(&out, PPB_S3, peak, 0) > 2 * mid); /* a belt, not a gentle slope */
+    /* Energy: R + T + sides within [0, 1] (the diffusion is not exact, but not wild either), and
+     * the unscattered beam exp(-3) straight down at normal incidence. */
+    double sum = out.totals.R + out.totals.T + out.totals.sides;
+    assert_true(sum > 0 && sum < 1);
+    assert_true(fabs(out.totals.ballistic - exp(-3.0)) < 1e-12);
+    assert_true(seconds < 30);
+    ppb_result_free(&out);
+}
+
+static void test_tube_converges_in_samples(void **state)
+{
+    (void)state;
+    /* The lit-strip quadrature (mp.samples nodes per mfp) converges: 8 and 16 nodes per mfp
+     * agree with 32 on every cell; samples_seg = 4 vs 8 differ only near the belt. */
+    ppb_scene sc = tu_tube();
+    sc.segments_top = 32;
+    sc.segments_side = 12;
+    ppb_config cfg = mp_config(sc);
+    ppb_result ref, r;
+    cfg.mp.samples = 32;
+    run_mp(&cfg, &ref);
+    for (int n = 4; n <= 16; n *= 2) {
+        cfg.mp.samples = n;
+        run_mp(&cfg, &r);
+        double worst = 0;
+        for (size_t i = 0; i < r.layout.ncells; i++)
+            worst = fmax(worst, fabs(r.radiance[i] / ref.radiance[i] - 1));
+        print_message("mp.samples %2d: worst relative change against 32: %.1e\n", n, worst);
+        if (n >= 8)
+            assert_true(worst < 1e-4);
+        ppb_result_free(&r);
+    }
+    ppb_result_free(&ref);
+}
+
+static void test_oblique_and_steps_run(void **state)
+{
+    (void)state;
+    /* Oblique light: ballistic by geometry. At 45 deg from x0 the beam leaves S2 at x0 + 3 if
+     * x0 < 2, else S4, always after optical depth min(3, 5 - x0) sqrt(2): average over
+     * x0 in [-5, 5] = (7 e^{-3 sqrt 2} + int_0^3 e^{-t sqrt 2} dt) / 10. */
+    ppb_scene sc = tu_tube();
+    sc.theta_deg = 45;
+    ppb_config cfg = mp_config(sc);
+    ppb_result out;
+    run_mp(&cfg, &out);
+    double s2 = sqrt(2.0);
+    double expect = (7 * exp(-3 * s2) + (1 - exp(-3 * s2)) / s2) / 10;
+    print_message("45 deg: ballistic %.8f expected %.8f, R %.4f T %.4f sides %.4f\n",
+                  out.totals.ballistic, expect, out.totals.R, out.totals.T, out.totals.sides);
+    assert_true(fabs(out.totals.ballistic / expect - 1) < 1e-8);
+    ppb_result_free(&out);
+    /* Shadow step: nothing lit at x >= 0 so S1 far right is darker than far left; density
+     * step: the right half (sigma_t = 0.5) transmits more through S2. */
+    sc = tu_tube();
+    sc.step = PPB_STEP_SHADOW;
+    cfg = mp_config(sc);
+    run_mp(&cfg, &out);
+    assert_true(rad(&out, PPB_S1, 0, 0) > 10 * rad(&out, PPB_S1, 127, 0));
+    assert_true(fabs(out.totals.ballistic - exp(-3.0)) < 1e-12);
+    ppb_result_free(&out);
+    sc = tu_tube();
+    sc.step = PPB_STEP_DENSITY;
+    cfg = mp_config(sc);
+    run_mp(&cfg, &out);
+    assert_true(rad(&out, PPB_S2, 120, 0) > rad(&out, PPB_S2, 7, 0));
+    assert_true(fabs(out.totals.ballistic - 0.5 * (exp(-3.0) + exp(-1.5))) < 1e-12);
+    ppb_result_free(&out);
+}
+
+static void test_slab_mode(void **state)
+{
+    (void)state;
+    /* Slab mode: radiance cos(theta_L) R / pi on S1, cos(theta_L) T / pi on S2, the totals from
+     * the closed-form plane integrals, ballistic exp(-tau0 / mu0). */
+    ppb_config cfg = mp_config(tu_slab(3.0, 0.95, 0.0, 30.0));
+    ppb_result out;
+    run_mp(&cfg, &out);
+    ppb_multipole mp;
+    ppb_err err;
+    assert_int_equal(ppb_multipole_init(&mp, 1.0, 0.95, 0.0, 3.0, 10, &err), 0);
+    double mu0 = cos(PPB_PI / 6);
+    assert_true(fabs(out.totals.R - ppb_multipole_total_R(&mp)) < 1e-15);
+    assert_true(fabs(rad(&out, PPB_S1, 0, 5) - mu0 * out.totals.R / PPB_PI) < 1e-15);
+    assert_true(fabs(rad(&out, PPB_S2, 0, 63) - mu0 * out.totals.T / PPB_PI) < 1e-15);
+    assert_true(fabs(out.totals.ballistic - exp(-3.0 / mu0)) < 1e-15);
+    assert_int_equal(out.totals.absorbed_tracked, 0);
+    ppb_result_free(&out);
+}
+
+static void test_rejects_bad_medium(void **state)
+{
+    (void)state;
+    ppb_multipole mp;
+    ppb_err err;
+    assert_int_equal(ppb_multipole_init(&mp, 0.0, 0.95, 0.0, 3.0, 0, &err), -1);
+    assert_int_equal(ppb_multipole_init(&mp, 1.0, 1.0, 0.0, 3.0, 10, &err), -1);
+    assert_non_null(strstr(err.msg, "albedo = 1"));
+    assert_int_equal(ppb_multipole_init(&mp, 1.0, 1.0, 0.0, INFINITY, 0, &err), 0); /* R_d = 1 */
+    assert_true(fabs(ppb_multipole_total_R(&mp) - 1) < 1e-15);
+    assert_int_equal(ppb_multipole_init(&mp, 1.0, 0.95, 0.0, 3.0, PPB_MP_MAX_PAIRS, &err), -1);
+    assert_non_null(strstr(err.msg, "pairs"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bessel_k1),
+        cmocka_unit_test(test_dipole_matches_jensen_rd),
+        cmocka_unit_test(test_slab_totals_match_profiles),
+        cmocka_unit_test(test_slab_converges_with_pairs),
+        cmocka_unit_test(test_strip_flux_against_brute_force),
+        cmocka_unit_test(test_tube_mirror_belt_and_time),
+        cmocka_unit_test(test_tube_converges_in_samples),
+        cmocka_unit_test(test_oblique_and_steps_run),
+        cmocka_unit_test(test_slab_mode),
+        cmocka_unit_test(test_rejects_bad_medium),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
