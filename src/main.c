@@ -10,6 +10,7 @@
 #include "ocl.h"
 #include "perf.h"
 #include "progress.h"
+#include "report.h"
 #include "sweep.h"
 
 enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
@@ -27,6 +28,7 @@ static void usage(FILE *out)
             "  devices             list OpenCL devices (index: platform / device)\n"
             "  keys                print every config key with its default and range\n"
             "  perf                benchmarks: solver, ray marcher, Monte Carlo\n"
+            "  report DIR CASE...  table2.csv/.md and README.md of a study from its cases\n"
             "\n"
             "options:\n"
             "  --device SEL        OpenCL device: index or name substring\n"
@@ -223,6 +225,20 @@ static int cmd_merge(const cli *c)
     return EXIT_OK;
 }
 
+static int cmd_report(const cli *c)
+{
+    if (c->nargs < 2) {
+        fprintf(stderr, "ppbench report: usage: ppbench report STUDY_DIR CASE...\n");
+        return EXIT_USAGE;
+    }
+    ppb_err err = {{0}};
+    if (ppb_report_write(c->args[0], c->args + 1, c->nargs - 1, &err)) {
+        fprintf(stderr, "ppbench report: %s\n", err.msg);
+        return EXIT_RUN;
+    }
+    return EXIT_OK;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") ||
@@ -250,6 +266,8 @@ int main(int argc, char **argv)
         return cmd_sweep(&c);
     if (!strcmp(cmd, "merge"))
         return cmd_merge(&c);
+    if (!strcmp(cmd, "report"))
+        return cmd_report(&c);
     fprintf(stderr, "ppbench: %s: unknown command (see --help)\n", cmd);
     return EXIT_USAGE;
 }
