@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# bench.sh [--quick] [--out DIR] [--set SEC.KEY=VAL ...]: the accuracy study of SPEC.md
+# section 6: every case of configs/study.list with every method, its plots, Table 2 and the
+# study README. Full runs write results/ (committed); --quick writes build/bench-quick/ with a
+# small photon budget, for a look in about a minute.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=results
+sets=()
+while [ $# -gt 0 ]; do
+  case $1 in
+    --quick) out=build/bench-quick
+             sets+=(--set mc.photons=2e6 --set pp.directions=128 --set bins.samples_dir=2) ;;
+    --out) out=$2; shift ;;
+    --set) sets+=(--set "$2"); shift ;;
+    *) echo "bench.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+  shift
+done
+mapfile -t cases < configs/study.list
+mkdir -p "$out"
+t0=$(date +%s)
+for i in "${!cases[@]}"; do
+  c=${cases[$i]}
+  printf '[%d/%d] %s (%ds elapsed)\n' $((i + 1)) ${#cases[@]} "$c" $(( $(date +%s) - t0 )) >&2
+  ./ppbench run "${sets[@]}" --out "$out/$c" "configs/$c.ini"
+  theta=$(awk -F' *= *' '$1 == "theta_deg" {print $2}' "configs/$c.ini")
+  bash scripts/plots.sh "$out/$c" "${theta:-0}"
+done
+./ppbench report "$out" "${cases[@]}"
+printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2
