@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# regress.sh: the regression gate `make test` runs after the unit tests (issue 7).
+# Runs the reduced study (every case of configs/study.list at a small photon budget) and the
+# slab checks (tests/regress/*.ini) under build/regress/ -- never over results/ -- then checks
+# every line of tests/thresholds.txt and prints each check with its measured value.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${REGRESS_OUT:-build/regress}
+photons=${REGRESS_PHOTONS:-3e6}
+mkdir -p "$out"
+t0=$(date +%s)
+mapfile -t cases < configs/study.list
+for c in "${cases[@]}"; do
+  echo "regress: $c ($(( $(date +%s) - t0 ))s)" >&2
+  ./ppbench run --quiet --set mc.photons="$photons" --out "$out/$c" "configs/$c.ini"
+done
+for f in tests/regress/*.ini; do
+  c=$(basename "$f" .ini)
+  echo "regress: $c ($(( $(date +%s) - t0 ))s)" >&2
+  ./ppbench run --quiet --out "$out/$c" "$f"
+done
+
+# value CASE FILE METHOD CELL COLUMN: one number from a case's CSV.
+#   FILE summary*.csv: the row (METHOD, CELL), COLUMN by name.
+#   FILE totals.csv:   COLUMN by name, or "balance" = |R + T + sides + absorbed + ballistic - 1|.
+#   FILE region:       CELL = "S1:x>2" etc.: rms_rel or rms_excess (SPEC.md 5) of METHOD against
+#                      mc over the segments of that surface whose s satisfies the condition.
+value() {
+  local case=$1 file=$2 method=$3 cell=$4 col=$5
+  local dir="$out/$case"
+  case $file in
+    summary*.csv)
+      awk -F, -v m="$method" -v c="$cell" -v col="$col" '
+        NR == 1 {for (i = 1; i <= NF; i++) idx[$i] = i; next}
+        $1 == m && $2 == c {print $(idx[col]); found = 1}
+        END {if (!found) print "missing"}' "$dir/$file" ;;
+    totals.csv)
+      awk -F, -v m="$method" -v col="$col" '
+        NR == 1 {for (i = 1; i <= NF; i++) idx[$i] = i; next}
+        $1 == m {v = (col == "balance") ? $2 + $3 + $4 + $5 + $6 - 1 : $(idx[col]);
+                 if (v < 0 && col == "balance") v = -v; print v; found = 1}
+        END {if (!found) print "missing"}' "$dir/$file" ;;
+    region)
+      local surf=${cell%%:*} cond=${cell#*:}
+      local op=${cond:1:1} lim=${cond:2}
+      awk -F, -v m="$method" -v s="$surf" -v op="$op" -v lim="$lim" -v col="$col" '
+        NR > 1 && $2 == s && ((op == ">" && $4 > lim) || (op == "<" && $4 < lim)) {
+          key = $3 "," $5 "," $6
+          if ($1 == "mc") {ref[key] = $7; se[key] = $8}
+          if ($1 == m) val[key] = $7 }
+        END { for (k in val) { d = val[k] - ref[k]; num += d * d; den += ref[k] * ref[k];
+                               noise += se[k] * se[k] }
+              if (den == 0) {print "missing"; exit}
+              r = num / den; n = noise / den
+              print (col == "rms_excess") ? sqrt(r > n ? r - n : 0) : sqrt(r) }' \
+        "$dir/radiance.csv" ;;
+  esac
+}
+
+fail=0 n=0
+while read -r case file method cell col op limit rest; do
+  [[ -z "$case" || "$case" == \#* ]] && continue
+  v=$(value "$case" "$file" "$method" "$cell" "$col")
+  lim=$limit
+  # A method id as the limit compares against that method's value in the same cell.
+  if ! [[ "$limit" =~ ^[0-9.eE+-]+$ ]]; then lim=$(value "$case" "$file" "$limit" "$cell" "$col"); fi
+  ok=$(awk -v v="$v" -v l="$lim" -v op="$op" 'BEGIN {
+    if (v == "missing" || l == "missing" || v != v + 0) {print 0; exit}
+    print (op == "<" ? v < l : v > l) }')
+  n=$((n + 1))
+  if [ "$ok" = 1 ]; then status=ok; else status=FAIL; fail=1; fi
+  printf '%-4s %-20s %-18s %-6s %-8s %-10s %s = %-10s %s %s\n' "$status" "$case" "$file" \
+    "$method" "$cell" "$col" "" "$v" "$op" "$limit${lim:+ ($lim)}"
+done < tests/thresholds.txt
+echo "regress: $n checks, $([ $fail = 0 ] && echo all passed || echo FAILURES) in $(( $(date +%s) - t0 ))s"
+exit $fail
