@@ -7,6 +7,7 @@
 
 #include "config.h"
 #include "experiment.h"
+#include "mc_shard.h"
 #include "ocl.h"
 #include "perf.h"
 #include "progress.h"
@@ -25,6 +26,10 @@ static void usage(FILE *out)
             "                      SPEC.md section 8's outputs under [output] dir\n"
             "  sweep CONFIG        run a grid sweep (keys holding lists) into <dir>/sweep.csv\n"
             "  merge DIR...        merge sweep shards (--out DIR) into one sweep.csv\n"
+            "  mc-shard CONFIG     trace part --shard I/N of the config's photons into\n"
+            "                      <--out>/mc_tallies.bin\n"
+            "  mc-merge CONFIG DIR...  add the shards' tallies and write mc, mc1 outputs to\n"
+            "                      --out, byte-identical to one run of the whole budget\n"
             "  devices             list OpenCL devices (index: platform / device)\n"
             "  keys                print every config key with its default and range\n"
             "  perf                benchmarks: solver, ray marcher, Monte Carlo\n"
@@ -225,6 +230,28 @@ static int cmd_merge(const cli *c)
     return EXIT_OK;
 }
 
+static int cmd_mc_shard(const cli *c, int merge)
+{
+    if (c->nargs < (merge ? 2 : 1) || (!merge && c->nargs != 1) || !c->out) {
+        fprintf(stderr, "ppbench: usage: ppbench mc-shard --shard I/N --out DIR CONFIG | "
+                        "ppbench mc-merge --out DIR CONFIG SHARD_DIR...\n");
+        return EXIT_USAGE;
+    }
+    static ppb_config cfg;
+    ppb_err err = {{0}};
+    if (load_config(c, c->args[0], &cfg, &err)) {
+        fprintf(stderr, "ppbench: %s\n", err.msg);
+        return EXIT_USAGE;
+    }
+    int rc = merge ? ppb_mc_shard_merge(&cfg, c->args + 1, c->nargs - 1, &err)
+                   : ppb_mc_shard_run(&cfg, c->device, c->quiet, c->shard_i, c->shard_n, &err);
+    if (rc) {
+        fprintf(stderr, "ppbench: %s: %s\n", cfg.path, err.msg);
+        return EXIT_RUN;
+    }
+    return EXIT_OK;
+}
+
 static int cmd_report(const cli *c)
 {
     if (c->nargs < 2) {
@@ -266,6 +293,8 @@ int main(int argc, char **argv)
         return cmd_sweep(&c);
     if (!strcmp(cmd, "merge"))
         return cmd_merge(&c);
+    if (!strcmp(cmd, "mc-shard") || !strcmp(cmd, "mc-merge"))
+        return cmd_mc_shard(&c, !strcmp(cmd, "mc-merge"));
     if (!strcmp(cmd, "report"))
         return cmd_report(&c);
     fprintf(stderr, "ppbench: %s: unknown command (see --help)\n", cmd);
