@@ -1,0 +1,144 @@
+/* Sweeps and Monte Carlo shards (issue 8), through the built binary ($PPBENCH):
+ * - a 2 x 3 x 2 sweep run whole, as 3 shards under GNU parallel then merged, and killed midway
+ *   then resumed, gives byte-identical sweep.csv files (expected: the whole run's bytes);
+ * - one Monte Carlo run split into 4 shards and merged gives radiance.csv and totals.csv
+ *   byte-identical to the single run (photon i's random numbers depend on i alone);
+ * - bad sweep configs fail before any work starts. */
+#include "testutil.h"
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static const char *bin(void)
+{
+    const char *b = getenv("PPBENCH");
+    return b ? b : "./ppbench";
+}
+
+static int sh(const char *fmt, ...)
+{
+    char cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* Cheap methods and a small photon budget: the test is about bookkeeping, not physics. */
+static const char *sweep_cfg =
+    "[experiment]\nname = sw\nmethods = mc, mp\n[tube]\nsegments_top = 16\nsegments_side = 6\n"
+    "[bins]\ntheta = 4\nphi = 4\n[medium]\ng = 0, 0.5\nalbedo = 0.5:0.9:0.2\n"
+    "[light]\ntheta_deg = 0, 30\n[mc]\nphotons = 20000\nbatches = 4\n[mp]\npairs = 2\n";
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void same_bytes(const char *a, const char *b)
+{
+    if (sh("cmp -s '%s' '%s'", a, b) != 0)
+        fail_msg("%s and %s differ", a, b);
+}
+
+static void test_sweep_whole_shards_resume(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("sweep");
+    char cfg[1200];
+    snprintf(cfg, sizeof cfg, "%s/sw.ini", d);
+    write_file(cfg, sweep_cfg);
+    const char *b = bin();
+    assert_int_equal(sh("%s sweep --quiet --out %s/whole %s", b, d, cfg), 0);
+    /* Three shards under GNU parallel, each in its own directory, then merged. */
+    assert_int_equal(sh("parallel --will-cite -j 3 '%s sweep --quiet --shard {}/3 --out %s/s{} "
+                        "%s' ::: 1 2 3",
+                        b, d, cfg),
+                     0);
+    assert_int_equal(sh("%s merge --out %s/merged %s/s1 %s/s2 %s/s3", b, d, d, d, d), 0);
+    char w[1300], m[1300];
+    snprintf(w, sizeof w, "%s/whole/sweep.csv", d);
+    snprintf(m, sizeof m, "%s/merged/sweep.csv", d);
+    same_bytes(w, m);
+    /* Killed once its first point is written, then resumed. */
+    assert_int_equal(sh("cd %s && (%s sweep --quiet --out %s/resumed %s & pid=$!; "
+                        "while ! ls %s/resumed/points/*.csv >/dev/null 2>&1; do sleep 0.05; done; "
+                        "kill -9 $pid; wait $pid; true)",
+                        d, b, d, cfg, d),
+                     0);
+    assert_int_equal(sh("test ! -e %s/resumed/sweep.csv", d), 0);
+    assert_int_equal(sh("%s sweep --quiet --out %s/resumed %s", b, d, cfg), 0);
+    snprintf(m, sizeof m, "%s/resumed/sweep.csv", d);
+    same_bytes(w, m);
+    /* 12 grid points x 2 methods + the header. */
+    assert_int_equal(sh("test $(wc -l < %s) -eq 25", w), 0);
+}
+
+static void test_mc_shards_merge(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("mcshard");
+    char cfg[1200];
+    snprintf(cfg, sizeof cfg, "%s/one.ini", d);
+    write_file(cfg, "[experiment]\nmethods = mc\n[tube]\nsegments_top = 16\nsegments_side = 6\n"
+                    "[mc]\nphotons = 40001\nbatches = 8\nseed = 3\n");
+    const char *b = bin();
+    assert_int_equal(sh("%s run --quiet --out %s/single %s", b, d, cfg), 0);
+    for (int i = 1; i <= 4; i++)
+        assert_int_equal(sh("%s mc-shard --quiet --shard %d/4 --out %s/p%d %s", b, i, d, i, cfg),
+                         0);
+    assert_int_equal(
+        sh("%s mc-merge --out %s/merged %s %s/p1 %s/p2 %s/p3 %s/p4", b, d, cfg, d, d, d, d), 0);
+    const char *files[] = {"radiance.csv", "totals.csv"};
+    for (int i = 0; i < 2; i++) {
+        char a[1300], c[1300];
+        snprintf(a, sizeof a, "%s/single/%s", d, files[i]);
+        snprintf(c, sizeof c, "%s/merged/%s", d, files[i]);
+        same_bytes(a, c);
+    }
+    /* A missing shard is refused: 3 of 4 parts do not make the budget. */
+    assert_int_not_equal(sh("%s mc-merge --out %s/bad %s %s/p1 %s/p2 %s/p3 2>/dev/null", b, d,
+                            cfg, d, d, d),
+                         0);
+}
+
+static void test_bad_sweeps(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("badsweep");
+    char cfg[1200];
+    const char *b = bin();
+    struct {
+        const char *text, *needle;
+    } cases[] = {
+        {"[medium]\ng = 0,,0.5\n", "empty value in list"},
+        {"[medium]\ng = 0:x:0.1\n", "'x' is not a number"},
+        {"[medium]\ng = 0\n", "nothing to sweep"},
+        {"[medium]\ng = -0.9:0.9:0.01\nalbedo = 0:1:0.01\n", "over the limit"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        snprintf(cfg, sizeof cfg, "%s/bad%zu.ini", d, i);
+        write_file(cfg, cases[i].text);
+        if (sh("%s sweep --quiet --out %s/o%zu %s 2>%s/err%zu.txt", b, d, i, cfg, d, i) != 2 ||
+            sh("grep -q -- '%s' %s/err%zu.txt", cases[i].needle, d, i) != 0)
+            fail_msg("sweep config %zu: expected exit 2 and '%s'", i, cases[i].needle);
+        /* Refused before any work: no output directory was made. */
+        assert_int_equal(sh("test ! -e %s/o%zu", d, i), 0);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_sweeps),
+        cmocka_unit_test(test_mc_shards_merge),
+        cmocka_unit_test(test_sweep_whole_shards_resume),
+    };
+    return cmocka_run_group_tests_name("sweep", tests, NULL, NULL);
+}
