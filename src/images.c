@@ -13,11 +13,10 @@
  *   error_<method>.png  for every method but the reference, when there is one: false colour of
  *                       the relative error e = (L_m - L_ref) / L_ref, clamped to +-50%,
  *                       diverging map blue (-50%) .. light grey (0) .. red (+50%); black where
- *                       L_ref <= 0 (no relative error). A colour bar under the views spans
- *                       -50% (left edge) to +50% (right edge) with black ticks every 25%.
- *   all.png             every method's tone-mapped picture side by side in the experiment's
- *                       order (the order of radiance.csv), same exposure.
- * Nothing is written in slab mode. */
+ *                       L_ref <= 0 or L_m is not finite (no relative error). A colour bar under the
+ * views spans -50% (left edge) to +50% (right edge) with black ticks every 25%. all.png every
+ * method's tone-mapped picture side by side in the experiment's order (the order of radiance.csv),
+ * same exposure. Nothing is written in slab mode. */
 #include "images.h"
 
 #include <math.h>
@@ -113,7 +112,7 @@ static double white_level(const img_ctx *c, int from)
 
 static unsigned char srgb_byte(double linear)
 {
-    double x = linear < 0 ? 0 : (linear > 1 ? 1 : linear);
+    double x = !(linear > 0) ? 0 : (linear > 1 ? 1 : linear); /* NaN shows black */
     double e = x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
     return (unsigned char)lround(255.0 * e);
 }
@@ -216,7 +215,7 @@ static int write_error(const img_ctx *c, int i, ppb_err *err)
         double ref = c->value[c->ref][k];
         if (c->kind[k] != PPB_PIX_SURFACE)
             put(px, c->kind[k] == PPB_PIX_CAP ? cap_colour : background);
-        else if (!(ref > 0))
+        else if (!(ref > 0) || !isfinite(c->value[i][k]))
             put(px, no_reference);
         else
             error_colour((c->value[i][k] - ref) / ref, px);

@@ -209,7 +209,8 @@ static fake *fake_new(const char *name, ppb_geometry geometry)
     assert_non_null(f);
     f->cfg.scene = tu_tube();
     f->cfg.scene.geometry = geometry;
-    snprintf(f->cfg.out_dir, sizeof f->cfg.out_dir, "%s/out", tu_scratch(name));
+    int len = snprintf(f->cfg.out_dir, sizeof f->cfg.out_dir, "%s/out", tu_scratch(name));
+    assert_true(len < (int)sizeof f->cfg.out_dir);
     f->ex.cfg = &f->cfg;
     ppb_layout lo = ppb_scene_layout(&f->cfg.scene);
     const char *ids[2] = {"mc", "pp"};
