@@ -12,11 +12,13 @@
  *                       slate blue, cut caps brown.
  *   error_<method>.png  for every method but the reference, when there is one: false colour of
  *                       the relative error e = (L_m - L_ref) / L_ref, clamped to +-50%,
- *                       diverging map blue (-50%) .. light grey (0) .. red (+50%); black where
- *                       L_ref <= 0 or L_m is not finite (no relative error). A colour bar under the
- * views spans -50% (left edge) to +50% (right edge) with black ticks every 25%. all.png every
- * method's tone-mapped picture side by side in the experiment's order (the order of radiance.csv),
- * same exposure. Nothing is written in slab mode. */
+ *                       diverging map blue (-50%) .. light grey (0) .. red (+50%); black
+ *                       where L_ref <= 0 or L_m is not finite (no relative error). A colour
+ *                       bar under the views spans -50% (left edge) to +50% (right edge),
+ *                       black ticks every 25%.
+ *   all.png             every method's tone-mapped picture side by side, in the experiment's
+ *                       order (the order of radiance.csv), same exposure; no labels.
+ * Nothing is written in slab mode. */
 #include "images.h"
 
 #include <math.h>
