@@ -23,9 +23,10 @@ typedef uint32_t ppb_u32;
 #define PPB_MC_FIXED_SCALE 4294967296.0f
 
 /* Russian roulette (unbiased): below this weight a photon survives with probability
- * 1 / PPB_MC_ROULETTE_M and has its weight multiplied by PPB_MC_ROULETTE_M. */
+ * 1 / PPB_MC_ROULETTE_M and has its weight multiplied by PPB_MC_ROULETTE_M (a power of two, so
+ * the survival test and the new weight are exact in float). */
 #define PPB_MC_ROULETTE_W 1e-3f
-#define PPB_MC_ROULETTE_M 10.0f
+#define PPB_MC_ROULETTE_M 8.0f
 
 /* Per-batch totals (each a fixed-point weight sum unless noted). */
 enum {

@@ -140,13 +140,20 @@ static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tall
     return 0;
 }
 
+/* Work-items per launch: enough to fill a GPU's compute units (2048 resident threads each) and,
+ * on a CPU, enough work-groups to balance the cores. Each work-item loops over photons. */
+static long long auto_items(const ppb_ocl *ocl)
+{
+    long long units = ocl->compute_units ? (long long)ocl->compute_units : 1;
+    return units * 2048;
+}
+
+/* Photons per launch: about 32 per work-item keeps launch overhead below a percent. Fixed by
+ * the device, never by timing, so a target-noise run stops at the same photon count every
+ * time on the same device. */
 static long long auto_chunk(const ppb_ocl *ocl)
 {
-    /* Enough work-items to fill every compute unit many times over (tens of thousands per
-     * unit keeps launch overhead below a percent on CPUs and GPUs alike), independent of
-     * timing so that a target-noise run stops at the same photon count every time. */
-    long long units = ocl->compute_units ? (long long)ocl->compute_units : 1;
-    return units * 65536;
+    return auto_items(ocl) * 32;
 }
 
 static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, mc_device *d, long long first,
@@ -209,9 +216,14 @@ static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, mc_device *d, long lo
         long long n = count - done < chunk ? count - done : chunk;
         p.first = (ppb_u64)(first + done);
         p.count = (ppb_u64)n;
-        size_t global = (size_t)n;
+        /* Global size: batches x P work-items, P a multiple of the work-group size, so each
+         * work-group stays inside one batch (see the kernel). */
+        size_t nb_sz = (size_t)t->batches;
+        size_t items = (size_t)(n < auto_items(ocl) ? n : auto_items(ocl));
+        size_t per_batch = (items + nb_sz - 1) / nb_sz;
         if (local)
-            global = (global + local - 1) / local * local;
+            per_batch = (per_batch + local - 1) / local * local;
+        size_t global = per_batch * nb_sz;
         if (ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_PARAMS, sizeof p, &p),
                          "clSetKernelArg(mc params)", err) ||
             ppb_cl_check(clEnqueueNDRangeKernel(ocl->queue, d->kernel, 1, NULL, &global,
