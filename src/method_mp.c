@@ -6,8 +6,9 @@
  * (below the entry point, at every incidence angle: Jensen et al. 2001's placement, not a
  * refracted-direction one), with the medium coefficients of the entry point; each sample point
  * of S1..S4 takes the diffusive flux through its own surface from the 3-D source-to-point
- * vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged over
- * samples_seg points per segment; radiance = flux / pi in every direction bin. */
+ * vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged over the
+ * segment (its 1/rho^2 part exactly, the smooth rest on samples_seg points); radiance = flux / pi
+ * in every direction bin. */
 #include "method_mp.h"
 
 #include <math.h>
@@ -51,32 +52,20 @@ static int mp_pieces(const ppb_config *cfg, mp_piece piece[2], int *npiece, ppb_
     return 0;
 }
 
-/* Flux per unit irradiance on S1 through surface surf at the tube point (x, y). */
-static double mp_point_flux(const ppb_config *cfg, const mp_piece *piece, int npiece, int surf,
-                            double x, double y)
-{
-    double sum = 0;
-    for (int i = 0; i < npiece; i++)
-        sum += ppb_multipole_strip_flux(&piece[i].mp, x, y, ppb_normal_x(surf), ppb_normal_y(surf),
-                                        piece[i].xa, piece[i].xb, cfg->mp.samples);
-    return sum;
-}
-
-/* Segment-averaged flux per unit irradiance: samples_seg points evenly inside the segment. */
+/* Segment-averaged flux per unit irradiance on S1 (multipole.h: the singular part averaged in
+ * closed form, the smooth rest on samples_seg points). */
 static double mp_segment_flux(const ppb_config *cfg, const mp_piece *piece, int npiece, int surf,
                               int seg, double seg_len)
 {
     double x, y;
     ppb_scene_sample_point(&cfg->scene, surf, seg, &x, &y);
-    int m = cfg->samples_seg > 0 ? cfg->samples_seg : 1;
     int along_x = surf == PPB_S1 || surf == PPB_S2;
-    double sum = 0;
-    for (int j = 0; j < m; j++) {
-        double off = ((j + 0.5) / m - 0.5) * seg_len;
-        sum += mp_point_flux(cfg, piece, npiece, surf, x + (along_x ? off : 0),
-                             y + (along_x ? 0 : off));
-    }
-    return sum / m;
+    double dx = along_x ? 0.5 * seg_len : 0, dy = along_x ? 0 : 0.5 * seg_len, sum = 0;
+    for (int i = 0; i < npiece; i++)
+        sum += ppb_multipole_segment_flux(&piece[i].mp, x - dx, y - dy, x + dx, y + dy,
+                                          ppb_normal_x(surf), ppb_normal_y(surf), piece[i].xa,
+                                          piece[i].xb, cfg->mp.samples, cfg->samples_seg);
+    return sum;
 }
 
 static void fill_bins(ppb_result *out, int surf, int seg, double radiance)

@@ -198,3 +198,58 @@ double ppb_multipole_strip_flux(const ppb_multipole *mp, double xp, double yp, d
     }
     return mp->albedo_reduced * sum / (2.0 * PPB_PI);
 }
+
+/* int atan(c / v) dc (v != 0). */
+static double atan_primitive(double c, double v)
+{
+    return c * atan(c / v) - 0.5 * v * log(c * c + v * v);
+}
+
+/* int ln(u^2 + v^2) dv, with 0 ln 0 = 0 at u = v = 0. */
+static double log_primitive(double u, double v)
+{
+    double r2 = u * u + v * v;
+    double vlog = v == 0 ? 0.0 : v * log(r2);
+    return vlog - 2.0 * v + (u == 0 ? 0.0 : 2.0 * u * atan(v / u));
+}
+
+/* Segment average of int_{xa}^{xb} (-u nx + v ny) / (u^2 + v^2) dx_e for one source at depth z:
+ * along x (nx = 0) the exit x runs over [x0, x1] at v = y0 + z; along y (ny = 0) v runs over
+ * [y0 + z, y1 + z] at u = x_e - x0. */
+static double inverse_square_segment(double x0, double y0, double x1, double y1, double nx,
+                                     double ny, double xa, double xb, double z)
+{
+    if (y0 == y1) {
+        double v = y0 + z;
+        if (v == 0 || x1 == x0)
+            return inverse_square_strip(xa - x0, xb - x0, v, nx, ny);
+        double up = atan_primitive(xb - x0, v) - atan_primitive(xb - x1, v);
+        double lo = atan_primitive(xa - x0, v) - atan_primitive(xa - x1, v);
+        return ny * (up - lo) / (x1 - x0);
+    }
+    double va = y0 + z, vb = y1 + z, ua = xa - x0, ub = xb - x0;
+    double logs = (log_primitive(ub, vb) - log_primitive(ub, va)) -
+                  (log_primitive(ua, vb) - log_primitive(ua, va));
+    return -0.5 * nx * logs / (vb - va);
+}
+
+double ppb_multipole_segment_flux(const ppb_multipole *mp, double x0, double y0, double x1,
+                                  double y1, double nx, double ny, double xa, double xb,
+                                  int nodes_per_mfp, int points)
+{
+    if (!(xb > xa))
+        return 0.0;
+    points = points < 1 ? 1 : points;
+    double sum = 0;
+    for (int k = 0; k < ppb_multipole_nsources(mp); k++) {
+        double z = mp->depth[k], rem = 0;
+        for (int j = 0; j < points; j++) {
+            double f = (j + 0.5) / points;
+            double xp = x0 + f * (x1 - x0), yp = y0 + f * (y1 - y0);
+            rem += remainder_strip(mp->sigma_tr, xa - xp, xb - xp, yp + z, nx, ny, nodes_per_mfp);
+        }
+        double line = inverse_square_segment(x0, y0, x1, y1, nx, ny, xa, xb, z) + rem / points;
+        sum += mp->charge[k] * line;
+    }
+    return mp->albedo_reduced * sum / (2.0 * PPB_PI);
+}

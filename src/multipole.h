@@ -69,4 +69,12 @@ double ppb_bessel_k1(double x);
 double ppb_multipole_strip_flux(const ppb_multipole *mp, double xp, double yp, double nx, double ny,
                                 double xa, double xb, int nodes_per_mfp);
 
+/* The same flux averaged over a segment of S1..S4 from (x0, y0) to (x1, y1): along x (y0 = y1,
+ * normal (0, +-1)) or along y (x0 = x1, normal (+-1, 0)). The 1/rho^2 part is averaged in closed
+ * form (primitives of atan and log), which resolves the sides' log singularity at y = -z_r; the
+ * smooth remainder by the midpoint rule on `points` points. */
+double ppb_multipole_segment_flux(const ppb_multipole *mp, double x0, double y0, double x1,
+                                  double y1, double nx, double ny, double xa, double xb,
+                                  int nodes_per_mfp, int points);
+
 #endif
