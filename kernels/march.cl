@@ -1,0 +1,273 @@
+/* march.cl: the ray marcher of `pp` and `ss` (paper Sec. 3, Eq. 13-17; SPEC.md section 7).
+ *
+ * One work-item owns one (segment, direction bin) cell: for every point of the segment and every
+ * direction sample of the bin it marches from the exit point p into the medium along -w to the
+ * far boundary and accumulates
+ *     L(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) J(q, w) dl,   q = p - l w,
+ * with J = [table part at tau = D cos(theta_L), average albedo abar] + C(w, abar) exp(-D) from
+ * the light maps (D, abar, lit). `ss` has C = p(w.w_L) and no table part (paper Eq. 5, n = 1).
+ *
+ * The ray is cut into pieces at every line where the medium or the maps have a jump or a kink
+ * (the step plane x = step_x, the light lines x' = step_x and x' = -W/2). Within a piece sigma_t
+ * and alpha are constant and, where the maps say so, D is linear in l with the slab's slope, lit
+ * and abar are constant: a "regular" piece. Per step of length h:
+ *   direct beam, exact for linear D:  alpha C lit e^{-d1-D1} sigma_t h phi(-(sigma_t h + D2 - D1))
+ *   R table (Eq. 15 with its step length, midpoint rule):  alpha lit sigma_t h e^{-d_mid}
+ * R(tau_mid) S table (Eq. 16-17 corrected, exact for linear tau):   alpha lit e^{-d1} [e^{-sigma_t
+ * h} S(tau2)
+ *                                                                                 - S(tau1)]
+ * with phi(z) = (e^z - 1)/z. Over the steps of a regular piece the S terms telescope, since
+ * d2 = d1 + sigma_t h: their sum is alpha lit [e^{-d_b} S(tau_b) - e^{-d_a} S(tau_a)], and the
+ * direct terms likewise sum to one phi term; the kernel evaluates those identical closed forms
+ * (P.telescope) and steps only through irregular pieces. Where a step's slope differs from the
+ * slab's, the S formula does not hold and that step uses the R rule. */
+#include "march_params.h"
+
+/* (e^z - 1) / z, stable at z = 0. */
+inline double ppb_phi1(double z)
+{
+    return fabs(z) < 1e-300 ? 1.0 : expm1(z) / z;
+}
+
+/* The maps at distance l along the march, tau = D cos(theta_L) clamped to the slab. */
+typedef struct ppb_msample {
+    double D, tau, abar, lit;
+} ppb_msample;
+
+inline ppb_msample ppb_sample(const ppb_march_params *P, __global const double *map, double px,
+                              double py, double mx, double my, double l)
+{
+    ppb_msample s;
+    ppb_map_lookup(map, P->map_xp0, P->map_h, P->map_nx, P->map_ny, P->tan_theta_l, px + l * mx,
+                   py + l * my, &s.D, &s.abar, &s.lit);
+    s.tau = clamp(s.D * P->cos_theta_l, 0.0, P->tau0);
+    return s;
+}
+
+/* Albedo node weights (paper Sec. 3.3: tables at several albedos, interpolated linearly). */
+typedef struct ppb_anodes {
+    int i;
+    double f;
+} ppb_anodes;
+
+inline ppb_anodes ppb_albedo_nodes(const ppb_march_params *P, double abar)
+{
+    ppb_anodes a = {0, 0.0};
+    if (P->nalb > 1) {
+        double t = (abar - P->alb0) / P->alb_h;
+        a.i = clamp((int)floor(t), 0, P->nalb - 2);
+        a.f = clamp(t - a.i, 0.0, 1.0);
+    }
+    return a;
+}
+
+/* Table value at tau, linear in tau and in the albedo nodes. */
+inline double ppb_table(const ppb_march_params *P, __global const double *tab, int ndir, int dir,
+                        ppb_anodes an, double tau)
+{
+    double t = tau / P->tau_h;
+    int k = clamp((int)floor(t), 0, P->ntau - 2);
+    double f = clamp(t - k, 0.0, 1.0);
+    __global const double *c = tab + ((long)an.i * ndir + dir) * P->ntau + k;
+    double v = c[0] + f * (c[1] - c[0]);
+    if (an.f > 0.0) {
+        c += (long)ndir * P->ntau;
+        v += an.f * (c[0] + f * (c[1] - c[0]) - v);
+    }
+    return v;
+}
+
+inline double ppb_coef(__global const double *coef, int ndir, int dir, ppb_anodes an)
+{
+    double v = coef[(long)an.i * ndir + dir];
+    return an.f > 0.0 ? v + an.f * (coef[(long)(an.i + 1) * ndir + dir] - v) : v;
+}
+
+/* Whether the S formula holds between two samples h apart: tau moves with the slab's slope. */
+inline int ppb_slope_ok(double tau1, double tau2, double r0, double sigma_t, double h)
+{
+    return fabs(tau2 - tau1 - r0 * sigma_t * h) <= 1e-9 * (1.0 + fabs(tau1) + fabs(tau2));
+}
+
+/* Marches one piece [la, lb] of constant sigma_t, alpha; returns its radiance and advances *d. */
+inline double ppb_piece(const ppb_march_params *P, __global const double *map,
+                        __global const double *tabR, __global const double *tabS,
+                        __global const double *coefC, int ndir, int dir, double r0, double px,
+                        double py, double mx, double my, double la, double lb, double sigma_t,
+                        double alpha, double *d)
+{
+    double len = lb - la, eps = 1e-9 * len;
+    ppb_msample a = ppb_sample(P, map, px, py, mx, my, la + eps);
+    ppb_msample b = ppb_sample(P, map, px, py, mx, my, lb - eps);
+    ppb_msample m = ppb_sample(P, map, px, py, mx, my, 0.5 * (la + lb));
+    double tolD = 1e-9 * (1.0 + a.D + b.D);
+    /* Bilinear weights sum to 1 only to an ulp, hence the tolerances. */
+    int regular = P->telescope && fabs(a.lit - b.lit) <= 1e-12 && fabs(a.lit - m.lit) <= 1e-12 &&
+                  fabs(a.abar - b.abar) <= 1e-12 && fabs(a.abar - m.abar) <= 1e-12 &&
+                  fabs(m.D - 0.5 * (a.D + b.D)) <= tolD &&
+                  fabs(m.tau - 0.5 * (a.tau + b.tau)) <= tolD;
+    double sum = 0.0, d0 = *d;
+    *d = d0 + sigma_t * len;
+    if (regular) {
+        if (a.lit <= 0.0)
+            return 0.0;
+        ppb_anodes an = ppb_albedo_nodes(P, a.abar);
+        double C = ppb_coef(coefC, ndir, dir, an);
+        /* The direct beam's steps summed: one exponential over the piece. */
+        sum = C * exp(-(d0 + a.D)) * sigma_t * len * ppb_phi1(-(sigma_t * len + b.D - a.D));
+        if (P->with_modes && P->table == PPB_TABLE_S &&
+            ppb_slope_ok(a.tau, b.tau, r0, sigma_t, len - 2.0 * eps)) {
+            sum += exp(-*d) * ppb_table(P, tabS, ndir, dir, an, b.tau) -
+                   exp(-d0) * ppb_table(P, tabS, ndir, dir, an, a.tau);
+        } else if (P->with_modes) {
+            /* R rule on a linear tau: the midpoints need no map lookups. */
+            int n = max(1, (int)ceil(len / P->step));
+            double h = len / n, att = exp(-sigma_t * h), e = exp(-(d0 + 0.5 * sigma_t * h));
+            for (int i = 0; i < n && d0 + sigma_t * h * i < P->d_cap; i++, e *= att)
+                sum += sigma_t * h * e *
+                       ppb_table(P, tabR, ndir, dir, an, a.tau + (b.tau - a.tau) * (i + 0.5) / n);
+        }
+        return alpha * a.lit * sum;
+    }
+    /* Irregular piece: step by step, maps sampled at every step's ends and midpoint. */
+    int n = max(1, (int)ceil(len / P->step));
+    double h = len / n;
+    ppb_msample s1 = a;
+    for (int i = 0; i < n; i++) {
+        double d1 = d0 + sigma_t * h * i;
+        if (d1 > P->d_cap)
+            break;
+        double l1 = la + h * i;
+        ppb_msample s2 = i + 1 == n ? b : ppb_sample(P, map, px, py, mx, my, l1 + h);
+        ppb_msample sm = ppb_sample(P, map, px, py, mx, my, l1 + 0.5 * h);
+        if (sm.lit > 0.0) {
+            ppb_anodes an = ppb_albedo_nodes(P, sm.abar);
+            double C = ppb_coef(coefC, ndir, dir, an);
+            double v = C * exp(-(d1 + s1.D)) * sigma_t * h * ppb_phi1(-(sigma_t * h + s2.D - s1.D));
+            if (P->with_modes) {
+                double hs = (i == 0 ? h - eps : h) - (i + 1 == n ? eps : 0.0);
+                if (P->table == PPB_TABLE_S && ppb_slope_ok(s1.tau, s2.tau, r0, sigma_t, hs))
+                    v += exp(-(d1 + sigma_t * h)) * ppb_table(P, tabS, ndir, dir, an, s2.tau) -
+                         exp(-d1) * ppb_table(P, tabS, ndir, dir, an, s1.tau);
+                else
+                    v += sigma_t * h * exp(-(d1 + 0.5 * sigma_t * h)) *
+                         ppb_table(P, tabR, ndir, dir, an, sm.tau);
+            }
+            sum += sm.lit * v;
+        }
+        s1 = s2;
+    }
+    return alpha * sum;
+}
+
+/* Radiance leaving p = (px, py) in direction w (w.n > 0), per unit E_perp. */
+inline double ppb_march_ray(const ppb_march_params *P, __global const double *map,
+                            __global const double *tabR, __global const double *tabS,
+                            __global const double *coefC, int ndir, int dir, double px, double py,
+                            double wx, double wy)
+{
+    double mx = -wx, my = -wy; /* the march direction, per unit length along the 3-D ray */
+    double lfar = INFINITY;
+    if (my > 0.0)
+        lfar = -py / my;
+    else if (my < 0.0)
+        lfar = (-P->height - py) / my;
+    if (P->tube) {
+        if (mx > 0.0)
+            lfar = fmin(lfar, (0.5 * P->width - px) / mx);
+        else if (mx < 0.0)
+            lfar = fmin(lfar, (-0.5 * P->width - px) / mx);
+    }
+    /* Beyond optical distance d_cap nothing counts (e^-d_cap is below double resolution of the
+     * sum); capping l keeps grazing rays finite. */
+    double sig_min =
+        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
+    lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
+
+    /* Piece ends: the step plane and the light lines through S1's shadow edges. */
+    double brk[5];
+    int nb = 0;
+    brk[nb++] = 0.0;
+    if (P->tube && P->step_kind != PPB_STEP_NONE) {
+        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
+        double cand[3] = {-1.0, -1.0, -1.0};
+        if ((P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO) && mx != 0.0)
+            cand[0] = (P->step_x - px) / mx;
+        if (dxp != 0.0)
+            cand[1] = (P->step_x - xp) / dxp;
+        if (P->tan_theta_l > 0.0 && dxp != 0.0)
+            cand[2] = (-0.5 * P->width - xp) / dxp;
+        for (int k = 0; k < 3; k++)
+            if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
+                brk[nb++] = cand[k];
+    } else if (P->tube && P->tan_theta_l > 0.0) {
+        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
+        double c = dxp != 0.0 ? (-0.5 * P->width - xp) / dxp : -1.0;
+        if (c > 1e-12 && c < lfar - 1e-12)
+            brk[nb++] = c;
+    }
+    for (int i = 2; i < nb; i++) /* insertion sort of at most three breaks */
+        for (int k = i; k > 1 && brk[k] < brk[k - 1]; k--) {
+            double s = brk[k];
+            brk[k] = brk[k - 1];
+            brk[k - 1] = s;
+        }
+    brk[nb++] = lfar;
+
+    double r0 = wy; /* d tau / (sigma_t dl) in a slab: tau = sigma_t depth, depth grows as wy l */
+    double d = 0.0, L = 0.0;
+    for (int k = 0; k + 1 < nb && d < P->d_cap; k++) {
+        double la = brk[k], lb = brk[k + 1];
+        if (lb <= la)
+            continue;
+        double xm = px + 0.5 * (la + lb) * mx;
+        double sigma_t =
+            P->tube ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
+                    : P->sigma_t;
+        double alpha = P->tube
+                           ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
+                           : P->albedo;
+        L += ppb_piece(P, map, tabR, tabS, coefC, ndir, dir, r0, px, py, mx, my, la, lb, sigma_t,
+                       alpha, &d);
+    }
+    return L;
+}
+
+/* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
+ * and the bin's direction samples (SPEC.md section 4). */
+__kernel void ppb_march_kernel(const ppb_march_params P, __global const double *map,
+                               __global const double *tabR, __global const double *tabS,
+                               __global const double *coefC, __global double *out)
+{
+    int nbins = P.ntheta * P.nphi;
+    int gid = (int)get_global_id(0);
+    int row = P.row0 + gid / nbins, bin = gid % nbins;
+    int surf = -1;
+    for (int s = 0; s < PPB_NSURF; s++)
+        if (P.nseg[s] > 0 && row >= P.offset[s] && row < P.offset[s] + P.nseg[s])
+            surf = s;
+    if (surf < 0)
+        return;
+    int seg = row - P.offset[surf], nsurf = P.tube ? 4 : 2;
+    int ndir = nsurf * nbins * P.nsamp * P.nsamp;
+    double cx = 0.0, cy = surf == PPB_S1 ? 0.0 : -P.height, seglen = 0.0;
+    int along_x = surf == PPB_S1 || surf == PPB_S2;
+    if (P.tube) {
+        ppb_segment_centre(surf, seg, P.nseg[surf], P.width, P.height, &cx, &cy);
+        seglen = (along_x ? P.width : P.height) / P.nseg[surf];
+    }
+    int npts = P.tube ? P.npts : 1;
+    double sum = 0.0;
+    for (int ip = 0; ip < npts; ip++) {
+        double o = ((ip + 0.5) / npts - 0.5) * seglen;
+        double px = cx + (along_x ? o : 0.0), py = cy + (along_x ? 0.0 : o);
+        for (int a = 0; a < P.nsamp; a++)
+            for (int b = 0; b < P.nsamp; b++) {
+                double wx, wy, wz;
+                ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
+                int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
+                sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, wx, wy);
+            }
+    }
+    out[(long)row * nbins + bin] = sum / (npts * P.nsamp * P.nsamp);
+}

@@ -1,0 +1,124 @@
+/* march_params.h: the one definition of what the ray-marching kernel (march.cl) receives, shared
+ * by the host (src/maps.c, src/march_tables.c, src/march.c) and the kernel.
+ *
+ * Owns: the launch parameters passed by value, the kernel argument indices, the layout of the
+ * light maps (paper Sec. 3.1 and 3.3: optical depth D along the light path and average albedo)
+ * and their bilinear lookup, the order of the direction samples that index the integral tables
+ * (paper Eq. 15-17), and the Henyey-Greenstein phase function (paper Sec. 4.1).
+ *
+ * Plain C that is also OpenCL C, like ppb_conventions.h. */
+#ifndef PPB_MARCH_PARAMS_H
+#define PPB_MARCH_PARAMS_H
+
+#include "ppb_conventions.h"
+
+#ifdef __OPENCL_VERSION__
+#define PPB_GMEM __global
+#else
+#define PPB_GMEM
+#endif
+
+/* Which table the march integrates the plane-parallel modes with (cfg->pp.table). */
+enum { PPB_TABLE_R = 0, PPB_TABLE_S = 1 };
+
+/* Kernel arguments of ppb_march_kernel, by index. */
+enum {
+    PPB_MARCH_ARG_PARAMS = 0, /* ppb_march_params by value */
+    PPB_MARCH_ARG_MAP = 1,    /* map cells, PPB_MAP_STRIDE doubles each */
+    PPB_MARCH_ARG_TAB_R = 2,  /* R table [nalb][ndir][ntau] (paper Eq. 15) */
+    PPB_MARCH_ARG_TAB_S = 3,  /* S table [nalb][ndir][ntau] (paper Eq. 16-17, corrected) */
+    PPB_MARCH_ARG_COEF_C = 4, /* [nalb][ndir]: coefficient of exp(-D) in the source */
+    PPB_MARCH_ARG_OUT = 5,    /* radiance [rows][nbins] */
+    PPB_MARCH_NARGS = 6
+};
+
+/* Map cell layout: every cell of the light-aligned grid stores its four corner values of each
+ * field as limits taken from inside the cell, so a jump that lies on a cell edge (the density or
+ * albedo step at normal incidence, a shadow edge) stays sharp under bilinear interpolation.
+ * Corner c = cx + 2 cy, cx along x', cy downwards in depth. */
+enum {
+    PPB_MAP_D = 0,    /* optical depth along the light path from S1, continued into shadow */
+    PPB_MAP_ABAR = 1, /* average albedo along the light path (paper Sec. 3.3) */
+    PPB_MAP_LIT = 2,  /* 1 lit, 0 shadowed (D is infinite there: the source is zero) */
+    PPB_MAP_NFIELD = 3,
+    PPB_MAP_STRIDE = 12 /* PPB_MAP_NFIELD x 4 corners */
+};
+
+/* Parameters of one launch, passed by value. All doubles first, then an even number of ints, so
+ * host and device agree on the layout without packing attributes; the host asserts the size. */
+typedef struct ppb_march_params {
+    /* scene (SPEC.md sections 1-3) */
+    double width, height; /* W (tube only), H */
+    double sigma_t, sigma_t_right, albedo, albedo_right, step_x;
+    double tan_theta_l, cos_theta_l; /* light incidence */
+    double light_x, light_y;         /* w_L = (light_x, light_y, 0) */
+    /* map: light-aligned grid over x' = x + y tan(theta_L) and depth -y */
+    double map_xp0; /* x' of the first node column */
+    double map_h;   /* cell size, mfp */
+    /* tables over tau = D cos(theta_L) in [0, tau0] and the average albedo */
+    double tau0, tau_h;
+    double alb0, alb_h;
+    /* march */
+    double step;  /* ray-march step length, mfp */
+    double d_cap; /* optical distance from the exit point beyond which the march stops */
+    int tube;     /* 1 tube, 0 slab */
+    int step_kind;
+    int map_nx, map_ny;
+    int ntau, nalb;
+    int with_modes; /* 0: single scattering (ss), no tables */
+    int table;      /* PPB_TABLE_R or PPB_TABLE_S */
+    int telescope;  /* 1: a regular piece's S-table step sum in closed form (exact identity) */
+    int nsamp;      /* direction samples per bin axis (n x n per bin) */
+    int npts;       /* points per segment */
+    int ntheta, nphi;
+    int row0;      /* first segment row of this launch */
+    int nseg[4];   /* segments per surface (slab: 1, 1, 0, 0) */
+    int offset[4]; /* first segment row of each surface, as ppb_layout */
+} ppb_march_params;
+
+/* Henyey-Greenstein phase function of the scattering cosine, per steradian (paper Sec. 4.1). */
+PPB_FN double ppb_hg_phase(double g, double cos_angle)
+{
+    double den = 1.0 + g * g - 2.0 * g * cos_angle;
+    return (1.0 - g * g) / (4.0 * PPB_PI * den * sqrt(den));
+}
+
+/* Direction sample (a, b) of bin (itheta, iphi) on surface surf: the stratified midpoints of an
+ * n x n grid in (sin^2 theta, phi), i.e. uniform in projected solid angle (SPEC.md section 4). */
+PPB_FN void ppb_march_dir(int surf, int bin, int a, int b, int n, int ntheta, int nphi, double *wx,
+                          double *wy, double *wz)
+{
+    ppb_bin_direction(surf, bin / nphi, bin % nphi, (a + 0.5) / n, (b + 0.5) / n, ntheta, nphi, wx,
+                      wy, wz);
+}
+
+/* Column of the integral tables that belongs to that direction sample. */
+PPB_FN int ppb_march_dir_index(int surf, int bin, int a, int b, int n, int nbins)
+{
+    return ((surf * nbins + bin) * n + a) * n + b;
+}
+
+/* Bilinear map lookup at (x, y): D, average albedo and lit fraction. x is sheared along the light
+ * (x' = x + y tan theta_L) so that every light path is a grid column: D is linear along it and
+ * shadow edges are column edges. Points off the grid take the nearest cell's extrapolation
+ * clamped to it. */
+PPB_FN void ppb_map_lookup(const PPB_GMEM double *cells, double xp0, double h, int nx, int ny,
+                           double tan_theta_l, double x, double y, double *D, double *abar,
+                           double *lit)
+{
+    double fx = (x + y * tan_theta_l - xp0) / h, fy = -y / h;
+    int i = (int)floor(fx), j = (int)floor(fy);
+    i = i < 0 ? 0 : (i >= nx ? nx - 1 : i);
+    j = j < 0 ? 0 : (j >= ny ? ny - 1 : j);
+    double tx = fx - i, ty = fy - j;
+    tx = tx < 0.0 ? 0.0 : (tx > 1.0 ? 1.0 : tx);
+    ty = ty < 0.0 ? 0.0 : (ty > 1.0 ? 1.0 : ty);
+    const PPB_GMEM double *c = cells + ((long)j * nx + i) * PPB_MAP_STRIDE;
+    double w00 = (1.0 - tx) * (1.0 - ty), w10 = tx * (1.0 - ty), w01 = (1.0 - tx) * ty,
+           w11 = tx * ty;
+    *D = w00 * c[0] + w10 * c[1] + w01 * c[2] + w11 * c[3];
+    *abar = w00 * c[4] + w10 * c[5] + w01 * c[6] + w11 * c[7];
+    *lit = w00 * c[8] + w10 * c[9] + w01 * c[10] + w11 * c[11];
+}
+
+#endif

@@ -1,0 +1,246 @@
+/* march.c: host side of the ray marcher (march.h). */
+#include "march.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "progress.h"
+
+_Static_assert(sizeof(ppb_march_params) == 19 * sizeof(double) + 22 * sizeof(int),
+               "ppb_march_params: doubles first, an even number of ints, no padding");
+
+static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
+{
+    static const double zero = 0.0;
+    cl_int rc;
+    /* A zero-length buffer is not allowed: unused tables get one element. */
+    cl_mem m = clCreateBuffer(ocl->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                              (data ? n : 1) * sizeof(double), (void *)(data ? data : &zero), &rc);
+    if (rc != CL_SUCCESS) {
+        ppb_fail(err, "OpenCL: clCreateBuffer(%s, %zu doubles) failed: %s", what, n,
+                 ppb_cl_errname(rc));
+        return NULL;
+    }
+    return m;
+}
+
+int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
+                     const ppb_march_tables *tab, const ppb_march_opts *opts, ppb_err *err)
+{
+    memset(mr, 0, sizeof *mr);
+    mr->ocl = ocl;
+    ppb_layout lo = ppb_scene_layout(sc);
+    mr->nbins = lo.nbins;
+    mr->rows = (int)(lo.ncells / (size_t)lo.nbins);
+    double th = sc->theta_deg * PPB_PI / 180.0, wl[3];
+    ppb_scene_light_dir(sc, wl);
+    int tube = sc->geometry == PPB_GEOM_TUBE;
+    ppb_march_params P = {
+        .width = sc->width,
+        .height = sc->height,
+        .sigma_t = sc->sigma_t,
+        .sigma_t_right = sc->sigma_t_right,
+        .albedo = sc->albedo,
+        .albedo_right = sc->albedo_right,
+        .step_x = sc->step_x,
+        .tan_theta_l = tan(th),
+        .cos_theta_l = cos(th),
+        .light_x = wl[0],
+        .light_y = wl[1],
+        .map_xp0 = maps->xp0,
+        .map_h = maps->h,
+        .tau0 = tab->tau0,
+        .tau_h = tab->tau_h,
+        .alb0 = tab->alb0,
+        .alb_h = tab->alb_h,
+        .step = opts->step,
+        .d_cap = opts->d_cap > 0.0 ? opts->d_cap : 40.0,
+        .tube = tube,
+        .step_kind = tube ? sc->step : PPB_STEP_NONE,
+        .map_nx = maps->nx,
+        .map_ny = maps->ny,
+        .ntau = tab->ntau,
+        .nalb = tab->nalb,
+        .with_modes = tab->R != NULL,
+        .table = (opts->table == PPB_TABLE_S && tab->S) ? PPB_TABLE_S : PPB_TABLE_R,
+        .telescope = opts->telescope,
+        .nsamp = tab->nsamp,
+        .npts = opts->npts < 1 ? 1 : opts->npts,
+        .ntheta = sc->ntheta,
+        .nphi = sc->nphi,
+    };
+    for (int s = 0; s < PPB_NSURF; s++) {
+        P.nseg[s] = lo.nseg[s];
+        P.offset[s] = lo.offset[s];
+    }
+    mr->params = P;
+    if (ppb_ocl_build(ocl, "march.cl", "", &mr->prog, err) ||
+        ppb_ocl_kernel(mr->prog, "ppb_march_kernel", &mr->kernel, err))
+        goto fail;
+    size_t tsize = (size_t)tab->nalb * tab->ndir * tab->ntau;
+    mr->map = upload(ocl, maps->cells, (size_t)maps->nx * maps->ny * PPB_MAP_STRIDE, "map", err);
+    if (!mr->map)
+        goto fail;
+    mr->tab_r = upload(ocl, tab->R, tsize, "R table", err);
+    if (!mr->tab_r)
+        goto fail;
+    mr->tab_s = upload(ocl, tab->S, tsize, "S table", err);
+    if (!mr->tab_s)
+        goto fail;
+    mr->coef_c = upload(ocl, tab->C, (size_t)tab->nalb * tab->ndir, "beam coefficients", err);
+    if (!mr->coef_c)
+        goto fail;
+    cl_int rc;
+    mr->out =
+        clCreateBuffer(ocl->context, CL_MEM_WRITE_ONLY, lo.ncells * sizeof(double), NULL, &rc);
+    if (ppb_cl_check(rc, "clCreateBuffer(radiance)", err))
+        goto fail;
+    cl_mem args[] = {[PPB_MARCH_ARG_MAP] = mr->map,
+                     [PPB_MARCH_ARG_TAB_R] = mr->tab_r,
+                     [PPB_MARCH_ARG_TAB_S] = mr->tab_s,
+                     [PPB_MARCH_ARG_COEF_C] = mr->coef_c,
+                     [PPB_MARCH_ARG_OUT] = mr->out};
+    for (int i = PPB_MARCH_ARG_MAP; i < PPB_MARCH_NARGS; i++)
+        if (ppb_cl_check(clSetKernelArg(mr->kernel, i, sizeof(cl_mem), &args[i]),
+                         "clSetKernelArg(march)", err))
+            goto fail;
+    return 0;
+fail:
+    ppb_marcher_free(mr);
+    return -1;
+}
+
+int ppb_marcher_run(ppb_marcher *mr, int row0, int nrows, ppb_err *err)
+{
+    if (nrows <= 0)
+        return 0;
+    mr->params.row0 = row0;
+    if (ppb_cl_check(
+            clSetKernelArg(mr->kernel, PPB_MARCH_ARG_PARAMS, sizeof mr->params, &mr->params),
+            "clSetKernelArg(march params)", err))
+        return -1;
+    size_t global = (size_t)nrows * (size_t)mr->nbins;
+    if (ppb_cl_check(clEnqueueNDRangeKernel(mr->ocl->queue, mr->kernel, 1, NULL, &global, NULL, 0,
+                                            NULL, NULL),
+                     "clEnqueueNDRangeKernel(march)", err))
+        return -1;
+    return ppb_cl_check(clFinish(mr->ocl->queue), "clFinish(march)", err);
+}
+
+int ppb_marcher_read(ppb_marcher *mr, double *radiance, ppb_err *err)
+{
+    size_t n = (size_t)mr->rows * (size_t)mr->nbins;
+    return ppb_cl_check(clEnqueueReadBuffer(mr->ocl->queue, mr->out, CL_TRUE, 0, n * sizeof(double),
+                                            radiance, 0, NULL, NULL),
+                        "clEnqueueReadBuffer(march radiance)", err);
+}
+
+void ppb_marcher_free(ppb_marcher *mr)
+{
+    cl_mem bufs[] = {mr->map, mr->tab_r, mr->tab_s, mr->coef_c, mr->out};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
+        if (bufs[i])
+            clReleaseMemObject(bufs[i]);
+    if (mr->kernel)
+        clReleaseKernel(mr->kernel);
+    if (mr->prog)
+        clReleaseProgram(mr->prog);
+    memset(mr, 0, sizeof *mr);
+}
+
+int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
+                  const ppb_march_tables *tab, const ppb_march_opts *opts, const char *label,
+                  int quiet, double *radiance, int *partial, ppb_err *err)
+{
+    ppb_marcher mr;
+    if (ppb_marcher_init(&mr, ocl, sc, maps, tab, opts, err))
+        return -1;
+    /* Launches of a few rows each let progress lines and Ctrl-C through; a row is 64 cells. */
+    const int chunk = 16;
+    ppb_progress pr;
+    ppb_progress_begin(&pr, label, "rows", mr.rows, quiet);
+    int done = 0, rc = 0;
+    *partial = 0;
+    while (done < mr.rows) {
+        if (ppb_interrupted()) {
+            *partial = 1;
+            break;
+        }
+        int n = mr.rows - done < chunk ? mr.rows - done : chunk;
+        if ((rc = ppb_marcher_run(&mr, done, n, err)))
+            break;
+        done += n;
+        ppb_progress_update(&pr, done);
+    }
+    ppb_progress_end(&pr, done);
+    if (!rc) {
+        /* Rows never marched read as zero. */
+        memset(radiance, 0, (size_t)mr.rows * mr.nbins * sizeof *radiance);
+        rc = ppb_marcher_read(&mr, radiance, err);
+        if (*partial)
+            memset(radiance + (size_t)done * mr.nbins, 0,
+                   (size_t)(mr.rows - done) * mr.nbins * sizeof *radiance);
+    }
+    ppb_marcher_free(&mr);
+    return rc;
+}
+
+void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
+                      ppb_totals *t)
+{
+    int tube = sc->geometry == PPB_GEOM_TUBE;
+    double psa = ppb_bin_proj_solid_angle(sc->ntheta, sc->nphi);
+    double flux[PPB_NSURF] = {0};
+    for (int s = 0; s < lo->nsurf; s++) {
+        double seglen =
+            !tube ? 1.0 : (s == PPB_S1 || s == PPB_S2 ? sc->width : sc->height) / lo->nseg[s];
+        for (int seg = 0; seg < lo->nseg[s]; seg++)
+            for (int b = 0; b < lo->nbins; b++)
+                flux[s] += radiance[ppb_cell(lo, s, seg, b)] * psa * seglen;
+    }
+    double entering = ppb_scene_lit_width(sc) * cos(sc->theta_deg * PPB_PI / 180.0);
+    memset(t, 0, sizeof *t);
+    if (entering > 0.0) {
+        t->R = flux[PPB_S1] / entering;
+        t->T = flux[PPB_S2] / entering;
+        t->sides = (flux[PPB_S3] + flux[PPB_S4]) / entering;
+    }
+    t->ballistic = ppb_ballistic_fraction(sc);
+    t->absorbed_tracked = 0;
+    ppb_totals_complete(t);
+}
+
+/* Tau resolution of the tables, nodes per unit optical depth: linear interpolation in tau. */
+#define PPB_TABLE_TAU_PER_MFP 64
+
+int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err)
+{
+    const ppb_config *cfg = ctx->cfg;
+    const ppb_scene *sc = &cfg->scene;
+    ppb_ocl *ocl;
+    if (ppb_ctx_ocl(ctx, &ocl, err))
+        return -1;
+    ppb_maps maps = {0};
+    ppb_march_tables tab = {0};
+    if (ppb_maps_build(sc, cfg->pp.map_res, &maps, err))
+        return -1;
+    int rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_TABLE_TAU_PER_MFP,
+                                              &tab, err)
+                        : ppb_march_tables_ss(sc, cfg->samples_dir, &tab, err);
+    if (rc) {
+        ppb_maps_free(&maps);
+        return -1;
+    }
+    ppb_march_opts opts = {
+        .table = cfg->pp.table, .step = cfg->pp.step, .telescope = 1, .npts = cfg->samples_seg};
+    rc = ppb_march_all(ocl, sc, &maps, &tab, &opts, out->method, ctx->quiet, out->radiance,
+                       &out->partial, err);
+    if (!rc) {
+        memset(out->se, 0, out->layout.ncells * sizeof *out->se);
+        ppb_march_totals(sc, &out->layout, out->radiance, &out->totals);
+    }
+    ppb_march_tables_free(&tab);
+    ppb_maps_free(&maps);
+    return rc;
+}
