@@ -1,0 +1,37 @@
+/* phase.h: the Henyey-Greenstein phase matrix of the direction cells (paper Eq. 8, with the
+ * consistent Galerkin form of SPEC.md section 10).
+ *
+ * Owns p(cos) = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2)) (normalised over 4 pi, so a row of
+ * P sums to 1), the cell-pair integrals S_ij = double integral of p over Omega_i x Omega_j
+ * (symmetric; P_ij = S_ij / |Omega_i|), and the cell integrals F_j(w) = integral of p(w.w')
+ * over Omega_j for one continuous direction w. Derivation: with I = sum_j I_j 1_{Omega_j},
+ * averaging alpha * integral p I over Omega_i gives alpha sum_j P_ij I_j with P_ij as above
+ * (paper Eq. 7-8 carry a stray |Omega| factor, SPEC.md section 10).
+ *
+ * Quadrature: product Gauss per cell (directions.h), the order chosen per pair from how close
+ * the pair comes to the HG peak (its complex singularity lies sqrt(D / |g|) away in angle,
+ * D = 1 + g^2 - 2|g| cos(theta_min)), so far pairs cost 9-16 nodes and touching pairs of a
+ * g = 0.95 function get up to 16 x 16 per cell. The self term (and for F the cell holding w)
+ * is not integrated: it is set so that rows conserve energy exactly (sum_j S_ij = |Omega_i|,
+ * sum_j F_j = 1), which keeps S symmetric and puts the small quadrature residual where the
+ * peak sits. */
+#ifndef PPB_PHASE_H
+#define PPB_PHASE_H
+
+#include "directions.h"
+#include "err.h"
+
+/* HG phase function per steradian; |g| < 1. */
+double pp_hg(double g, double cos_theta);
+
+/* The two N x N blocks of S (row-major): Sa_ij = S(up i, up j), Sb_ij = S(up i, down N + j).
+ * By the up/down mirror S(down, down) = Sa and S(down, up) = Sb; both blocks are symmetric. */
+int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err);
+
+/* The full 2N x 2N matrix P_ij = S_ij / |Omega_i| (rows sum to 1); for tests and small N. */
+int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err);
+
+/* F[j] = integral over cell j of p(w . w') dw' for j in [0, 2N), summing to 1. */
+int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err);
+
+#endif
