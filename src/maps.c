@@ -141,8 +141,8 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
     if (b <= a)
         return 0.0;
     /* The integrand is smooth between the entry points where the path's end switches from S2 to
-     * S4 or where it starts or ends on the step; composite Simpson between those breaks is exact
-     * to ~1e-12 for these exponentials. */
+     * S4 or where it starts or ends on the step (it may jump there); Gauss-Legendre panels between
+     * those breaks never sample a break and are exact to ~1e-14 for these exponentials. */
     double t = tan(th), brk[5] = {a, b, 0, 0, 0};
     int nb = 2;
     double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
@@ -155,16 +155,19 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
             brk[k] = brk[k - 1];
             brk[k - 1] = s;
         }
+    static const double gx[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                                 0.9061798459386640};
+    static const double gw[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+                                 0.4786286704993665, 0.2369268850561891};
+    const int panels = 64;
     double sum = 0.0;
-    const int panels = 512;
     for (int p = 0; p + 1 < nb; p++) {
-        double lo = brk[p], hi = brk[p + 1], hstep = (hi - lo) / panels;
-        if (hi <= lo)
-            continue;
-        double s = beam_transmittance(sc, lo) + beam_transmittance(sc, hi);
-        for (int k = 1; k < panels; k++)
-            s += (k & 1 ? 4.0 : 2.0) * beam_transmittance(sc, lo + k * hstep);
-        sum += s * hstep / 3.0;
+        double hstep = (brk[p + 1] - brk[p]) / panels;
+        for (int k = 0; hstep > 0.0 && k < panels; k++) {
+            double mid = brk[p] + (k + 0.5) * hstep;
+            for (int q = 0; q < 5; q++)
+                sum += 0.5 * hstep * gw[q] * beam_transmittance(sc, mid + 0.5 * hstep * gx[q]);
+        }
     }
     return sum / (b - a);
 }

@@ -1,0 +1,249 @@
+/* test_maps.c: the light maps (src/maps.h) against closed forms of SPEC.md sections 1-3 for the
+ * uniform tube, the three step cases and oblique light, and the exact ballistic fraction. */
+#include "testutil.h"
+
+#include <math.h>
+
+#include "maps.h"
+
+/* cmocka's assert_float_equal compares floats; these checks need doubles. */
+#define assert_close(a, b, tol)                                                                    \
+    do {                                                                                           \
+        double a_ = (a), b_ = (b);                                                                 \
+        if (!(fabs(a_ - b_) <= (tol)))                                                             \
+            fail_msg("%s = %.15g, expected %.15g (tol %g)", #a, a_, b_, (double)(tol));            \
+    } while (0)
+
+/* The map at 16 cells per mfp: every study case's jumps lie on cell edges, so the bilinear
+ * lookup must reproduce the closed forms to rounding wherever it is read. */
+#define RES 16
+
+static ppb_maps build(const ppb_scene *sc)
+{
+    ppb_maps m;
+    ppb_err err;
+    if (ppb_maps_build(sc, RES, &m, &err))
+        fail_msg("%s", err.msg);
+    return m;
+}
+
+/* A grid of probe points over the cross-section, off the cell edges and on them. */
+#define NPX 41
+#define NPY 13
+static void probe(int i, int j, double *x, double *y)
+{
+    *x = -5.0 + 10.0 * i / (NPX - 1) * 0.9999 + 1e-4 * (i == 0);
+    *y = -3.0 * j / (NPY - 1) * 0.9999;
+}
+
+static void test_uniform_normal(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    ppb_maps m = build(&sc);
+    for (int i = 0; i < NPX; i++)
+        for (int j = 0; j < NPY; j++) {
+            double x, y, D, abar, lit;
+            probe(i, j, &x, &y);
+            ppb_maps_lookup(&m, x, y, &D, &abar, &lit);
+            assert_close(D, -y, 1e-9);       /* D = sigma_t depth (vertical light) */
+            assert_close(abar, 0.95, 1e-12); /* one albedo */
+            assert_close(lit, 1.0, 1e-12);   /* all of S1 lit */
+        }
+    ppb_maps_free(&m);
+}
+
+static void test_density_step(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.step = PPB_STEP_DENSITY;
+    ppb_maps m = build(&sc);
+    /* Closed form: the vertical light path stays in its column, D = sigma_t(x) |y|, with
+     * sigma_t = 1 for x < 0 and 0.5 for x >= 0 (SPEC.md section 6, density_step). Probes right
+     * beside the step test that the jump is kept sharp. */
+    double xs[] = {-4.9, -1.0, -0.01, -1e-6, 0.0, 1e-6, 0.01, 2.5, 4.99};
+    for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++)
+        for (int j = 0; j < NPY; j++) {
+            double y = -3.0 * j / (NPY - 1), D, abar, lit;
+            ppb_maps_lookup(&m, xs[i], y, &D, &abar, &lit);
+            assert_close(D, (xs[i] < 0 ? 1.0 : 0.5) * -y, 1e-8);
+            assert_close(abar, 0.95, 1e-12);
+        }
+    ppb_maps_free(&m);
+}
+
+static void test_albedo_step(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.step = PPB_STEP_ALBEDO;
+    ppb_maps m = build(&sc);
+    /* Closed form: the average along a vertical path is the column's own albedo, 0.95 left of
+     * x = 0 and 0.475 right of it; D is unchanged, |y|. */
+    double xs[] = {-4.9, -0.01, -1e-6, 1e-6, 0.01, 4.9};
+    for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++)
+        for (int j = 0; j < NPY; j++) {
+            double y = -3.0 * j / (NPY - 1), D, abar, lit;
+            ppb_maps_lookup(&m, xs[i], y, &D, &abar, &lit);
+            assert_close(abar, xs[i] < 0 ? 0.95 : 0.475, 1e-8);
+            assert_close(D, -y, 1e-8);
+        }
+    ppb_maps_free(&m);
+}
+
+static void test_shadow_step(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.step = PPB_STEP_SHADOW;
+    ppb_maps m = build(&sc);
+    /* SPEC.md section 3: S1 lit for x < 0 only; with vertical light D = |y| there and infinite
+     * (ppb_maps_depth) under the dark half, right up to the edge. */
+    double xs[] = {-4.9, -0.5, -1e-6, 1e-6, 0.5, 4.9};
+    for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++)
+        for (int j = 0; j < NPY; j++) {
+            double y = -3.0 * j / (NPY - 1);
+            double D = ppb_maps_depth(&m, xs[i], y);
+            if (xs[i] < 0)
+                assert_close(D, -y, 1e-8);
+            else
+                assert_true(isinf(D));
+        }
+    ppb_maps_free(&m);
+}
+
+static void test_oblique_shadow_triangle(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.theta_deg = 45;
+    ppb_maps m = build(&sc);
+    /* SPEC.md section 3 at 45 deg: D = sqrt(2) |y| along the slanted path, and the triangle
+     * x < -W/2 + |y| next to S3 is in shadow. The map's columns follow the light, so the edge is
+     * a column edge: exact on both sides. */
+    for (int i = 0; i < NPX; i++)
+        for (int j = 0; j < NPY; j++) {
+            double x, y;
+            probe(i, j, &x, &y);
+            double edge = -5.0 - y;
+            if (fabs(x - edge) < 1e-7)
+                continue;
+            double D = ppb_maps_depth(&m, x, y);
+            if (x > edge)
+                assert_close(D, sqrt(2.0) * -y, 1e-8);
+            else
+                assert_true(isinf(D));
+        }
+    /* S3 itself is dark below its top corner. */
+    assert_true(isinf(ppb_maps_depth(&m, -5.0, -0.5)));
+    ppb_maps_free(&m);
+}
+
+static void test_oblique_density_exact(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.theta_deg = 45;
+    sc.step = PPB_STEP_DENSITY;
+    /* Closed form at (x, y) = (1, -2): the path to S1 runs up-left to x' = -1; it spends
+     * |dx| = 1 right of x = 0 and 1 left, each sqrt(2) long: D = sqrt(2)(0.5 + 1). */
+    double D, abar;
+    int lit;
+    ppb_light_path_exact(&sc, 1.0, -2.0, &D, &abar, &lit);
+    assert_close(D, sqrt(2.0) * 1.5, 1e-12);
+    assert_int_equal(lit, 1);
+    /* The map is exact away from the kink lines (the step and the light line through its foot)
+     * and converges to the exact value next to them as map_res grows. */
+    ppb_maps m = build(&sc);
+    ppb_maps_lookup(&m, 1.0 + 0.5 / RES, -2.0 + 0.25 / RES, &D, &abar, &(double){0});
+    double Dx;
+    ppb_light_path_exact(&sc, 1.0 + 0.5 / RES, -2.0 + 0.25 / RES, &Dx, &abar, &lit);
+    assert_close(D, Dx, 1e-8);
+    ppb_maps_free(&m);
+    double errs[2];
+    int res[2] = {8, 64};
+    for (int r = 0; r < 2; r++) {
+        ppb_err err;
+        assert_int_equal(ppb_maps_build(&sc, res[r], &m, &err), 0);
+        double worst = 0.0, lt;
+        for (int k = 0; k < 200; k++) { /* points straddling the step line x = 0 */
+            double x = -0.05 + 0.1 * k / 199.0, y = -1.7, Dm, Dx2, ab;
+            ppb_maps_lookup(&m, x, y, &Dm, &ab, &lt);
+            ppb_light_path_exact(&sc, x, y, &Dx2, &ab, &lit);
+            worst = fmax(worst, fabs(Dm - Dx2));
+        }
+        errs[r] = worst;
+        ppb_maps_free(&m);
+    }
+    /* Linear interpolation across a kink: error ~ h x slope jump, so 8x finer cells cut it ~8x. */
+    assert_true(errs[1] < errs[0] / 4.0);
+}
+
+static void test_average_albedo_oblique(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.theta_deg = 45;
+    sc.step = PPB_STEP_ALBEDO;
+    /* Paper Sec. 3.3: length average along the path. From (1, -2) the path has half its length
+     * on each side of x = 0: (0.95 + 0.475) / 2. */
+    double D, abar;
+    int lit;
+    ppb_light_path_exact(&sc, 1.0, -2.0, &D, &abar, &lit);
+    assert_close(abar, 0.7125, 1e-12);
+    ppb_maps m = build(&sc);
+    double Dm, am, lt;
+    ppb_maps_lookup(&m, 1.0, -2.0, &Dm, &am, &lt);
+    assert_close(am, 0.7125, 1e-8); /* (1, -2) lies in a cell no kink line cuts */
+    ppb_maps_free(&m);
+}
+
+static void test_slab(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_slab(2.0, 0.9, 0.0, 30.0);
+    ppb_maps m = build(&sc);
+    /* Slab mode: D = depth / cos(theta_L) at any x (SPEC.md section 2). */
+    for (int j = 0; j <= 20; j++) {
+        double y = -2.0 * j / 20.0;
+        for (double x = -100; x <= 100; x += 37.5)
+            assert_close(ppb_maps_depth(&m, x, y), -y / cos(PPB_PI / 6), 1e-9);
+    }
+    ppb_maps_free(&m);
+}
+
+static void test_ballistic(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    assert_close(ppb_ballistic_fraction(&sc), exp(-3.0), 1e-12); /* e^-tau0 */
+    sc.step = PPB_STEP_DENSITY; /* half the width at tau = 3, half at 1.5 */
+    assert_close(ppb_ballistic_fraction(&sc), 0.5 * (exp(-3.0) + exp(-1.5)), 1e-12);
+    sc.step = PPB_STEP_SHADOW; /* normalised by the lit width: e^-3 again */
+    assert_close(ppb_ballistic_fraction(&sc), exp(-3.0), 1e-12);
+    sc.step = PPB_STEP_NONE;
+    sc.theta_deg = 45;
+    /* Entry x_e in [-5, 2] crosses to S2 (path 3 sqrt 2); x_e in (2, 5] leaves through S4
+     * after (5 - x_e) sqrt 2: [7 e^{-3 sqrt 2} + (1 - e^{-3 sqrt 2}) / sqrt 2] / 10. */
+    double r2 = sqrt(2.0), e = exp(-3.0 * r2);
+    assert_close(ppb_ballistic_fraction(&sc), (7.0 * e + (1.0 - e) / r2) / 10.0, 1e-10);
+    ppb_scene slab = tu_slab(2.0, 0.9, 0.0, 60.0);
+    assert_close(ppb_ballistic_fraction(&slab), exp(-4.0), 1e-12); /* tau0 / mu0 */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_uniform_normal),
+        cmocka_unit_test(test_density_step),
+        cmocka_unit_test(test_albedo_step),
+        cmocka_unit_test(test_shadow_step),
+        cmocka_unit_test(test_oblique_shadow_triangle),
+        cmocka_unit_test(test_oblique_density_exact),
+        cmocka_unit_test(test_average_albedo_oblique),
+        cmocka_unit_test(test_slab),
+        cmocka_unit_test(test_ballistic),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
