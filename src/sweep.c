@@ -13,6 +13,7 @@
 #include "experiment.h"
 #include "metrics.h"
 #include "progress.h"
+#include "sweep_plot.h"
 
 /* FNV-1a over the resolved settings that shape results (output.dir and the name excluded),
  * so a renamed or moved sweep still finds its finished points. */
@@ -258,6 +259,8 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
     const char *dirs[1] = {cfg->out_dir};
     long long missing = assemble(dirs, 1, cfg->out_dir, err);
     if (missing < 0)
+        return -1;
+    if (missing == 0 && ppb_sweep_heatmaps(cfg, cfg->out_dir, err))
         return -1;
     if (!o->quiet && missing)
         fprintf(stderr, "%s: %lld points left to other shards; merge when done\n", cfg->name,
