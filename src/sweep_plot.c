@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "metrics.h"
+#include "method.h"
 
 /* Columns of sweep.csv: point, one per axis, method, rms per summary cell, ... */
 #define COL_METHOD(naxes) ((naxes) + 2)
@@ -79,7 +79,7 @@ int ppb_sweep_heatmaps(const ppb_config *cfg, const char *dir, ppb_err *err)
         return 0;
     for (int m = 0; m < cfg->nmethods; m++) {
         const char *id = cfg->methods[m];
-        if (!strcmp(id, "mc"))
+        if (ppb_method_find(id)->reference == 1)
             continue; /* the reference: its RMS against itself is empty */
         if (plot_method(cfg, dir, id, err))
             return -1;
