@@ -1,13 +1,15 @@
 /* march_tables.c: builds the R and S tables and the beam coefficients (march_tables.h). */
 #include "march_tables.h"
 
+/* ppsolver.h first: cblas.h pulls in complex.h, whose macro I would break its prototypes. */
+#include "ppsolver.h"
+
 #include <cblas.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../kernels/march_params.h"
-#include "ppsolver.h"
 
 static int nsurfaces(const ppb_scene *sc)
 {
@@ -82,8 +84,8 @@ static double s_term(double lambda, double r0, double delta, double e_tau, doubl
 
 /* Tables of one albedo node. A is [ndir][ne] (A_k(w)), r0 per direction. */
 static void fill_node(ppb_march_tables *t, int node, const double *A, const double *r0, int ne,
-                      const double *lambda, const double *tau_ref, int want_s, double *E,
-                      double *A2)
+                      const double *lambda, const double *tau_ref, double lin, int want_s,
+                      double *E, double *A2)
 {
     size_t off = (size_t)node * t->ndir * t->ntau;
     /* E[i][k] = e_k(tau_i) */
@@ -93,6 +95,11 @@ static void fill_node(ppb_march_tables *t, int node, const double *A, const doub
     /* Paper Eq. 15: R[dir][i] = sum_k A[dir][k] e_k(tau_i), one matrix product. */
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, t->ndir, t->ntau, ne, 1.0, A, ne, E, ne,
                 0.0, t->R + off, t->ntau);
+    /* alpha = 1: the diffusion mode's isotropic linear part lin tau. */
+    if (lin != 0.0)
+        for (int dir = 0; dir < t->ndir; dir++)
+            for (int i = 0; i < t->ntau; i++)
+                t->R[off + (size_t)dir * t->ntau + i] += lin * i * t->tau_h;
     if (!want_s)
         return;
     /* S = sum_k A_k/(lambda_k r0 - 1) [e_k(tau) - e_k(tau*) e^{-delta/r0}]: the first part is
@@ -113,7 +120,7 @@ static void fill_node(ppb_march_tables *t, int node, const double *A, const doub
             /* A horizontal ray keeps its tau: S = -R. */
             for (int i = 0; i < t->ntau; i++)
                 row[i] = -t->R[off + (size_t)dir * t->ntau + i];
-            continue;
+            continue; /* (the linear part included: R holds it) */
         }
         double tau_star = r > 0.0 ? t->tau0 : 0.0;
         int i_star = r > 0.0 ? t->ntau - 1 : 0;
@@ -123,7 +130,9 @@ static void fill_node(ppb_march_tables *t, int node, const double *A, const doub
         for (int i = 0; i < t->ntau; i++) {
             double tau = i * t->tau_h, delta = tau_star - tau;
             double att = exp(-delta / r);
-            row[i] -= c_far * att;
+            /* The linear part's S solves r0 S' - S = lin tau: -lin (tau + r0), plus the
+             * homogeneous term that zeroes it at tau*. */
+            row[i] += -c_far * att - lin * (tau + r) + lin * (tau_star + r) * att;
             for (int k = 0; k < ne; k++) {
                 double den = lambda[k] * r - 1.0;
                 if (fabs(den) >= near)
@@ -169,6 +178,7 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
         r0[dir] = wdir[3 * dir + 1];
     }
     double *A = NULL, *A2 = NULL, *E = NULL, *lambda = NULL, *tau_ref = NULL, *a = NULL;
+    pp_solution *first = NULL; /* its phase matrix serves every albedo node */
     int rc = 0;
     for (int node = 0; node < nalb && rc == 0; node++) {
         double alb = t->alb0 + node * t->alb_h;
@@ -185,7 +195,7 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
                          .mu0 = cos(sc->theta_deg * PPB_PI / 180.0),
                          .directions = pp->directions};
         pp_solution *sol = NULL;
-        if (pp_solve(&prm, &sol, err)) {
+        if (pp_solve_ex(&prm, first, &sol, NULL, err)) {
             rc = -1;
             break;
         }
@@ -193,7 +203,8 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
         int ne = pp->modes > 0 && pp->modes < nm ? pp->modes : nm;
         t->modes_kept = ne;
         if (A && nm != t->nmodes) {
-            pp_free(sol);
+            if (sol != first)
+                pp_free(sol);
             rc = ppb_fail(err, "march tables: the slab solutions disagree on the mode count");
             break;
         }
@@ -206,7 +217,8 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
             tau_ref = malloc((size_t)nm * sizeof *tau_ref);
             a = malloc((size_t)nm * sizeof *a);
             if (!A || (want_s && !A2) || !E || !lambda || !tau_ref || !a) {
-                pp_free(sol);
+                if (sol != first)
+                    pp_free(sol);
                 rc = ppb_fail(err, "march tables: out of memory for %d modes", nm);
                 break;
             }
@@ -220,9 +232,15 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
                 A[(size_t)dir * ne + k] = a[k] / alb;
             C[dir] = beam_phase(sc, wdir + 3 * dir) + b / alb;
         }
-        pp_free(sol);
-        fill_node(t, node, A, r0, ne, lambda, tau_ref, want_s, E, A2);
+        double lin = pp_source_linear(sol) / alb;
+        if (!first)
+            first = sol;
+        else
+            pp_free(sol);
+        fill_node(t, node, A, r0, ne, lambda, tau_ref, lin, want_s, E, A2);
     }
+    if (first)
+        pp_free(first);
     free(A);
     free(A2);
     free(E);
