@@ -245,10 +245,9 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
     size_t tstride = (size_t)PPB_MC_NTALLY * t->ncells;
     /* Per-batch sums of each surface (integers, exact), then the batch statistics. */
     uint64_t *surf = calloc(nb * PPB_NSURF, sizeof *surf);
-    uint64_t *aux = calloc(nb * 4, sizeof *aux); /* sides, absorbed+, roulette net, capture */
-    int64_t *signed_tmp = calloc(nb * 2, sizeof *signed_tmp);
-    if (!surf || !aux || !signed_tmp) {
-        free(surf), free(aux), free(signed_tmp);
+    uint64_t *sides = calloc(nb, sizeof *sides);
+    if (!surf || !sides) {
+        free(surf), free(sides);
         return;
     }
     for (size_t b = 0; b < nb; b++) {
@@ -258,17 +257,16 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
             for (size_t i = i0; i < i1; i++)
                 surf[b * PPB_NSURF + (size_t)s] += c[i];
         }
-        aux[b * 4 + 0] = surf[b * PPB_NSURF + PPB_S3] + surf[b * PPB_NSURF + PPB_S4];
+        sides[b] = surf[b * PPB_NSURF + PPB_S3] + surf[b * PPB_NSURF + PPB_S4];
     }
     batch_stat R = batch_mean(t, surf + PPB_S1, PPB_NSURF, unit);
     batch_stat T = batch_mean(t, surf + PPB_S2, PPB_NSURF, unit);
-    batch_stat S = batch_mean(t, aux, 4, unit);
+    batch_stat S = batch_mean(t, sides, 1, unit);
     batch_stat B = batch_mean(t, t->totals + PPB_MC_T_BALLISTIC, PPB_MC_NTOT, unit);
     batch_stat C = batch_mean(t, t->totals + PPB_MC_T_CAPTURE, PPB_MC_NTOT, unit);
     batch_stat E = batch_mean(t, t->totals + PPB_MC_T_EVENTS, PPB_MC_NTOT, 1.0);
-    /* The roulette balance (loss - gain) is signed: shift each batch by its gain so the sums
-     * stay unsigned, i.e. compute loss and gain apart and subtract the means; the batch spread
-     * is computed from the differences. */
+    /* The roulette balance (loss - gain) is signed, so it is tallied as two unsigned sums; its
+     * mean is the difference of their means and its spread comes from the batch differences. */
     batch_stat L = batch_mean(t, t->totals + PPB_MC_T_RLOSS, PPB_MC_NTOT, unit);
     batch_stat G = batch_mean(t, t->totals + PPB_MC_T_RGAIN, PPB_MC_NTOT, unit);
     double net = L.mean - G.mean, ss_net = 0, ss_abs = 0;
@@ -302,7 +300,7 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
         st->se.absorbed = dof > 0 ? sqrt(ss_abs / dof) : 0;
         st->mean.absorbed_tracked = 1;
     }
-    free(surf), free(aux), free(signed_tmp);
+    free(surf), free(sides);
 }
 
 void ppb_mc_x0_segments(const ppb_scene *sc, int segs[2])

@@ -18,9 +18,14 @@ typedef struct mc_fixture {
     ppb_run_ctx ctx;
 } mc_fixture;
 
+/* Resets f to a scene, keeping its device open between scenes of one test. */
 static void fixture_init(mc_fixture *f, ppb_scene sc, long long photons)
 {
+    ppb_ocl ocl = f->ctx.ocl;
+    int open = f->ctx.ocl_open;
     memset(f, 0, sizeof *f);
+    f->ctx.ocl = ocl;
+    f->ctx.ocl_open = open;
     f->cfg.scene = sc;
     f->cfg.mc.photons = photons;
     f->cfg.mc.batches = 16;
@@ -71,7 +76,7 @@ static int same_tallies(const ppb_mc_tallies *a, const ppb_mc_tallies *b)
 static void test_energy_balance(void **state)
 {
     (void)state;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_tube(), 0);
     ppb_mc_tallies t;
     trace(&f, 0, 200000, &t);
@@ -89,6 +94,7 @@ static void test_energy_balance(void **state)
                   "slab: R + T + ballistic + capture (roulette unbiased)");
     assert_within(st.mean.sides, 0.0, 0.0, "slab: no sides");
     ppb_mc_tallies_free(&t);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* The unscattered beam: a fraction exp(-tau / cos theta_L) crosses a slab (Beer-Lambert), and
@@ -97,7 +103,7 @@ static void test_energy_balance(void **state)
 static void test_ballistic(void **state)
 {
     (void)state;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_slab(1, 0.9, 0.5, 30), 0);
     const long long n = 200000;
     ppb_mc_tallies t;
@@ -109,6 +115,7 @@ static void test_ballistic(void **state)
     /* 16 batches estimate the standard error to about 1/sqrt(2 x 15) = 18 %. */
     assert_true(st.se.ballistic > 0.5 * binom && st.se.ballistic < 1.6 * binom);
     ppb_mc_tallies_free(&t);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* Published slab values within 3 standard errors.
@@ -124,7 +131,7 @@ static void test_ballistic(void **state)
 static void test_slab_published(void **state)
 {
     (void)state;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_slab(2, 0.9, 0.75, 0), 0);
     ppb_mc_tallies t;
     trace(&f, 0, 400000, &t);
@@ -142,6 +149,7 @@ static void test_slab_published(void **state)
     assert_within(st.mean.R, 0.48592, 3 * st.se.R, "adding-doubling R (g=0, tau=3)");
     assert_within(st.mean.T, 0.22539, 3 * st.se.T, "adding-doubling diffuse T (g=0, tau=3)");
     ppb_mc_tallies_free(&t);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* mc1 against single scattering in closed form (isotropic, normal incidence mu0 = 1; van de
@@ -177,7 +185,7 @@ static void test_single_scattering(void **state)
     }
     r1 *= alpha / 2, t1 *= alpha / 2;
 
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_slab(tau, alpha, 0, 0), 0);
     ppb_mc_tallies t;
     trace(&f, 0, 400000, &t);
@@ -213,6 +221,7 @@ static void test_single_scattering(void **state)
         fail_msg("mc1 S1 radiance vs closed form: chi^2 = %.1f over 64 bins", chi2);
     ppb_result_free(&mc1);
     ppb_mc_tallies_free(&t);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* Bit-identity (SPEC.md 10): the same seed and photons give the same tallies, hence the same
@@ -225,7 +234,7 @@ static void test_bit_identical(void **state)
     ppb_scene sc = tu_tube();
     sc.step = PPB_STEP_DENSITY;
     sc.theta_deg = 45;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, sc, 0);
     const long long n = 100000;
     ppb_mc_tallies ref, t;
@@ -295,6 +304,7 @@ static void test_bit_identical(void **state)
     ppb_mc_tallies_free(&other);
     ppb_mc_tallies_free(&ref), ppb_mc_tallies_free(&a), ppb_mc_tallies_free(&b);
     ppb_mc_tallies_free(&la), ppb_mc_tallies_free(&lb);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* Sum over cells of ((x - y) / sqrt(se_x^2 + se_y^2))^2, and the count: for two independent
@@ -322,7 +332,7 @@ static double mean_z2(const ppb_result *x, const ppb_result *y, const size_t *ma
 static void test_seeds(void **state)
 {
     (void)state;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_tube(), 0);
     const long long n = 200000;
     ppb_mc_tallies t1, t2;
@@ -350,6 +360,7 @@ static void test_seeds(void **state)
         fail_msg("seed 1 vs 2: mean z^2 = %.3f over %d cells", z2, count);
     ppb_result_free(&r1), ppb_result_free(&r2);
     ppb_mc_tallies_free(&t1), ppb_mc_tallies_free(&t2);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* Mirror symmetry x -> -x of the normal-incidence tube without a step (SPEC.md 4): S3 <-> S4,
@@ -359,7 +370,7 @@ static void test_seeds(void **state)
 static void test_mirror_symmetry(void **state)
 {
     (void)state;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_tube(), 0);
     ppb_mc_tallies t;
     trace(&f, 0, 300000, &t);
@@ -403,6 +414,7 @@ static void test_mirror_symmetry(void **state)
     free(map);
     ppb_result_free(&r);
     ppb_mc_tallies_free(&t);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* The method entry: mc and mc1 filled, mc1 a subset of mc cell by cell (the once-scattered
@@ -412,7 +424,7 @@ static void test_mirror_symmetry(void **state)
 static void test_method_entry(void **state)
 {
     (void)state;
-    mc_fixture f;
+    mc_fixture f = {0};
     fixture_init(&f, tu_tube(), 100000);
     ppb_layout lo = ppb_scene_layout(&f.cfg.scene);
     ppb_result out[2];
@@ -454,6 +466,7 @@ static void test_method_entry(void **state)
     assert_true(ppb_mc_noise_rel(&out[0], PPB_S1, segs, 2) < 0.2);
     assert_true(ppb_mc_noise_rel(&out[0], PPB_S2, segs, 2) < 0.2);
     ppb_result_free(&out[0]), ppb_result_free(&out[1]);
+    ppb_ctx_close(&f.ctx);
 }
 
 /* Batch bookkeeping of a photon range: photon i belongs to batch i % batches. */
