@@ -211,9 +211,6 @@ void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *r
     ppb_totals_complete(t);
 }
 
-/* Tau resolution of the tables, nodes per unit optical depth: linear interpolation in tau. */
-#define PPB_TABLE_TAU_PER_MFP 64
-
 int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
@@ -225,7 +222,7 @@ int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err 
     ppb_march_tables tab = {0};
     if (ppb_maps_build(sc, cfg->pp.map_res, &maps, err))
         return -1;
-    int rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_TABLE_TAU_PER_MFP,
+    int rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
                                               &tab, err)
                         : ppb_march_tables_ss(sc, cfg->samples_dir, &tab, err);
     if (rc) {

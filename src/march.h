@@ -47,6 +47,10 @@ int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
 void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
                       ppb_totals *t);
 
+/* Tau resolution of the tables, nodes per unit optical depth (linear interpolation in tau; the
+ * S march reads its table only at piece ends, the R march at every step). */
+#define PPB_MARCH_TAU_PER_MFP 64
+
 /* Both methods' shared run: maps, tables (pp when with_modes, else ss), march, totals. */
 int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err);
 
