@@ -14,7 +14,10 @@
  * g = 0.95 function get up to 16 x 16 per cell. The self term (and for F the cell holding w)
  * is not integrated: it is set so that rows conserve energy exactly (sum_j S_ij = |Omega_i|,
  * sum_j F_j = 1), which keeps S symmetric and puts the small quadrature residual where the
- * peak sits. */
+ * peak sits.
+ * Known limitation: for strongly backward g (g < -0.9) the peak lies on the pairs (i, antipode
+ * of i), which are integrated, not fixed by conservation, so at coarse N their residual (up to
+ * 1e-2 of a row at N = 40, g = -0.95) lands on the diagonal. Rows still sum to 1 exactly. */
 #ifndef PPB_PHASE_H
 #define PPB_PHASE_H
 
