@@ -87,6 +87,7 @@ static void test_nodes_lie_in_their_cell(void **state)
         for (int a = 0; a < 25; a++)
             assert_int_equal(pp_dirs_cell_of(&d, nodes + 4 * a), i);
     }
+    pp_dirs_free(&d);
     assert_int_equal(pp_dirs_make(0, &d, &err), -1);
     assert_non_null(strstr(err.msg, "cells per hemisphere"));
 }
