@@ -170,7 +170,7 @@ static int find_point(const char *const *dirs, int ndirs, const char *hash, cons
                       char *path, size_t n)
 {
     for (int d = 0; d < ndirs; d++) {
-        snprintf(path, n, "%s/points/%s.%s", dirs[d], hash, ext);
+        snprintf(path, n, "%s/points/%.16s.%s", dirs[d], hash, ext);
         if (exists(path))
             return 0;
     }
