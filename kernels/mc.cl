@@ -1,20 +1,30 @@
 /* mc.cl: the photon Monte Carlo transport kernel (SPEC.md sections 1-4 and 7, method `mc`).
  *
- * One work-item traces one photon: it enters S1 uniformly over the lit part along w_L, flies
- * free paths sampled in optical depth through the piecewise-constant medium (traced exactly
- * across the density step plane x = step_x), scatters by Henyey-Greenstein, loses weight by
- * implicit capture (w *= alpha) with unbiased Russian roulette, and leaves at its first boundary
- * crossing (n = 1). Its exit weight goes into integer fixed-point tallies (kernels/mc_params.h),
- * so sums do not depend on the order of the atomic additions.
+ * A photon enters S1 uniformly over the lit part along w_L, flies free paths sampled in optical
+ * depth through the piecewise-constant medium (traced exactly across the density step plane
+ * x = step_x), scatters by Henyey-Greenstein, loses weight by implicit capture (w *= alpha) with
+ * unbiased Russian roulette, and leaves at its first boundary crossing (n = 1). Its exit weight
+ * goes into integer fixed-point tallies (kernels/mc_params.h), so sums do not depend on the
+ * order of the atomic additions.
  *
- * Random numbers: Philox4x32-10 (Random123; Salmon et al., SC'11) keyed by the seed, with the
- * counter (photon index, call number): a photon's path depends only on the seed and its index,
- * never on the work-group size, the chunking or the device layout.
+ * Layout: each work-item runs PPB_MC_LANES photons side by side in OpenCL vector types (one
+ * photon per lane; a lane whose photon leaves or dies takes the work-item's next photon). On a
+ * CPU this is what makes the kernel SIMD: a photon's loop has a data-dependent trip count, so
+ * no compiler vectorises across work-items. The host picks 8 lanes on CPUs and 2 on GPUs; a
+ * photon's path never depends on its lane, work-item or launch.
  *
- * Precision: transport in float (positions are O(10) mfp, so float's 1e-6 relative resolution
- * is far below any bin or segment; float halves register pressure and doubles the SIMD width on
- * CPUs). Binning at exit uses the shared double-precision conventions (ppb_conventions.h), the
- * same code the host uses, on the float direction promoted to double. */
+ * Random numbers: Philox4x32-10 (Random123; Salmon et al., SC'11, the same bijection as
+ * Random123's philox4x32, evaluated on a vector of counters) keyed by the seed. Photon i's
+ * k-th step uses the counter (i mod 2^32, i / 2^32, k, 0): free path, HG cosine, azimuth,
+ * roulette; its entry point uses (i mod 2^32, i / 2^32, 0, 1). So a photon's path depends only
+ * on the seed and its index.
+ *
+ * Precision: transport in float (positions are O(10) mfp, so float's 1e-7 relative resolution
+ * is far below any bin or segment; float doubles the SIMD width over double). Binning at exit
+ * uses the shared double-precision conventions (ppb_conventions.h) on the float direction
+ * promoted to double, the same code the host uses. log and sin/cos are written out in plain
+ * arithmetic (below) so that results cannot depend on which math-library variant a compiler
+ * picks for a vector width. */
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 
 #include <Random123/philox.h>
@@ -22,118 +32,95 @@
 #include "mc_params.h"
 #include "ppb_conventions.h"
 
+#ifndef PPB_MC_LANES
+#define PPB_MC_LANES 8
+#endif
+#define PPB_CAT_(a, b) a##b
+#define PPB_CAT(a, b)  PPB_CAT_(a, b)
+#define PPB_VEC(type)  PPB_CAT(type, PPB_MC_LANES)
+typedef PPB_VEC(float) vfloat;
+typedef PPB_VEC(int) vint; /* lane masks: -1 true, 0 false, as vector comparisons give */
+typedef PPB_VEC(uint) vuint;
+#define VLOAD          PPB_CAT(vload, PPB_MC_LANES)
+#define VSTORE         PPB_CAT(vstore, PPB_MC_LANES)
+#define AS_VINT        PPB_CAT(as_int, PPB_MC_LANES)
+#define AS_VFLOAT      PPB_CAT(as_float, PPB_MC_LANES)
+#define CONVERT_VFLOAT PPB_CAT(convert_float, PPB_MC_LANES)
+#define CONVERT_VINT   PPB_CAT(convert_int, PPB_MC_LANES)
+#define LANES          PPB_MC_LANES
+
+/* Philox4x32-10 of PPB_MC_LANES counters (Random123's round and key schedule). */
+typedef struct ppb_mc_vctr {
+    vuint v0, v1, v2, v3;
+} ppb_mc_vctr;
+
+inline ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
+{
+    for (int round = 0; round < 10; round++) {
+        if (round > 0) {
+            k0 += PHILOX_W32_0;
+            k1 += PHILOX_W32_1;
+        }
+        vuint lo0 = (vuint)PHILOX_M4x32_0 * c.v0, hi0 = mul_hi((vuint)PHILOX_M4x32_0, c.v0);
+        vuint lo1 = (vuint)PHILOX_M4x32_1 * c.v2, hi1 = mul_hi((vuint)PHILOX_M4x32_1, c.v2);
+        ppb_mc_vctr out = {hi1 ^ c.v1 ^ k0, lo1, hi0 ^ c.v3 ^ k1, lo0};
+        c = out;
+    }
+    return c;
+}
+
 /* Philox output word to a uniform in (0, 1): 23 bits plus half a step, exact in float, never 0
- * (log) nor 1. Four uniforms per call. */
-inline float ppb_mc_uniform(uint r)
+ * (log) nor 1. */
+inline vfloat ppb_mc_uniform(vuint r)
+{
+    return (CONVERT_VFLOAT(r >> 9) + 0.5f) * 0x1p-23f;
+}
+inline float ppb_mc_uniform1(uint r)
 {
     return ((float)(r >> 9) + 0.5f) * 0x1p-23f;
 }
 
 /* Natural log of x in (0, 1], by the fdlibm/musl logf reduction (x = 2^k (1 + f),
- * log(1 + f) = 2 atanh(f / (2 + f)) by a minimax polynomial in s^2). Written out with plain
- * arithmetic rather than the builtin so that a photon's path does not depend on whether the
- * compiler vectorises the work-item loop (a vector math library may round differently), which
- * would break bit-identity across work-group sizes; it is also faster than PoCL's builtin. */
-inline float ppb_mc_log(float x)
+ * log(1 + f) = 2 atanh(f / (2 + f)) by a minimax polynomial in s^2); relative error below
+ * 1e-7 over the uniforms drawn here. */
+inline vfloat ppb_mc_log(vfloat x)
 {
-    int ix = as_int(x) + (0x3f800000 - 0x3f3504f3); /* mantissa into [sqrt(1/2), sqrt(2)) */
-    int k = (ix >> 23) - 0x7f;
-    float f = as_float((ix & 0x007fffff) + 0x3f3504f3) - 1.0f;
-    float s = f / (2.0f + f), z = s * s, w = z * z;
-    float t1 = w * (0.40000972152f + w * 0.24279078841f);
-    float t2 = z * (0.66666662693f + w * 0.28498786688f);
-    float hfsq = 0.5f * f * f, dk = (float)k;
-    return s * (hfsq + t1 + t2) + dk * 9.0580006145e-06f - hfsq + f + dk * 6.9313812256e-01f;
+    vint ix = AS_VINT(x) + (0x3f800000 - 0x3f3504f3); /* mantissa into [sqrt(1/2), sqrt(2)) */
+    vfloat k = CONVERT_VFLOAT((ix >> 23) - 0x7f);
+    vfloat f = AS_VFLOAT((ix & 0x007fffff) + 0x3f3504f3) - 1.0f;
+    vfloat s = f / (2.0f + f), z = s * s, w = z * z;
+    vfloat t1 = w * (0.40000972152f + w * 0.24279078841f);
+    vfloat t2 = z * (0.66666662693f + w * 0.28498786688f);
+    vfloat hfsq = 0.5f * f * f;
+    return s * (hfsq + t1 + t2) + k * 9.0580006145e-06f - hfsq + f + k * 6.9313812256e-01f;
 }
 
 /* sin and cos of 2 pi u for u in (0, 1): reduction to the nearest quadrant (exact in float),
- * then Taylor polynomials on [-pi/4, pi/4] (truncation below 3e-8). Plain arithmetic, for the
- * reason given at ppb_mc_log. */
-inline float ppb_mc_sincos2pi(float u, float *c)
+ * then Taylor polynomials on [-pi/4, pi/4] (truncation below 3e-8). */
+inline vfloat ppb_mc_sincos2pi(vfloat u, vfloat *c)
 {
-    float t = 4.0f * u;
-    float q = floor(t + 0.5f);
-    float r = (t - q) * 1.57079632679f;
-    float r2 = r * r;
-    float sr =
+    vfloat t = 4.0f * u;
+    vfloat q = floor(t + 0.5f);
+    vfloat r = (t - q) * 1.57079632679f;
+    vfloat r2 = r * r;
+    vfloat sr =
         r *
         (1.0f + r2 * (-1.0f / 6 + r2 * (1.0f / 120 + r2 * (-1.0f / 5040 + r2 * (1.0f / 362880)))));
-    float cr = 1.0f + r2 * (-0.5f + r2 * (1.0f / 24 + r2 * (-1.0f / 720 + r2 * (1.0f / 40320))));
-    switch ((int)q & 3) {
-    case 0:
-        *c = cr;
-        return sr;
-    case 1:
-        *c = -sr;
-        return cr;
-    case 2:
-        *c = -cr;
-        return -sr;
-    default:
-        *c = sr;
-        return -cr;
-    }
-}
-
-/* A photon's random stream: 32-bit words drawn in order, four per Philox call whose counter is
- * (photon index, call number); the key is the seed. Drawing only the words a step needs (one
- * for the free path, two more for a scattering, one for roulette) costs about one Philox call
- * per 1.3 steps instead of one per step. */
-typedef struct ppb_mc_rng {
-    philox4x32_key_t key;
-    philox4x32_ctr_t ctr;
-    philox4x32_ctr_t out;
-    int used;
-} ppb_mc_rng;
-
-inline ppb_mc_rng ppb_mc_rng_start(ulong seed, ulong photon)
-{
-    ppb_mc_rng r;
-    r.key.v[0] = (uint)seed, r.key.v[1] = (uint)(seed >> 32);
-    r.ctr.v[0] = (uint)photon, r.ctr.v[1] = (uint)(photon >> 32);
-    r.ctr.v[2] = 0, r.ctr.v[3] = 0;
-    r.used = 4;
-    return r;
-}
-
-inline float ppb_mc_next(ppb_mc_rng *r)
-{
-    if (r->used == 4) {
-        r->out = philox4x32(r->ctr, r->key);
-        r->ctr.v[2]++;
-        r->used = 0;
-    }
-    return ppb_mc_uniform(r->out.v[r->used++]);
+    vfloat cr = 1.0f + r2 * (-0.5f + r2 * (1.0f / 24 + r2 * (-1.0f / 720 + r2 * (1.0f / 40320))));
+    vint quadrant = CONVERT_VINT(q) & 3;
+    vint q1 = quadrant == 1, q2 = quadrant == 2, q3 = quadrant == 3;
+    vfloat s = select(select(select(sr, cr, q1), -sr, q2), -cr, q3);
+    *c = select(select(select(cr, -sr, q1), -cr, q2), sr, q3);
+    return s;
 }
 
 /* Henyey-Greenstein cosine by inversion (e.g. Wang, Jacques & Zheng 1995, MCML Eq. 3.28). */
-inline float ppb_mc_hg_cos(float g, float inv_2g, float u)
+inline vfloat ppb_mc_hg_cos(float g, float inv_2g, vfloat u)
 {
     if (fabs(g) < 1e-4f)
         return 2.0f * u - 1.0f;
-    float s = (1.0f - g * g) / (1.0f - g + 2.0f * g * u);
-    float c = (1.0f + g * g - s * s) * inv_2g;
-    return clamp(c, -1.0f, 1.0f);
-}
-
-/* New direction after scattering by polar cosine ct and azimuth (cp, sp) relative to w
- * (MCML Eq. 3.30-3.31 with z as the reference axis; w.z = 0 at entry, so the pole case is
- * rare). One Newton step for 1/|n| around 1 renormalises it, so float round-off cannot build
- * up along long paths. */
-inline float3 ppb_mc_rotate(float3 w, float ct, float cp, float sp)
-{
-    float st = sqrt(fmax(0.0f, 1.0f - ct * ct));
-    float3 n;
-    if (fabs(w.z) > 0.99999f) {
-        n = (float3)(st * cp, st * sp, copysign(ct, w.z));
-    } else {
-        float r2 = 1.0f - w.z * w.z;
-        float r = sqrt(r2), st_r = st / r;
-        n.x = st_r * (w.x * w.z * cp - w.y * sp) + w.x * ct;
-        n.y = st_r * (w.y * w.z * cp + w.x * sp) + w.y * ct;
-        n.z = -st * cp * r + w.z * ct;
-    }
-    return n * (1.5f - 0.5f * dot(n, n));
+    vfloat s = (1.0f - g * g) / (1.0f - g + 2.0f * g * u);
+    return clamp((1.0f + g * g - s * s) * inv_2g, -1.0f, 1.0f);
 }
 
 /* Segment of an exit point on surface surf (slab: always 0). */
@@ -157,142 +144,167 @@ typedef struct ppb_mc_sums {
     ulong ballistic, capture, rgain, rloss, events;
 } ppb_mc_sums;
 
-/* Traces one photon and tallies its exit. */
-inline void ppb_mc_photon(const ppb_mc_params *pp, ulong photon, __global ulong *base,
-                          ppb_mc_sums *sums)
+/* The state of every lane, kept in private arrays so that one lane can be finished and
+ * restarted on its own; the step loads them into vectors. */
+typedef struct ppb_mc_lanes {
+    float x[LANES], y[LANES], wx[LANES], wy[LANES], wz[LANES];
+    float weight[LANES], capture[LANES], rgain[LANES], rloss[LANES], tau[LANES];
+    uint ctr0[LANES], ctr1[LANES], step[LANES];
+    int nscat[LANES], need_tau[LANES], active[LANES], done[LANES], left[LANES], side[LANES];
+} ppb_mc_lanes;
+
+/* Starts photon `photon` in lane l: entry on S1 (y = 0) along w_L. */
+inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong photon)
 {
-    const ppb_mc_params p = *pp;
-    ppb_mc_rng rng = ppb_mc_rng_start(p.seed, photon);
-    /* Entry on S1 (y = 0) along w_L. */
-    float x = 0.0f, y = 0.0f;
-    if (p.tube)
-        x = p.enter_x0 + p.enter_width * ppb_mc_next(&rng);
-    float3 w = (float3)(p.light_x, p.light_y, 0.0f);
-    const float half_w = 0.5f * p.width;
-    const int density_step = p.step == PPB_STEP_DENSITY;
-    const float inv_2g = 0.5f / p.g; /* unused (inf) when g = 0 */
-    const float inv_sigma_left = 1.0f / p.sigma_t, inv_sigma_right = 1.0f / p.sigma_t_right;
-
-    float weight = 1.0f, capture = 0.0f, rgain = 0.0f, rloss = 0.0f;
-    uint nscat = 0;
-    int exit_surf = -1;
-
-    for (;;) {
-        float tau = -ppb_mc_log(ppb_mc_next(&rng)); /* optical depth to the next interaction */
-
-        /* Fly: at most two legs, since a straight line crosses the step plane at most once.
-         * A point on the plane belongs to the side it moves into (x >= step_x is right). */
-        for (;;) {
-            float dx = INFINITY, dy = INFINITY;
-            if (p.tube) {
-                if (w.x > 0.0f)
-                    dx = (half_w - x) / w.x;
-                else if (w.x < 0.0f)
-                    dx = (-half_w - x) / w.x;
-            }
-            if (w.y > 0.0f)
-                dy = -y / w.y;
-            else if (w.y < 0.0f)
-                dy = (-p.height - y) / w.y;
-            float d_wall = fmin(dx, dy);
-
-            float sigma = p.sigma_t, inv_sigma = inv_sigma_left, d_plane = INFINITY;
-            if (density_step) {
-                int right = x > p.step_x || (x == p.step_x && w.x >= 0.0f);
-                sigma = right ? p.sigma_t_right : p.sigma_t;
-                inv_sigma = right ? inv_sigma_right : inv_sigma_left;
-                if (right && w.x < 0.0f)
-                    d_plane = (p.step_x - x) / w.x;
-                else if (!right && w.x > 0.0f)
-                    d_plane = (p.step_x - x) / w.x;
-            }
-            float d_leg = fmin(d_wall, d_plane);
-            float s = tau * inv_sigma;
-            if (s < d_leg) {
-                x += s * w.x;
-                y += s * w.y;
-                break; /* interaction inside the medium */
-            }
-            tau = fmax(0.0f, tau - d_leg * sigma);
-            if (d_plane < d_wall) {
-                y += d_plane * w.y;
-                x = p.step_x; /* exactly on the plane: the side test above sees the crossing */
-                continue;
-            }
-            if (dx <= dy) {
-                exit_surf = w.x > 0.0f ? PPB_S4 : PPB_S3;
-                y += dx * w.y;
-                x = w.x > 0.0f ? half_w : -half_w;
-            } else {
-                exit_surf = w.y > 0.0f ? PPB_S1 : PPB_S2;
-                x += dy * w.x;
-                y = w.y > 0.0f ? 0.0f : -p.height;
-            }
-            break;
-        }
-        if (exit_surf >= 0)
-            break;
-
-        /* Scatter: implicit capture with the albedo at the interaction point. */
-        float alpha = (float)ppb_albedo_at((double)x, p.step, (double)p.step_x, (double)p.albedo,
-                                           (double)p.albedo_right);
-        capture += weight * (1.0f - alpha);
-        weight *= alpha;
-        nscat++;
-        if (weight <= 0.0f)
-            break; /* alpha = 0: captured whole */
-        float ct = ppb_mc_hg_cos(p.g, inv_2g, ppb_mc_next(&rng));
-        float cp, sp = ppb_mc_sincos2pi(ppb_mc_next(&rng), &cp);
-        w = ppb_mc_rotate(w, ct, cp, sp);
-
-        /* Russian roulette: survive with probability 1/M at M times the weight (M = 8, so
-         * the test u < 1/M on the 2^-23 grid has probability exactly 1/M). */
-        if (weight < PPB_MC_ROULETTE_W) {
-            if (ppb_mc_next(&rng) < 1.0f / PPB_MC_ROULETTE_M) {
-                rgain += weight * (PPB_MC_ROULETTE_M - 1.0f);
-                weight *= PPB_MC_ROULETTE_M;
-            } else {
-                rloss += weight;
-                weight = 0.0f;
-                break;
-            }
-        }
+    s->ctr0[l] = (uint)photon, s->ctr1[l] = (uint)(photon >> 32), s->step[l] = 0;
+    float x = 0.0f;
+    if (p->tube) {
+        philox4x32_ctr_t c = {{(uint)photon, (uint)(photon >> 32), 0, 1}};
+        philox4x32_key_t k = {{(uint)p->seed, (uint)(p->seed >> 32)}};
+        x = p->enter_x0 + p->enter_width * ppb_mc_uniform1(philox4x32(c, k).v[0]);
     }
+    s->x[l] = x, s->y[l] = 0.0f;
+    s->wx[l] = p->light_x, s->wy[l] = p->light_y, s->wz[l] = 0.0f;
+    s->weight[l] = 1.0f, s->capture[l] = s->rgain[l] = s->rloss[l] = 0.0f, s->tau[l] = 0.0f;
+    s->nscat[l] = 0, s->need_tau[l] = -1, s->active[l] = -1;
+}
 
-    if (exit_surf >= 0) {
-        ulong q = ppb_mc_fixed(weight);
-        if (nscat == 0) {
+/* Tallies lane l's photon, which has left (s->left) or died. */
+inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_lanes *s, int l,
+                          __global ulong *base, ppb_mc_sums *sums)
+{
+    if (s->left[l]) {
+        float wx = s->wx[l], wy = s->wy[l];
+        int surf = s->side[l] ? (wx > 0.0f ? PPB_S4 : PPB_S3) : (wy > 0.0f ? PPB_S1 : PPB_S2);
+        ulong q = ppb_mc_fixed(s->weight[l]);
+        if (s->nscat[l] == 0) {
             sums->ballistic += q;
         } else {
-            int seg = ppb_mc_segment(&p, exit_surf, x, y);
+            int seg = ppb_mc_segment(p, surf, s->x[l], s->y[l]);
             int bin =
-                ppb_dir_bin(exit_surf, (double)w.x, (double)w.y, (double)w.z, p.ntheta, p.nphi);
+                ppb_dir_bin(surf, (double)wx, (double)wy, (double)s->wz[l], p->ntheta, p->nphi);
             size_t cell =
-                ((size_t)p.offset[exit_surf] + (size_t)seg) * (size_t)(p.ntheta * p.nphi) +
-                (size_t)bin;
-            atom_add(base + PPB_MC_TALLY_ALL * p.ncells + cell, q);
-            if (nscat == 1)
-                atom_add(base + PPB_MC_TALLY_ONCE * p.ncells + cell, q);
+                ((size_t)p->offset[surf] + (size_t)seg) * (size_t)(p->ntheta * p->nphi) + bin;
+            atom_add(base + PPB_MC_TALLY_ALL * p->ncells + cell, q);
+            if (s->nscat[l] == 1)
+                atom_add(base + PPB_MC_TALLY_ONCE * p->ncells + cell, q);
         }
     }
-    sums->capture += ppb_mc_fixed(capture);
-    sums->events += nscat;
-    sums->rgain += ppb_mc_fixed(rgain);
-    sums->rloss += ppb_mc_fixed(rloss);
+    sums->capture += ppb_mc_fixed(s->capture[l]);
+    sums->events += (ulong)s->nscat[l];
+    sums->rgain += ppb_mc_fixed(s->rgain[l]);
+    sums->rloss += ppb_mc_fixed(s->rloss[l]);
+}
+
+/* One step of every lane: a flight leg to the next interaction, the step plane or a wall,
+ * then (at an interaction) implicit capture, HG scattering and roulette. A leg that reaches
+ * the step plane stops there with its remaining optical depth; a straight line crosses the
+ * plane at most once, so a flight takes at most two legs. */
+inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *medium)
+{
+    const float half_w = 0.5f * p->width, sx = p->step_x;
+    vint active = VLOAD(0, s->active);
+    vfloat x = VLOAD(0, s->x), y = VLOAD(0, s->y);
+    vfloat wx = VLOAD(0, s->wx), wy = VLOAD(0, s->wy), wz = VLOAD(0, s->wz);
+    vuint step = VLOAD(0, s->step);
+
+    ppb_mc_vctr c = {VLOAD(0, s->ctr0), VLOAD(0, s->ctr1), step, (vuint)0};
+    c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
+    VSTORE(step + 1, 0, s->step);
+    vfloat tau = select(VLOAD(0, s->tau), -ppb_mc_log(ppb_mc_uniform(c.v0)), VLOAD(0, s->need_tau));
+
+    /* Distances to the walls (tube sides only in tube mode) and to the step plane. Lanes
+     * moving parallel to a wall divide by zero; select() discards those values. */
+    vfloat inf = (vfloat)INFINITY;
+    vfloat dx = inf;
+    if (p->tube)
+        dx = select(select(inf, (-half_w - x) / wx, wx < 0.0f), (half_w - x) / wx, wx > 0.0f);
+    vfloat dy = select(select(inf, (-p->height - y) / wy, wy < 0.0f), -y / wy, wy > 0.0f);
+    vfloat d_wall = fmin(dx, dy);
+    /* medium: sigma_t left/right, 1/sigma_t left/right, alpha left/right (ppb_conventions.h) */
+    vfloat sigma = (vfloat)medium[0], inv_sigma = (vfloat)medium[2], d_plane = inf;
+    if (p->step == PPB_STEP_DENSITY) {
+        /* A point on the plane belongs to the side it moves into (x >= step_x is right). */
+        vint right = (x > sx) | ((x == sx) & (wx >= 0.0f));
+        sigma = select(sigma, (vfloat)medium[1], right);
+        inv_sigma = select(inv_sigma, (vfloat)medium[3], right);
+        vint toward = (right & (wx < 0.0f)) | (~right & (wx > 0.0f));
+        d_plane = select(inf, (sx - x) / wx, toward);
+    }
+    vfloat d_leg = fmin(d_wall, d_plane);
+    vfloat dist = tau * inv_sigma;
+    vint inter = (dist < d_leg) & active;
+    vint cross = ~inter & (d_plane < d_wall) & active;
+    vint left = ~inter & ~cross & active;
+    vfloat go = select(d_leg, dist, inter);
+    x += go * wx;
+    y += go * wy;
+    x = select(x, (vfloat)sx, cross); /* exactly on the plane: the side test sees the crossing */
+    VSTORE(select(tau, fmax(0.0f, tau - d_leg * sigma), cross), 0, s->tau);
+    VSTORE(~cross, 0, s->need_tau);
+    vint side = left & (dx <= dy);
+    x = select(x, select((vfloat)-half_w, (vfloat)half_w, wx > 0.0f), side);
+    y = select(y, select((vfloat)-p->height, (vfloat)0.0f, wy > 0.0f), left & ~side);
+
+    /* Interaction: implicit capture with the albedo at the point, then scattering. */
+    vfloat alpha = (vfloat)medium[4];
+    if (p->step == PPB_STEP_ALBEDO)
+        alpha = select(alpha, (vfloat)medium[5], x >= sx);
+    vfloat weight = VLOAD(0, s->weight);
+    VSTORE(VLOAD(0, s->capture) + select((vfloat)0.0f, weight * (1.0f - alpha), inter), 0,
+           s->capture);
+    weight = select(weight, weight * alpha, inter);
+    VSTORE(VLOAD(0, s->nscat) - inter, 0, s->nscat);
+
+    vfloat ct = ppb_mc_hg_cos(p->g, 0.5f / p->g, ppb_mc_uniform(c.v1));
+    vfloat cp, sp = ppb_mc_sincos2pi(ppb_mc_uniform(c.v2), &cp);
+    /* New direction (MCML Eq. 3.30-3.31 with z as the reference axis; w.z = 0 at entry, so
+     * the pole case is rare), then one Newton step for 1/|n| so round-off cannot build up. */
+    vfloat st = sqrt(fmax(0.0f, 1.0f - ct * ct));
+    vfloat r = sqrt(fmax(1e-12f, 1.0f - wz * wz)), st_r = st / r;
+    vfloat nx = st_r * (wx * wz * cp - wy * sp) + wx * ct;
+    vfloat ny = st_r * (wy * wz * cp + wx * sp) + wy * ct;
+    vfloat nz = -st * cp * r + wz * ct;
+    vint pole = fabs(wz) > 0.99999f;
+    nx = select(nx, st * cp, pole);
+    ny = select(ny, st * sp, pole);
+    nz = select(nz, copysign(ct, wz), pole);
+    vfloat renorm = 1.5f - 0.5f * (nx * nx + ny * ny + nz * nz);
+    wx = select(wx, nx * renorm, inter);
+    wy = select(wy, ny * renorm, inter);
+    wz = select(wz, nz * renorm, inter);
+
+    /* Russian roulette: survive with probability 1/M at M times the weight (M = 8, so the test
+     * u < 1/M on the 2^-23 grid has probability exactly 1/M). alpha = 0 ends a photon too. */
+    vint roulette = inter & (weight < PPB_MC_ROULETTE_W);
+    vint survive = ppb_mc_uniform(c.v3) < 1.0f / PPB_MC_ROULETTE_M;
+    VSTORE(VLOAD(0, s->rgain) +
+               select((vfloat)0.0f, weight * (PPB_MC_ROULETTE_M - 1.0f), roulette & survive),
+           0, s->rgain);
+    VSTORE(VLOAD(0, s->rloss) + select((vfloat)0.0f, weight, roulette & ~survive), 0, s->rloss);
+    weight = select(weight, select((vfloat)0.0f, weight * PPB_MC_ROULETTE_M, survive), roulette);
+    vint dead = inter & (weight <= 0.0f);
+
+    VSTORE(x, 0, s->x), VSTORE(y, 0, s->y);
+    VSTORE(wx, 0, s->wx), VSTORE(wy, 0, s->wy), VSTORE(wz, 0, s->wz);
+    VSTORE(weight, 0, s->weight);
+    VSTORE(left | dead, 0, s->done);
+    VSTORE(left, 0, s->left);
+    VSTORE(side, 0, s->side);
 }
 
 /* The global size is batches x P (the host makes it so): work-items [b P, (b + 1) P) trace the
  * chunk's photons of batch b (i % batches == b), work-item b P + q taking the q-th, (q + P)-th,
  * ... of them. Work-groups of consecutive work-items then stay inside one batch, so the cell
- * tallies they update are one batch's slice (cache-resident on a CPU), and a work-item's
- * totals are summed privately with one atomic per total at the end. Which work-item traces a
- * photon never changes the photon's path, and integer sums do not depend on their order, so any
- * global size, work-group size or chunking gives the same tallies. */
+ * tallies they update are one batch's slice, and a work-item's totals are summed privately with
+ * one atomic per total at the end. Which work-item or lane traces a photon never changes the
+ * photon's path, and integer sums do not depend on their order, so any global size, work-group
+ * size, lane count or chunking gives the same tallies. */
 __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
                                   __global ulong *totals)
 {
-    const ulong per_batch = get_global_size(0) / (ulong)p.batches;
     const ulong batches = (ulong)p.batches;
+    const ulong per_batch = get_global_size(0) / batches;
     const int batch = (int)(get_global_id(0) / per_batch);
     const ulong q0 = get_global_id(0) % per_batch;
     /* The chunk's photons of this batch: first + off + batches m, m = 0 .. n - 1. */
@@ -301,9 +313,44 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     if (q0 >= n)
         return;
     __global ulong *base = cells + (size_t)batch * PPB_MC_NTALLY * p.ncells;
+
+    /* The medium's two sides from the shared conventions (x < step_x left, x >= step_x right). */
+    float medium[6];
+    medium[0] = (float)ppb_sigma_t_at(p.step_x - 1.0, p.step, p.step_x, p.sigma_t, p.sigma_t_right);
+    medium[1] = (float)ppb_sigma_t_at(p.step_x, p.step, p.step_x, p.sigma_t, p.sigma_t_right);
+    medium[2] = 1.0f / medium[0], medium[3] = 1.0f / medium[1];
+    medium[4] = (float)ppb_albedo_at(p.step_x - 1.0, p.step, p.step_x, p.albedo, p.albedo_right);
+    medium[5] = (float)ppb_albedo_at(p.step_x, p.step, p.step_x, p.albedo, p.albedo_right);
+
     ppb_mc_sums sums = {0, 0, 0, 0, 0};
-    for (ulong m = q0; m < n; m += per_batch)
-        ppb_mc_photon(&p, p.first + off + batches * m, base, &sums);
+    ppb_mc_lanes s;
+    ulong m = q0;
+    for (int l = 0; l < LANES; l++) {
+        if (m < n) {
+            ppb_mc_start(&p, &s, l, p.first + off + batches * m);
+            m += per_batch;
+        } else {
+            s.active[l] = 0;
+        }
+    }
+    for (;;) {
+        ppb_mc_step(&p, &s, medium);
+        int busy = 0;
+        for (int l = 0; l < LANES; l++) {
+            if (s.active[l] && s.done[l]) {
+                ppb_mc_finish(&p, &s, l, base, &sums);
+                if (m < n) {
+                    ppb_mc_start(&p, &s, l, p.first + off + batches * m);
+                    m += per_batch;
+                } else {
+                    s.active[l] = 0;
+                }
+            }
+            busy |= s.active[l];
+        }
+        if (!busy)
+            break;
+    }
 
     __global ulong *tot = totals + (size_t)batch * PPB_MC_NTOT;
     atom_add(tot + PPB_MC_T_BALLISTIC, sums.ballistic);
@@ -311,4 +358,29 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     atom_add(tot + PPB_MC_T_EVENTS, sums.events);
     atom_add(tot + PPB_MC_T_RGAIN, sums.rgain);
     atom_add(tot + PPB_MC_T_RLOSS, sums.rloss);
+}
+
+/* Self-check for tests/test_mc.c: the vector Philox above against Random123's philox4x32 on
+ * varied counters and keys; counts mismatching words into *mismatches. */
+__kernel void ppb_mc_philox_check(ulong seed, __global uint *mismatches)
+{
+    uint g = (uint)get_global_id(0);
+    uint c0[LANES], c1[LANES], c2[LANES], c3[LANES];
+    for (int l = 0; l < LANES; l++) {
+        c0[l] = g * LANES + (uint)l, c1[l] = g ^ 0x9e3779b9u, c2[l] = (uint)l * 977u + g;
+        c3[l] = g & 1;
+    }
+    ppb_mc_vctr c = {VLOAD(0, c0), VLOAD(0, c1), VLOAD(0, c2), VLOAD(0, c3)};
+    c = ppb_mc_philox(c, (uint)seed, (uint)(seed >> 32));
+    uint out[4][LANES];
+    VSTORE(c.v0, 0, out[0]), VSTORE(c.v1, 0, out[1]), VSTORE(c.v2, 0, out[2]);
+    VSTORE(c.v3, 0, out[3]);
+    philox4x32_key_t k = {{(uint)seed, (uint)(seed >> 32)}};
+    for (int l = 0; l < LANES; l++) {
+        philox4x32_ctr_t s = {{c0[l], c1[l], c2[l], c3[l]}};
+        philox4x32_ctr_t r = philox4x32(s, k);
+        for (int w = 0; w < 4; w++)
+            if (r.v[w] != out[w][l])
+                atomic_inc(mismatches);
+    }
 }

@@ -1,5 +1,6 @@
 #include "method_mc.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -140,25 +141,39 @@ static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tall
     return 0;
 }
 
-/* Work-items per launch: enough to fill a GPU's compute units (2048 resident threads each) and,
- * on a CPU, enough work-groups to balance the cores. Each work-item loops over photons. */
-static long long auto_items(const ppb_ocl *ocl)
+/* How the kernel is laid out on a device: photons side by side per work-item (SIMD lanes on a
+ * CPU, where nothing vectorises across work-items; 2 on a GPU, whose SIMD is the work-items)
+ * and work-items per launch (enough to fill a GPU's compute units, 2048 resident threads each,
+ * or to balance a CPU's cores). None of it changes a photon's path. */
+typedef struct mc_shape {
+    int lanes;
+    long long items;
+} mc_shape;
+
+static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
 {
+    cl_device_type type = 0;
+    if (ppb_cl_check(clGetDeviceInfo(ocl->device, CL_DEVICE_TYPE, sizeof type, &type, NULL),
+                     "clGetDeviceInfo(CL_DEVICE_TYPE)", err))
+        return -1;
     long long units = ocl->compute_units ? (long long)ocl->compute_units : 1;
-    return units * 2048;
+    int cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
+    shape->lanes = cpu ? 8 : 2;
+    shape->items = units * (cpu ? 1024 : 2048);
+    return 0;
 }
 
-/* Photons per launch: about 32 per work-item keeps launch overhead below a percent. Fixed by
- * the device, never by timing, so a target-noise run stops at the same photon count every
- * time on the same device. */
-static long long auto_chunk(const ppb_ocl *ocl)
+/* Photons per launch: 64 per lane keeps the lanes busy to the end and the launch overhead
+ * below a percent. Fixed by the device, never by timing, so a target-noise run stops at the
+ * same photon count every time on the same device. */
+static long long auto_chunk(const mc_shape *shape)
 {
-    return auto_items(ocl) * 32;
+    return shape->items * shape->lanes * 64;
 }
 
-static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, mc_device *d, long long first,
-                           long long count, ppb_mc_tallies *t, ppb_mc_trace_info *info,
-                           ppb_err *err)
+static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape, mc_device *d,
+                           long long first, long long count, ppb_mc_tallies *t,
+                           ppb_mc_trace_info *info, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
     size_t nb = (size_t)t->batches;
@@ -185,11 +200,16 @@ static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, mc_device *d, long lo
                      "clSetKernelArg(mc totals)", err))
         return -1;
 
-    size_t local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 0;
+    /* Work-group size 0 means ppbench picks: 64 work-items keep a group inside one batch and
+     * give PoCL's CPU driver enough groups to balance its cores (its own choice is slower),
+     * and suit GPUs too. */
+    size_t local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 64;
+    if (!cfg->mc.workgroup && local > ocl->max_workgroup)
+        local = ocl->max_workgroup;
     if (local > ocl->max_workgroup)
         return ppb_fail(err, "mc: workgroup %zu exceeds the device's maximum %zu", local,
                         ocl->max_workgroup);
-    long long chunk = cfg->mc.chunk > 0 ? cfg->mc.chunk : auto_chunk(ocl);
+    long long chunk = cfg->mc.chunk > 0 ? cfg->mc.chunk : auto_chunk(shape);
 
     ppb_mc_tallies tmp = {0};
     tmp.fingerprint = t->fingerprint, tmp.seed = t->seed, tmp.batches = t->batches;
@@ -219,15 +239,15 @@ static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, mc_device *d, long lo
         /* Global size: batches x P work-items, P a multiple of the work-group size, so each
          * work-group stays inside one batch (see the kernel). */
         size_t nb_sz = (size_t)t->batches;
-        size_t items = (size_t)(n < auto_items(ocl) ? n : auto_items(ocl));
+        long long want = n / (shape->lanes * 64) + 1; /* about 64 photons per lane */
+        size_t items = (size_t)(want < shape->items ? want : shape->items);
         size_t per_batch = (items + nb_sz - 1) / nb_sz;
-        if (local)
-            per_batch = (per_batch + local - 1) / local * local;
+        per_batch = (per_batch + local - 1) / local * local;
         size_t global = per_batch * nb_sz;
         if (ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_PARAMS, sizeof p, &p),
                          "clSetKernelArg(mc params)", err) ||
-            ppb_cl_check(clEnqueueNDRangeKernel(ocl->queue, d->kernel, 1, NULL, &global,
-                                                local ? &local : NULL, 0, NULL, NULL),
+            ppb_cl_check(clEnqueueNDRangeKernel(ocl->queue, d->kernel, 1, NULL, &global, &local, 0,
+                                                NULL, NULL),
                          "clEnqueueNDRangeKernel(ppb_mc_trace_kernel)", err) ||
             ppb_cl_check(clFinish(ocl->queue), "clFinish(mc)", err)) {
             status = -1;
@@ -282,12 +302,17 @@ int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tall
     if (!has64 || !hasfp64)
         return ppb_fail(err, "mc: device %s lacks %s, needed for the bit-reproducible tallies",
                         ocl->name, !has64 ? "cl_khr_int64_base_atomics" : "cl_khr_fp64");
+    mc_shape shape;
+    if (device_shape(ocl, &shape, err))
+        return -1;
+    char opts[64];
+    snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d", shape.lanes);
     mc_device d = {0};
-    int status = ppb_ocl_build(ocl, "mc.cl", "", &d.prog, err);
+    int status = ppb_ocl_build(ocl, "mc.cl", opts, &d.prog, err);
     if (status == 0)
         status = ppb_ocl_kernel(d.prog, "ppb_mc_trace_kernel", &d.kernel, err);
     if (status == 0)
-        status = trace_on_device(ctx, ocl, &d, first, count, t, info, err);
+        status = trace_on_device(ctx, ocl, &shape, &d, first, count, t, info, err);
     mc_device_release(&d);
     return status;
 }
