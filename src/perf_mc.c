@@ -7,7 +7,7 @@
 
 /* Photons per timed case: enough for a few seconds on a 2-core CPU (the launches then dominate
  * the fixed costs); $PPBENCH_PERF_MC_PHOTONS overrides it for quick or long runs. */
-#define PERF_MC_PHOTONS 4000000LL
+#define PERF_MC_PHOTONS 10000000LL
 
 /* SPEC.md section 6's tube with the given g; the settings that do not change the physics
  * (work-group, chunk) come from the experiment when there is one. */
@@ -58,6 +58,59 @@ static int perf_trace(ppb_run_ctx *ctx, const ppb_config *cfg, long long count, 
     return rc;
 }
 
+/* MCX-CL (pmcxcl, Fang et al.) on the equivalent homogeneous slab: a 100 x 100 x 3 grid of
+ * 1 mm voxels with mu_a = 0.05, mu_s = 0.95 /mm (sigma_t = 1, alpha = 0.95, tau = 3), HG g,
+ * n = 1 inside and out (no reflection), a pencil beam at normal incidence. It runs in a Python
+ * child; pmcxcl builds its kernel on PoCL only with libstdc++ preloaded, and reports its
+ * statistics only with the fluence output on, so both are set. Its own device choice is the
+ * first OpenCL device (gpuid 1), which it names. Returns photons/s, or 0 when pmcxcl is not
+ * installed or fails (then why goes into note). */
+static double mcx_photons_per_s(double g, long long photons, char *device, size_t cap, char *note,
+                                size_t note_cap)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd,
+             "LD_PRELOAD=/usr/lib/x86_64-linux-gnu/libstdc++.so.6 python3 -c '"
+             "import numpy as np, pmcxcl\n"
+             "cfg = {\"nphoton\": %lld, \"vol\": np.ones((100, 100, 3), dtype=\"uint8\"),"
+             " \"tstart\": 0, \"tend\": 1e-8, \"tstep\": 1e-8,"
+             " \"srcpos\": [50, 50, 0], \"srcdir\": [0, 0, 1],"
+             " \"prop\": [[0, 0, 1, 1], [0.05, 0.95, %.17g, 1]], \"isreflect\": 0,"
+             " \"gpuid\": 1, \"autopilot\": 1, \"issave2pt\": 1}\n"
+             "pmcxcl.run(dict(cfg, nphoton=10000))\n"
+             "r = pmcxcl.run(cfg)\n"
+             "print(\"PPB_MCX\", r[\"stat\"][\"nphoton\"], r[\"stat\"][\"runtime\"],"
+             " pmcxcl.gpuinfo()[0][\"name\"])\n"
+             "' 2>/dev/null",
+             photons, g);
+    FILE *p = popen(cmd, "r");
+    if (!p) {
+        snprintf(note, note_cap, "cannot start python3");
+        return 0;
+    }
+    char line[1024];
+    double rate = 0;
+    snprintf(note, note_cap, "pmcxcl not installed or failed");
+    while (fgets(line, sizeof line, p)) {
+        long long n;
+        double ms;
+        int at = 0;
+        if (sscanf(line, "PPB_MCX %lld %lf %n", &n, &ms, &at) == 2 && ms > 0) {
+            rate = (double)n / (ms * 1e-3);
+            snprintf(device, cap, "%s", line + at);
+            device[strcspn(device, "\n")] = 0;
+        }
+    }
+    pclose(p);
+    return rate;
+}
+
+/* pmcxcl is optional: probed with a plain import. */
+static int have_pmcxcl(void)
+{
+    return system("python3 -c 'import pmcxcl' >/dev/null 2>&1") == 0;
+}
+
 int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
 {
     ppb_ocl *ocl;
@@ -85,6 +138,35 @@ int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
                 (double)photons / sec, ev / sec, ev / (double)photons,
                 ev / sec >= 20e6 ? "(>= 20 M events/s target)"
                                  : "(below the 20 M events/s target)");
+    }
+
+    /* MCX-CL on the same device, same run, on the equivalent slab: ours in slab mode (the
+     * same medium, thickness and beam), photons/s against photons/s. */
+    if (!have_pmcxcl()) {
+        fprintf(out, "MCX-CL comparison skipped: the Python package pmcxcl is not installed\n");
+        return 0;
+    }
+    const long long mcx_photons = 1000000;
+    for (int i = 0; i < 2; i++) {
+        ppb_config cfg;
+        perf_config(ctx, gs[i], &cfg);
+        cfg.scene.geometry = PPB_GEOM_SLAB;
+        double sec, ev;
+        if (perf_trace(ctx, &cfg, photons, &sec, &ev, err))
+            return -1;
+        char device[512] = "?", note[128];
+        double mcx =
+            mcx_photons_per_s(gs[i], mcx_photons, device, sizeof device, note, sizeof note);
+        double ours = (double)photons / sec;
+        if (mcx <= 0) {
+            fprintf(out, "slab tau=3 g=%.1f: ppbench %.4g photons/s; MCX-CL: %s\n", gs[i], ours,
+                    note);
+            continue;
+        }
+        fprintf(out,
+                "slab tau=3 g=%.1f: ppbench %.4g photons/s, MCX-CL (pmcxcl on %s) %.4g "
+                "photons/s: ratio %.2f\n",
+                gs[i], ours, device, mcx, ours / mcx);
     }
     return 0;
 }
