@@ -10,6 +10,7 @@
 
 #include "mc_tally.h"
 #include "method_mc.h"
+#include "method_ppslab.h"
 #include "progress.h"
 
 /* One run context per test, on the default device ($PPBENCH_DEVICE or 0). */
@@ -471,6 +472,51 @@ static void test_method_entry(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
+/* Slab-mode exit radiance against the plane-parallel solver (ppslab, the sibling issue's
+ * deterministic answer, itself checked against PythonicDISORT in test_ppsolver), on
+ * configs/slab_g0.ini (tau 3, alpha 0.95, normal light) at g = 0 and g = 0.5: every bin of S1 and
+ * S2 agrees within the combined noise and discretisation error. The statistic is the mean of
+ * z^2 = (mc - ppslab)^2 / (se^2 + (1e-3 ppslab)^2) over the 128 bins, the 0.1 % allowance
+ * covering the solver's direction discretisation (test_ppsolver holds it well inside that); for
+ * agreement it is near 15/13 = 1.15 (t variables, 15 degrees of freedom), and a 1 % bias
+ * would add about (0.01 / 0.006)^2 = 2.8 at 4e6 photons. */
+static void test_slab_vs_ppslab(void **state)
+{
+    (void)state;
+    const char *gs[2] = {"0", "0.5"};
+    for (int i = 0; i < 2; i++) {
+        mc_fixture f = {0};
+        ppb_err err;
+        char path[1024];
+        snprintf(path, sizeof path, "%s/../configs/slab_g0.ini", PPB_KERNEL_DIR);
+        if (ppb_config_load(&f.cfg, path, &err) ||
+            ppb_config_set(&f.cfg, "medium", "g", gs[i], &err))
+            fail_msg("%s", err.msg);
+        f.ctx.cfg = &f.cfg;
+        f.ctx.quiet = 1;
+        ppb_layout lo = ppb_scene_layout(&f.cfg.scene);
+        ppb_result mc[2], pp;
+        assert_int_equal(ppb_result_init(&mc[0], "mc", &lo, &err), 0);
+        assert_int_equal(ppb_result_init(&mc[1], "mc1", &lo, &err), 0);
+        assert_int_equal(ppb_result_init(&pp, "ppslab", &lo, &err), 0);
+        if (ppb_method_mc(&f.ctx, mc, &err) || ppb_method_ppslab(&f.ctx, &pp, &err))
+            fail_msg("%s", err.msg);
+        double z2 = 0;
+        for (size_t c = 0; c < lo.ncells; c++) {
+            double d = mc[0].radiance[c] - pp.radiance[c];
+            double var = mc[0].se[c] * mc[0].se[c] + 1e-6 * pp.radiance[c] * pp.radiance[c];
+            z2 += d * d / var;
+        }
+        z2 /= (double)lo.ncells;
+        print_message("g = %s: mean z^2 %.3f over %zu bins (R mc %.5f ppslab %.5f)\n", gs[i], z2,
+                      lo.ncells, mc[0].totals.R, pp.totals.R);
+        if (z2 > 2.0)
+            fail_msg("mc vs ppslab at g = %s: mean z^2 = %.3f over %zu bins", gs[i], z2, lo.ncells);
+        ppb_result_free(&mc[0]), ppb_result_free(&mc[1]), ppb_result_free(&pp);
+        ppb_ctx_close(&f.ctx);
+    }
+}
+
 /* The kernel's vector Philox is Random123's philox4x32 (the Philox4x32-10 bijection of Salmon
  * et al. 2011): compared word by word on 4096 x lanes counters, with a key of both halves
  * set, at the lane count the CPU path uses (8) and the GPU path (2). */
@@ -535,6 +581,7 @@ int main(void)
         cmocka_unit_test(test_slab_published),  cmocka_unit_test(test_single_scattering),
         cmocka_unit_test(test_bit_identical),   cmocka_unit_test(test_seeds),
         cmocka_unit_test(test_mirror_symmetry), cmocka_unit_test(test_method_entry),
+        cmocka_unit_test(test_slab_vs_ppslab),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     return rc;
