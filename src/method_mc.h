@@ -23,8 +23,12 @@ typedef struct ppb_mc_trace_info {
 } ppb_mc_trace_info;
 
 /* Traces photons [first, first + count) of ctx->cfg's scene with ctx->cfg->mc's seed, batches,
- * work-group size and chunk, adding them to t (from ppb_mc_tallies_init with the same scene,
- * seed and batches). info may be NULL. */
+ * work-group size (0: 64) and chunk (0: sized to the device, 2^19 photons per compute unit on a
+ * CPU), adding them to t (from ppb_mc_tallies_init with the same scene, seed and batches).
+ * Stops after the current chunk on SIGINT/SIGTERM (ppb_interrupted) or once noise_rel at the
+ * x = 0 cells of S1 and S2 is below cfg->mc.target_noise (checked after every chunk); what was
+ * traced is always the prefix [first, first + info->traced), so the result is bit-identical to
+ * a run of that many photons. info may be NULL. */
 int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
                  ppb_mc_trace_info *info, ppb_err *err);
 
