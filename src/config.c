@@ -66,7 +66,7 @@ static const key_def keys[] = {
      "independent batches for standard errors"},
     {"mc", "seed", K_LLONG, F(mc.seed), 0, 9.2e18, "1", NULL, "random seed (Philox key)"},
     {"mc", "workgroup", K_INT, F(mc.workgroup), 0, 4096, "0", NULL,
-     "work-group size, 0 = the runtime's choice (results do not depend on it)"},
+     "work-group size, 0 = ppbench picks (64); results do not depend on it"},
     {"mc", "chunk", K_LLONG, F(mc.chunk), 0, 1e12, "0", NULL,
      "photons per kernel launch, 0 = sized to the device (results do not depend on it)"},
     {"mc", "first", K_LLONG, F(mc.first), 0, 1e13, "0", NULL,
@@ -403,6 +403,14 @@ static int apply_defaults(ppb_config *cfg, ppb_err *err)
                             keys[i].key, why);
     cfg->naxes = 0;
     return 0;
+}
+
+int ppb_config_defaults(ppb_config *cfg, ppb_err *err)
+{
+    memset(cfg, 0, sizeof *cfg);
+    snprintf(cfg->path, sizeof cfg->path, "(defaults)");
+    snprintf(cfg->name, sizeof cfg->name, "defaults");
+    return apply_defaults(cfg, err);
 }
 
 int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)

@@ -67,6 +67,9 @@ typedef struct ppb_config {
     ppb_axis axes[PPB_MAX_AXES];
 } ppb_config;
 
+/* Every key at its default (the study's settings); no file involved. */
+int ppb_config_defaults(ppb_config *cfg, ppb_err *err);
+
 /* Loads and validates a config; on error nothing in *cfg is meaningful. */
 int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err);
 
