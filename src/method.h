@@ -10,13 +10,17 @@
 #include "ocl.h"
 #include "result.h"
 
-/* What a method gets: the experiment and an OpenCL device opened on first use. */
+struct ppb_march_cache;
+
+/* What a method gets: the experiment, an OpenCL device opened on first use, and caches that
+ * outlive one experiment (a sweep reuses the marcher's tables across grid points). */
 typedef struct ppb_run_ctx {
     const ppb_config *cfg;
     const char *device_selector; /* --device, or NULL */
     ppb_ocl ocl;
     int ocl_open;
     int quiet;                   /* no progress lines */
+    struct ppb_march_cache *march_cache; /* owned by the caller; NULL = build afresh */
 } ppb_run_ctx;
 
 /* The device, opened on first call and shared by every method of the run. */
