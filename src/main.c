@@ -41,6 +41,7 @@ static void usage(FILE *out)
             "  --out DIR           output directory (overrides [output] dir)\n"
             "  --set SEC.KEY=VAL   override a config key (may repeat)\n"
             "  --shard I/N         sweep: run only the I-th of N parts (1-based)\n"
+            "  --jobs J            sweep: J processes on this machine (default 1)\n"
             "  --yes               sweep: allow a grid larger than the safety limit\n"
             "  --quiet             no progress lines on stderr\n"
             "  -h, --help          this text\n"
@@ -65,6 +66,7 @@ typedef struct cli {
     int nsets;
     int quiet, yes;
     int shard_i, shard_n;
+    int jobs;
     const char *args[256];
     int nargs;
 } cli;
@@ -93,6 +95,12 @@ static int parse_cli(int argc, char **argv, cli *c)
             c->out = argv[++i];
         } else if (!strcmp(a, "--set") && has_next && c->nsets < 64) {
             c->sets[c->nsets++] = argv[++i];
+        } else if (!strcmp(a, "--jobs") && has_next) {
+            c->jobs = atoi(argv[++i]);
+            if (c->jobs < 1 || c->jobs > 64) {
+                fprintf(stderr, "ppbench: --jobs %s: expected 1 to 64\n", argv[i]);
+                return EXIT_USAGE;
+            }
         } else if (!strcmp(a, "--shard") && has_next) {
             if (!parse_shard(argv[++i], c)) {
                 fprintf(stderr, "ppbench: --shard %s: expected I/N with 1 <= I <= N\n", argv[i]);
@@ -203,7 +211,7 @@ static int cmd_sweep(const cli *c)
         return EXIT_USAGE;
     }
     ppb_sweep_opts o = {.device = c->device, .quiet = c->quiet, .yes = c->yes,
-                        .shard_i = c->shard_i, .shard_n = c->shard_n};
+                        .shard_i = c->shard_i, .shard_n = c->shard_n, .jobs = c->jobs};
     int rc = ppb_sweep_run(&cfg, &o, &err);
     if (rc == PPB_SWEEP_BAD_CONFIG) {
         fprintf(stderr, "ppbench: %s\n", err.msg);

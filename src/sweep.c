@@ -92,12 +92,11 @@ static void write_rows(const ppb_config *cfg, const ppb_config *pt, long long i,
 }
 
 static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i,
-                     const ppb_sweep_opts *o, ppb_err *err)
+                     ppb_run_ctx *ctx, ppb_err *err)
 {
     static ppb_experiment ex;
-    ppb_run_ctx ctx = {.device_selector = o->device, .quiet = 1};
     double t0 = ppb_now();
-    int rc = ppb_experiment_compute(&ex, pt, &ctx, err);
+    int rc = ppb_experiment_compute(&ex, pt, ctx, err);
     if (rc == 0 && !ex.partial) {
         char path[1300];
         uint64_t h = point_hash(pt);
@@ -114,7 +113,6 @@ static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i,
         }
     }
     ppb_experiment_free(&ex);
-    ppb_ctx_close(&ctx);
     return rc;
 }
 
@@ -221,27 +219,59 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
     return 0;
 }
 
+/* The points with index % parts == part, one device context for all of them. */
 static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, int parts,
-                     ppb_err *err)
+                     int quiet, ppb_err *err)
 {
     long long n = ppb_config_npoints(cfg);
     static ppb_config pt;
     ppb_progress pr;
-    ppb_progress_begin(&pr, cfg->name, "points", (double)n, o->quiet);
+    ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
+    ppb_run_ctx ctx = {.device_selector = o->device, .quiet = 1};
     long long done = 0;
-    for (long long i = 0; i < n && !ppb_interrupted(); i++) {
-        if (i % parts != part)
-            continue;
+    int rc = 0;
+    for (long long i = part; i < n && rc == 0 && !ppb_interrupted(); i += parts) {
         char path[1300];
-        if (ppb_config_point(cfg, i, &pt, err))
-            return -1;
+        if ((rc = ppb_config_point(cfg, i, &pt, err)) != 0)
+            break;
         point_file(cfg->out_dir, point_hash(&pt), "csv", path, sizeof path);
-        if (!exists(path) && run_point(cfg, &pt, i, o, err))
-            return -1;
+        if (!exists(path))
+            rc = run_point(cfg, &pt, i, &ctx, err);
         ppb_progress_update(&pr, (double)++done * parts);
     }
+    ppb_ctx_close(&ctx);
     ppb_progress_end(&pr, (double)done);
-    return 0;
+    return rc;
+}
+
+/* --jobs J: J processes, each its own device context, taking every J-th point of this shard;
+ * the first one shows progress. A failing child's message is on its stderr. */
+static int run_jobs(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
+{
+    int jobs = o->jobs > 1 ? o->jobs : 1, parts = o->shard_n * jobs;
+    if (jobs == 1)
+        return run_shard(cfg, o, o->shard_i - 1, o->shard_n, o->quiet, err);
+    fflush(NULL);
+    pid_t pids[64];
+    for (int j = 0; j < jobs; j++) {
+        pids[j] = fork();
+        if (pids[j] < 0)
+            return ppb_fail(err, "--jobs: fork failed");
+        if (pids[j] == 0) {
+            ppb_err e = {{0}};
+            int rc = run_shard(cfg, o, o->shard_i - 1 + o->shard_n * j, parts, o->quiet || j, &e);
+            if (rc)
+                fprintf(stderr, "ppbench sweep (job %d): %s\n", j + 1, e.msg);
+            _exit(rc ? 1 : 0);
+        }
+    }
+    int failed = 0;
+    for (int j = 0; j < jobs; j++) {
+        int st;
+        if (waitpid(pids[j], &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
+            failed++;
+    }
+    return failed ? ppb_fail(err, "%d of %d jobs failed", failed, jobs) : 0;
 }
 
 int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
@@ -252,7 +282,7 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
     snprintf(dir, sizeof dir, "%s/points", cfg->out_dir);
     if (ppb_mkdirs(dir, err) || write_grid(cfg, err))
         return -1;
-    if (run_shard(cfg, o, o->shard_i - 1, o->shard_n, err))
+    if (run_jobs(cfg, o, err))
         return -1;
     if (ppb_interrupted())
         return 0;

@@ -6,7 +6,8 @@
  * that of the point's resolved settings, so a re-run skips finished points and recomputes
  * changed ones. --shard I/N takes the points with index % N == I - 1; merge concatenates
  * shard directories' points in grid order into one sweep.csv, byte-identical to a whole run.
- * Timings go to timings.csv beside it, never into sweep.csv. */
+ * Timings go to timings.csv beside it, never into sweep.csv. --jobs J runs J processes on
+ * this machine, each taking every J-th point of the shard. */
 #ifndef PPB_SWEEP_H
 #define PPB_SWEEP_H
 
@@ -20,6 +21,7 @@ typedef struct ppb_sweep_opts {
     const char *device;
     int quiet, yes;
     int shard_i, shard_n; /* 1-based part of n */
+    int jobs;             /* processes on this machine (each opens the device), 1 = serial */
 } ppb_sweep_opts;
 
 /* Returns 0, -1 on a run failure, PPB_SWEEP_BAD_CONFIG when the grid is refused before any

@@ -1,6 +1,7 @@
 /* Sweeps and Monte Carlo shards (issue 8), through the built binary ($PPBENCH):
- * - a 2 x 3 x 2 sweep run whole, as 3 shards under GNU parallel then merged, and killed midway
- *   then resumed, gives byte-identical sweep.csv files (expected: the whole run's bytes);
+ * - a 2 x 3 x 2 sweep run whole, as 3 shards under GNU parallel then merged, with --jobs 2, and
+ *   killed midway then resumed, gives byte-identical sweep.csv files (expected: the whole
+ *   run's bytes);
  * - one Monte Carlo run split into 4 shards and merged gives radiance.csv and totals.csv
  *   byte-identical to the single run (photon i's random numbers depend on i alone);
  * - bad sweep configs fail before any work starts. */
@@ -65,6 +66,10 @@ static void test_sweep_whole_shards_resume(void **state)
     char w[1300], m[1300];
     snprintf(w, sizeof w, "%s/whole/sweep.csv", d);
     snprintf(m, sizeof m, "%s/merged/sweep.csv", d);
+    same_bytes(w, m);
+    /* Two processes on this machine (--jobs 2). */
+    assert_int_equal(sh("%s sweep --quiet --jobs 2 --out %s/jobs %s", b, d, cfg), 0);
+    snprintf(m, sizeof m, "%s/jobs/sweep.csv", d);
     same_bytes(w, m);
     /* Killed once its first point is written, then resumed. */
     assert_int_equal(sh("cd %s && (%s sweep --quiet --out %s/resumed %s & pid=$!; "
