@@ -15,7 +15,7 @@ static const ppb_method methods[] = {
     {"ss", NULL, 0, 0, "single scattering by ray marching", ppb_method_ss},
     {"mp", NULL, 0, 0, "multipole diffusion", ppb_method_mp},
     {"mp+ss", NULL, 0, 0, "multipole diffusion plus single scattering", ppb_method_mp_ss},
-    {"ppslab", NULL, 1, 0, "plane-parallel solution at the slab faces (slab mode only)",
+    {"ppslab", NULL, 1, 2, "plane-parallel solution at the slab faces (slab mode only)",
      ppb_method_ppslab},
 };
 

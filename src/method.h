@@ -35,7 +35,8 @@ typedef struct ppb_method {
     const char *id;
     const char *also;      /* id of a companion result, or NULL */
     int slab_only;         /* ppslab */
-    int reference;         /* the Monte Carlo: metrics compare every other method to it */
+    int reference;         /* 1: the Monte Carlo, which every other method is measured against;
+                              2: an exact answer methods are also checked against (ppslab) */
     const char *summary;
     ppb_method_fn run;
 } ppb_method;

@@ -69,8 +69,9 @@ while read -r case file method cell col op limit rest; do
     print (op == "<" ? v < l : v > l) }')
   n=$((n + 1))
   if [ "$ok" = 1 ]; then status=ok; else status=FAIL; fail=1; fi
-  printf '%-4s %-20s %-18s %-6s %-8s %-10s %s = %-10s %s %s\n' "$status" "$case" "$file" \
-    "$method" "$cell" "$col" "" "$v" "$op" "$limit${lim:+ ($lim)}"
+  shown=$limit; [ "$lim" = "$limit" ] || shown="$limit ($lim)"
+  printf '%-4s %-20s %-18s %-6s %-8s %-10s = %-12s %s %s\n' "$status" "$case" "$file" \
+    "$method" "$cell" "$col" "$v" "$op" "$shown"
 done < tests/thresholds.txt
 echo "regress: $n checks, $([ $fail = 0 ] && echo all passed || echo FAILURES) in $(( $(date +%s) - t0 ))s"
 exit $fail
