@@ -4,7 +4,7 @@
 # root, otherwise says which command to run).
 CC      ?= gcc
 BUILD   ?= build
-PKGS    := OpenCL lapacke openblas OpenEXR libpng inih cmocka
+PKGS    := OpenCL lapacke openblas OpenEXR libpng inih
 OPT     ?= -O2 -g
 WARN    := -Wall -Wextra $(if $(WERROR),-Werror)
 SAN     ?=
@@ -17,16 +17,18 @@ SRC   := $(filter-out src/main.c,$(wildcard src/*.c))
 OBJ   := $(SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
+BIN   ?= ppbench
 
 .PHONY: all deps test unit asan bench perf format format-check clean
-all: ppbench
+all: $(BIN)
 
 # Dependencies first: the pkg-config flags are only asked for once the packages are there.
-$(BUILD)/deps.mk: scripts/deps.sh
+$(BUILD)/deps.mk: scripts/deps.sh Makefile
 	@mkdir -p $(BUILD)
 	@bash scripts/deps.sh
-	@echo "PKG_CFLAGS := $$(pkg-config --cflags $(PKGS))" > $@.tmp
+	@echo "PKG_CFLAGS := $$(pkg-config --cflags $(PKGS) cmocka)" > $@.tmp
 	@echo "PKG_LIBS := $$(pkg-config --libs $(PKGS)) -lm -lpthread" >> $@.tmp
+	@echo "TEST_LIBS := $$(pkg-config --libs cmocka)" >> $@.tmp
 	@mv $@.tmp $@
 ifeq ($(filter clean format format-check,$(MAKECMDGOALS)),)
 include $(BUILD)/deps.mk
@@ -41,31 +43,32 @@ $(LIB): $(OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-ppbench: $(BUILD)/obj/main.o $(LIB)
+$(BIN): $(BUILD)/obj/main.o $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $^ $(PKG_LIBS)
 
 $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS)
+	$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS) \
+	  $(TEST_LIBS)
 
 # Unit tests: every tests/test_*.c is a cmocka suite; each prints cmocka's own summary.
-unit: ppbench $(TESTS)
+unit: $(BIN) $(TESTS)
 	@mkdir -p $(BUILD)/tmp
 	@fail=0; for t in $(TESTS); do \
-	  echo "== $$t"; PPBENCH=$(CURDIR)/ppbench TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
+	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
 	done; exit $$fail
 
 test: unit
 	@bash tests/regress.sh
 
 asan:
-	$(MAKE) BUILD=build-asan SAN="-fsanitize=address,undefined -fno-omit-frame-pointer" \
-	  OPT="-O1 -g" unit
+	$(MAKE) BUILD=build-asan BIN=build-asan/ppbench OPT="-O1 -g" \
+	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" unit
 
-bench: ppbench
+bench: $(BIN)
 	@bash scripts/bench.sh $(if $(QUICK),--quick)
 
-perf: ppbench
+perf: $(BIN)
 	@./ppbench perf
 
 format:
