@@ -25,11 +25,23 @@ enum { PPB_S1 = 0, PPB_S2 = 1, PPB_S3 = 2, PPB_S4 = 3, PPB_NSURF = 4 };
 enum { PPB_STEP_NONE = 0, PPB_STEP_DENSITY = 1, PPB_STEP_ALBEDO = 2, PPB_STEP_SHADOW = 3 };
 
 /* Outward normal of a surface, as (x, y); the z component is 0. */
-PPB_FN double ppb_normal_x(int surf) { return surf == PPB_S3 ? -1.0 : surf == PPB_S4 ? 1.0 : 0.0; }
-PPB_FN double ppb_normal_y(int surf) { return surf == PPB_S1 ? 1.0 : surf == PPB_S2 ? -1.0 : 0.0; }
+PPB_FN double ppb_normal_x(int surf)
+{
+    return surf == PPB_S3 ? -1.0 : surf == PPB_S4 ? 1.0 : 0.0;
+}
+PPB_FN double ppb_normal_y(int surf)
+{
+    return surf == PPB_S1 ? 1.0 : surf == PPB_S2 ? -1.0 : 0.0;
+}
 /* t = n x b with b = +z gives t = (n_y, -n_x, 0): +x on S1, -x on S2, +y on S3, -y on S4. */
-PPB_FN double ppb_tangent_x(int surf) { return ppb_normal_y(surf); }
-PPB_FN double ppb_tangent_y(int surf) { return -ppb_normal_x(surf); }
+PPB_FN double ppb_tangent_x(int surf)
+{
+    return ppb_normal_y(surf);
+}
+PPB_FN double ppb_tangent_y(int surf)
+{
+    return -ppb_normal_x(surf);
+}
 
 /* Theta bin of an outgoing direction with mu = cos(theta) = w.n >= 0: edges at
  * sin^2(theta) = k / ntheta (equal projected solid angle). */
@@ -58,7 +70,10 @@ PPB_FN int ppb_dir_bin(int surf, double wx, double wy, double wz, int ntheta, in
 
 /* Projected solid angle of every bin: (1/2) d(sin^2) x 2 d(phi) = pi / (ntheta nphi); the
  * folded bin counts both phi and -phi. */
-PPB_FN double ppb_bin_proj_solid_angle(int ntheta, int nphi) { return PPB_PI / (ntheta * nphi); }
+PPB_FN double ppb_bin_proj_solid_angle(int ntheta, int nphi)
+{
+    return PPB_PI / (ntheta * nphi);
+}
 
 /* A direction inside bin (itheta, iphi) at fractional position (u, v) in [0,1)^2, uniform in
  * sin^2(theta) and phi, i.e. uniform in projected solid angle; written in world coordinates

@@ -3,8 +3,8 @@
 #include "ppb_conventions.h"
 
 __kernel void bins_of(__global const double *mu, __global const double *wt,
-                      __global const double *wb, __global int *theta_bin,
-                      __global int *phi_bin, int ntheta, int nphi)
+                      __global const double *wb, __global int *theta_bin, __global int *phi_bin,
+                      int ntheta, int nphi)
 {
     size_t i = get_global_id(0);
     theta_bin[i] = ppb_theta_bin(mu[i], ntheta);

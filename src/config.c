@@ -317,9 +317,8 @@ static int on_key(void *user, const char *section, const char *name, const char 
     int i = find_key(section, name);
     snprintf(st->what, sizeof st->what, "[%s] %s", section, name);
     if (i < 0) {
-        snprintf(st->why, sizeof st->why, "%s", section_known(section)
-                                                    ? "unknown key"
-                                                    : "unknown section");
+        snprintf(st->why, sizeof st->why, "%s",
+                 section_known(section) ? "unknown key" : "unknown section");
         return 0;
     }
     if (st->seen[i]) {
@@ -399,8 +398,8 @@ static int apply_defaults(ppb_config *cfg, ppb_err *err)
     char why[512];
     for (int i = 0; i < NKEYS; i++)
         if (set_key(cfg, i, keys[i].def, 0, why, sizeof why))
-            return ppb_fail(err, "internal: default of [%s] %s: %s", keys[i].section,
-                            keys[i].key, why);
+            return ppb_fail(err, "internal: default of [%s] %s: %s", keys[i].section, keys[i].key,
+                            why);
     cfg->naxes = 0;
     return 0;
 }
@@ -528,8 +527,8 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out)
 
 void ppb_config_write_keys(FILE *out)
 {
-    static const char *types[] = {"integer", "integer", "real", "one of", "name", "path",
-                                  "list of method ids"};
+    static const char *types[] = {"integer", "integer",           "real", "one of", "name",
+                                  "path",    "list of method ids"};
     fprintf(out, "| section | key | type | default | range | meaning |\n");
     fprintf(out, "|---|---|---|---|---|---|\n");
     for (int i = 0; i < NKEYS; i++) {

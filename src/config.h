@@ -14,18 +14,18 @@
 #include "scene.h"
 
 #define PPB_MAX_METHODS 16
-#define PPB_MAX_AXES 8
-#define PPB_MAX_LIST 1024
-#define PPB_MAX_KEYS 64
+#define PPB_MAX_AXES    8
+#define PPB_MAX_LIST    1024
+#define PPB_MAX_KEYS    64
 
 typedef struct ppb_mc_settings {
-    long long photons;    /* photon budget */
-    int batches;          /* independent batches for standard errors */
-    long long seed;       /* Philox key */
-    int workgroup;        /* local size; 0 = let the runtime choose */
-    long long chunk;      /* photons per kernel launch; 0 = sized to the device */
-    long long first;      /* first photon index of this run (a shard of one point) */
-    double target_noise;  /* stop early when noise_rel at the x = 0 cells falls below; 0 = off */
+    long long photons;   /* photon budget */
+    int batches;         /* independent batches for standard errors */
+    long long seed;      /* Philox key */
+    int workgroup;       /* local size; 0 = let the runtime choose */
+    long long chunk;     /* photons per kernel launch; 0 = sized to the device */
+    long long first;     /* first photon index of this run (a shard of one point) */
+    double target_noise; /* stop early when noise_rel at the x = 0 cells falls below; 0 = off */
 } ppb_mc_settings;
 
 typedef struct ppb_pp_settings {
@@ -38,8 +38,8 @@ typedef struct ppb_pp_settings {
 } ppb_pp_settings;
 
 typedef struct ppb_mp_settings {
-    int pairs;      /* dipole pairs beyond the first (multipole) */
-    int samples;    /* quadrature nodes per mfp over the lit strip */
+    int pairs;   /* dipole pairs beyond the first (multipole) */
+    int samples; /* quadrature nodes per mfp over the lit strip */
 } ppb_mp_settings;
 
 /* One swept key: its table index and values. */
@@ -56,14 +56,14 @@ typedef struct ppb_config {
     int nmethods;
     char methods[PPB_MAX_METHODS][32];
     ppb_scene scene;
-    int samples_dir;  /* directions per bin axis for deterministic methods (n x n per bin) */
-    int samples_seg;  /* points per segment for deterministic methods */
+    int samples_dir; /* directions per bin axis for deterministic methods (n x n per bin) */
+    int samples_seg; /* points per segment for deterministic methods */
     ppb_mc_settings mc;
     ppb_pp_settings pp;
     ppb_mp_settings mp;
     char out_dir[1024];
     int key_line[PPB_MAX_KEYS]; /* line of each key in the file, 0 = default */
-    int naxes; /* keys holding lists: a sweep */
+    int naxes;                  /* keys holding lists: a sweep */
     ppb_axis axes[PPB_MAX_AXES];
 } ppb_config;
 

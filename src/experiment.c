@@ -138,8 +138,8 @@ static int write_provenance(const ppb_experiment *ex, ppb_err *err)
     time_t now = time(NULL);
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
     fprintf(af.f, "# ppbench provenance: what produced the files beside this one\n");
-    fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION,
-            ex->cfg->path, when);
+    fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
+            when);
     fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
             ex->partial);
     for (int i = 0; i < ex->n; i++)
@@ -170,8 +170,7 @@ static int write_comparisons(const ppb_experiment *ex, ppb_err *err)
         char file[128];
         snprintf(file, sizeof file, "summary_%s.csv", ex->res[i].method);
         out_path(ex, file, path, sizeof path);
-        if (ppb_write_summary_csv(path, ex->res, ex->n, &ex->res[i], skip_for(&ex->res[i]),
-                                  err))
+        if (ppb_write_summary_csv(path, ex->res, ex->n, &ex->res[i], skip_for(&ex->res[i]), err))
             return -1;
     }
     return 0;

@@ -49,15 +49,16 @@ static void usage(FILE *out)
             "methods:\n");
     for (int i = 0; i < ppb_method_count(); i++)
         fprintf(out, "  %-8s %s\n", ppb_method_at(i)->id, ppb_method_at(i)->summary);
-    fprintf(out, "\n"
-                 "examples:\n"
-                 "  ppbench run configs/uniform_g0_normal.ini\n"
-                 "  ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini\n"
-                 "  ppbench sweep --shard 2/3 configs/sweep_example.ini\n"
-                 "  PPBENCH_DEVICE=pthread ppbench devices\n"
-                 "\n"
-                 "exit codes: 0 success; 1 a run failed (OpenCL, I/O, numerics); 2 bad command\n"
-                 "line or config; 130 interrupted (what was done is written, marked partial).\n");
+    fprintf(out,
+            "\n"
+            "examples:\n"
+            "  ppbench run configs/uniform_g0_normal.ini\n"
+            "  ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini\n"
+            "  ppbench sweep --shard 2/3 configs/sweep_example.ini\n"
+            "  PPBENCH_DEVICE=pthread ppbench devices\n"
+            "\n"
+            "exit codes: 0 success; 1 a run failed (OpenCL, I/O, numerics); 2 bad command\n"
+            "line or config; 130 interrupted (what was done is written, marked partial).\n");
 }
 
 typedef struct cli {
@@ -125,8 +126,7 @@ static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_err 
         char sec[64], key[64];
         const char *eq = strchr(c->sets[i], '=');
         const char *dot = strchr(c->sets[i], '.');
-        if (!eq || !dot || dot > eq ||
-            sscanf(c->sets[i], "%63[^.].%63[^=]", sec, key) != 2)
+        if (!eq || !dot || dot > eq || sscanf(c->sets[i], "%63[^.].%63[^=]", sec, key) != 2)
             return ppb_fail(err, "--set %s: expected SECTION.KEY=VALUE", c->sets[i]);
         if (ppb_config_set(cfg, sec, key, eq + 1, err))
             return -1;
@@ -210,8 +210,12 @@ static int cmd_sweep(const cli *c)
         fprintf(stderr, "ppbench: %s\n", err.msg);
         return EXIT_USAGE;
     }
-    ppb_sweep_opts o = {.device = c->device, .quiet = c->quiet, .yes = c->yes,
-                        .shard_i = c->shard_i, .shard_n = c->shard_n, .jobs = c->jobs};
+    ppb_sweep_opts o = {.device = c->device,
+                        .quiet = c->quiet,
+                        .yes = c->yes,
+                        .shard_i = c->shard_i,
+                        .shard_n = c->shard_n,
+                        .jobs = c->jobs};
     int rc = ppb_sweep_run(&cfg, &o, &err);
     if (rc == PPB_SWEEP_BAD_CONFIG) {
         fprintf(stderr, "ppbench: %s\n", err.msg);

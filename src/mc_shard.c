@@ -40,8 +40,8 @@ int ppb_mc_shard_run(const ppb_config *cfg, const char *device, int quiet, int i
     return rc;
 }
 
-static int load_sum(const ppb_config *cfg, const char *const *dirs, int ndirs,
-                    ppb_mc_tallies *sum, ppb_err *err)
+static int load_sum(const ppb_config *cfg, const char *const *dirs, int ndirs, ppb_mc_tallies *sum,
+                    ppb_err *err)
 {
     if (ppb_mc_tallies_init(sum, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
         return -1;

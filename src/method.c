@@ -10,7 +10,8 @@
 
 /* The registry: the order here is the order of outputs. */
 static const ppb_method methods[] = {
-    {"mc", "mc1", 0, 1, "photon Monte Carlo reference (mc1: its once-scattered part)", ppb_method_mc},
+    {"mc", "mc1", 0, 1, "photon Monte Carlo reference (mc1: its once-scattered part)",
+     ppb_method_mc},
     {"pp", NULL, 0, 0, "plane-parallel ray marching, the paper's method", ppb_method_pp},
     {"ss", NULL, 0, 0, "single scattering by ray marching", ppb_method_ss},
     {"mp", NULL, 0, 0, "multipole diffusion", ppb_method_mp},
@@ -19,7 +20,10 @@ static const ppb_method methods[] = {
      ppb_method_ppslab},
 };
 
-int ppb_method_count(void) { return (int)(sizeof methods / sizeof methods[0]); }
+int ppb_method_count(void)
+{
+    return (int)(sizeof methods / sizeof methods[0]);
+}
 
 const ppb_method *ppb_method_at(int i)
 {

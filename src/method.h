@@ -19,7 +19,7 @@ typedef struct ppb_run_ctx {
     const char *device_selector; /* --device, or NULL */
     ppb_ocl ocl;
     int ocl_open;
-    int quiet;                   /* no progress lines */
+    int quiet;                           /* no progress lines */
     struct ppb_march_cache *march_cache; /* owned by the caller; NULL = build afresh */
 } ppb_run_ctx;
 
@@ -33,10 +33,10 @@ typedef int (*ppb_method_fn)(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
 typedef struct ppb_method {
     const char *id;
-    const char *also;      /* id of a companion result, or NULL */
-    int slab_only;         /* ppslab */
-    int reference;         /* 1: the Monte Carlo, which every other method is measured against;
-                              2: an exact answer methods are also checked against (ppslab) */
+    const char *also; /* id of a companion result, or NULL */
+    int slab_only;    /* ppslab */
+    int reference;    /* 1: the Monte Carlo, which every other method is measured against;
+                         2: an exact answer methods are also checked against (ppslab) */
     const char *summary;
     ppb_method_fn run;
 } ppb_method;

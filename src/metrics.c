@@ -29,8 +29,7 @@ ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_poi
 
 const char *ppb_cell_name(int cell)
 {
-    static const char *names[PPB_NCELLS] = {"R_x0",   "T_x0",   "S1_all",
-                                            "S2_all", "S3_all", "S4_all"};
+    static const char *names[PPB_NCELLS] = {"R_x0", "T_x0", "S1_all", "S2_all", "S3_all", "S4_all"};
     return (cell >= 0 && cell < PPB_NCELLS) ? names[cell] : "?";
 }
 

@@ -22,8 +22,15 @@ typedef struct ppb_point {
 ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_point *pts, int n);
 
 /* The summary cells of SPEC.md section 5, in output order. */
-enum { PPB_CELL_R_X0, PPB_CELL_T_X0, PPB_CELL_S1_ALL, PPB_CELL_S2_ALL, PPB_CELL_S3_ALL,
-       PPB_CELL_S4_ALL, PPB_NCELLS };
+enum {
+    PPB_CELL_R_X0,
+    PPB_CELL_T_X0,
+    PPB_CELL_S1_ALL,
+    PPB_CELL_S2_ALL,
+    PPB_CELL_S3_ALL,
+    PPB_CELL_S4_ALL,
+    PPB_NCELLS
+};
 const char *ppb_cell_name(int cell);
 
 /* Points of a summary cell; returns how many were written to pts (at most the surface's

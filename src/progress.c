@@ -21,8 +21,14 @@ void ppb_progress_install_signals(void)
     sigaction(SIGTERM, &sa, NULL);
 }
 
-int ppb_interrupted(void) { return interrupted != 0; }
-void ppb_interrupt_reset(void) { interrupted = 0; }
+int ppb_interrupted(void)
+{
+    return interrupted != 0;
+}
+void ppb_interrupt_reset(void)
+{
+    interrupted = 0;
+}
 
 double ppb_now(void)
 {

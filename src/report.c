@@ -15,10 +15,14 @@ typedef struct paper_row {
 } paper_row;
 
 static const paper_row paper[] = {
-    {"uniform_g0_normal", "R_x0", 13, 13, 23, 65},   {"uniform_g0_normal", "T_x0", 4, 72, 24, 56},
-    {"uniform_g0_oblique", "R_x0", 10, 43, 101, 57}, {"uniform_g0_oblique", "T_x0", 8, 210, 302, 89},
-    {"uniform_gm05_normal", "R_x0", 20, 23, 51, 48}, {"uniform_gm05_normal", "T_x0", 5, 84, 189, 47},
-    {"uniform_gp05_normal", "R_x0", 24, 19, 6, 81},  {"uniform_gp05_normal", "T_x0", 7, 58, 26, 66},
+    {"uniform_g0_normal", "R_x0", 13, 13, 23, 65},
+    {"uniform_g0_normal", "T_x0", 4, 72, 24, 56},
+    {"uniform_g0_oblique", "R_x0", 10, 43, 101, 57},
+    {"uniform_g0_oblique", "T_x0", 8, 210, 302, 89},
+    {"uniform_gm05_normal", "R_x0", 20, 23, 51, 48},
+    {"uniform_gm05_normal", "T_x0", 5, 84, 189, 47},
+    {"uniform_gp05_normal", "R_x0", 24, 19, 6, 81},
+    {"uniform_gp05_normal", "T_x0", 7, 58, 26, 66},
 };
 
 static double paper_value(const char *case_name, const char *cell, const char *method)
@@ -45,8 +49,7 @@ typedef struct summary_row {
 } summary_row;
 
 /* Reads <dir>/<case>/summary.csv; returns the row count or -1. */
-static int read_summary(const char *dir, const char *name, summary_row *rows, int cap,
-                        ppb_err *err)
+static int read_summary(const char *dir, const char *name, summary_row *rows, int cap, ppb_err *err)
 {
     char path[1200], line[512];
     snprintf(path, sizeof path, "%s/%s/summary.csv", dir, name);
@@ -68,7 +71,10 @@ static int read_summary(const char *dir, const char *name, summary_row *rows, in
     return n;
 }
 
-static void md_cell(FILE *f, double v) { fprintf(f, isnan(v) ? " - |" : " %.1f |", v); }
+static void md_cell(FILE *f, double v)
+{
+    fprintf(f, isnan(v) ? " - |" : " %.1f |", v);
+}
 
 static int write_tables(const char *dir, const char *const *cases, int ncases, ppb_err *err)
 {
@@ -98,8 +104,8 @@ static int write_tables(const char *dir, const char *const *cases, int ncases, p
             if (strcmp(r->cell, "R_x0") && strcmp(r->cell, "T_x0"))
                 continue;
             double pv = paper_value(cases[c], r->cell, r->method);
-            fprintf(csv.f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g\n", cases[c], r->cell, r->method,
-                    r->rms, r->noise, r->excess, pv / 100);
+            fprintf(csv.f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g\n", cases[c], r->cell, r->method, r->rms,
+                    r->noise, r->excess, pv / 100);
             fprintf(md.f, "| %s | %c | %s |", cases[c], r->cell[0], r->method);
             md_cell(md.f, 100 * r->rms);
             md_cell(md.f, 100 * r->noise);

@@ -18,8 +18,8 @@ typedef struct ppb_result {
     double *radiance; /* [layout.ncells], 1/sr per E_perp, scattered light only */
     double *se;       /* [layout.ncells], standard error; 0 for deterministic methods */
     ppb_totals totals;
-    int partial;          /* 1: interrupted before the full budget (Monte Carlo) */
-    long long photons;    /* Monte Carlo photons traced; 0 otherwise */
+    int partial;       /* 1: interrupted before the full budget (Monte Carlo) */
+    long long photons; /* Monte Carlo photons traced; 0 otherwise */
 } ppb_result;
 
 int ppb_result_init(ppb_result *r, const char *method, const ppb_layout *lo, ppb_err *err);

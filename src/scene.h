@@ -26,11 +26,11 @@ typedef struct ppb_scene {
 
 /* Where each surface's segments sit in a flat radiance array. */
 typedef struct ppb_layout {
-    int nsurf;               /* 4 for the tube, 2 for the slab */
-    int nseg[PPB_NSURF];     /* 0 for surfaces that do not exist */
-    int offset[PPB_NSURF];   /* first segment row of each surface */
-    int nbins;               /* ntheta * nphi */
-    size_t ncells;           /* total rows * nbins */
+    int nsurf;             /* 4 for the tube, 2 for the slab */
+    int nseg[PPB_NSURF];   /* 0 for surfaces that do not exist */
+    int offset[PPB_NSURF]; /* first segment row of each surface */
+    int nbins;             /* ntheta * nphi */
+    size_t ncells;         /* total rows * nbins */
 } ppb_layout;
 
 ppb_layout ppb_scene_layout(const ppb_scene *sc);

@@ -85,14 +85,14 @@ static void write_rows(const ppb_config *cfg, const ppb_config *pt, long long i,
         }
         ppb_totals t = ex->res[m].totals;
         ppb_totals_complete(&t);
-        fprintf(f, ",%.6g,%.6g,%.10g,%.10g,%.10g,%.10g,%.10g\n", x0[0].noise_rel,
-                x0[1].noise_rel, t.R, t.T, t.sides, t.absorbed, t.ballistic);
+        fprintf(f, ",%.6g,%.6g,%.10g,%.10g,%.10g,%.10g,%.10g\n", x0[0].noise_rel, x0[1].noise_rel,
+                t.R, t.T, t.sides, t.absorbed, t.ballistic);
     }
     free(pts);
 }
 
-static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i,
-                     ppb_run_ctx *ctx, ppb_err *err)
+static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i, ppb_run_ctx *ctx,
+                     ppb_err *err)
 {
     static ppb_experiment ex;
     double t0 = ppb_now();
@@ -220,8 +220,8 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
 }
 
 /* The points with index % parts == part, one device context for all of them. */
-static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, int parts,
-                     int quiet, ppb_err *err)
+static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, int parts, int quiet,
+                     ppb_err *err)
 {
     long long n = ppb_config_npoints(cfg);
     static ppb_config pt;

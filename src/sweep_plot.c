@@ -8,7 +8,7 @@
 
 /* Columns of sweep.csv: point, one per axis, method, rms per summary cell, ... */
 #define COL_METHOD(naxes) ((naxes) + 2)
-#define COL_RMS_R(naxes) ((naxes) + 3)
+#define COL_RMS_R(naxes)  ((naxes) + 3)
 
 /* Rows of one method whose axes beyond the first two sit at their first value, as
  * "x y rms_R rms_T" lines for gnuplot. */

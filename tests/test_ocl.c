@@ -123,8 +123,8 @@ static void test_list(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_error_names), cmocka_unit_test(test_list),
-        cmocka_unit_test(test_choose_device), cmocka_unit_test(test_build_log),
+        cmocka_unit_test(test_error_names),         cmocka_unit_test(test_list),
+        cmocka_unit_test(test_choose_device),       cmocka_unit_test(test_build_log),
         cmocka_unit_test(test_kernel_matches_host),
     };
     return cmocka_run_group_tests_name("ocl", tests, NULL, NULL);

@@ -108,9 +108,8 @@ static void test_mc_shards_merge(void **state)
         same_bytes(a, c);
     }
     /* A missing shard is refused: 3 of 4 parts do not make the budget. */
-    assert_int_not_equal(sh("%s mc-merge --out %s/bad %s %s/p1 %s/p2 %s/p3 2>/dev/null", b, d,
-                            cfg, d, d, d),
-                         0);
+    assert_int_not_equal(
+        sh("%s mc-merge --out %s/bad %s %s/p1 %s/p2 %s/p3 2>/dev/null", b, d, cfg, d, d, d), 0);
 }
 
 static void test_bad_sweeps(void **state)

@@ -34,10 +34,21 @@ static inline const char *tu_scratch(const char *name)
 /* SPEC.md section 6's defaults: W = 10, H = 3, sigma_t = 1, alpha = 0.95, g = 0, normal light. */
 static inline ppb_scene tu_tube(void)
 {
-    ppb_scene sc = {.geometry = PPB_GEOM_TUBE, .width = 10, .height = 3, .segments_top = 128,
-                    .segments_side = 36, .sigma_t = 1, .albedo = 0.95, .g = 0,
-                    .step = PPB_STEP_NONE, .step_x = 0, .sigma_t_right = 0.5,
-                    .albedo_right = 0.475, .theta_deg = 0, .ntheta = 8, .nphi = 8};
+    ppb_scene sc = {.geometry = PPB_GEOM_TUBE,
+                    .width = 10,
+                    .height = 3,
+                    .segments_top = 128,
+                    .segments_side = 36,
+                    .sigma_t = 1,
+                    .albedo = 0.95,
+                    .g = 0,
+                    .step = PPB_STEP_NONE,
+                    .step_x = 0,
+                    .sigma_t_right = 0.5,
+                    .albedo_right = 0.475,
+                    .theta_deg = 0,
+                    .ntheta = 8,
+                    .nphi = 8};
     return sc;
 }
 
