@@ -73,6 +73,15 @@ static void test_devices_and_keys(void **state)
     (void)state;
     expect("devices", 0, "0: ");
     expect("keys", 0, "| mc | photons |");
+    /* configs/README.md documents every key: it must hold the table `ppbench keys` prints
+     * (the source of both is the key table in src/config.c). */
+    char cmd[1400];
+    const char *b = getenv("PPBENCH");
+    snprintf(cmd, sizeof cmd,
+             "%s keys | while IFS= read -r l; do grep -qxF -- \"$l\" configs/README.md || "
+             "{ echo \"configs/README.md lacks: $l\"; exit 1; }; done",
+             b ? b : "./ppbench");
+    assert_int_equal(system(cmd), 0);
     expect("run --device no-such-device-xyz --quiet --set experiment.methods=mc "
            "--set mc.photons=1000 --out /nonexistent-dir/x configs/uniform_g0_normal.ini",
            1, "no device name contains it");
