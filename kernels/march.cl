@@ -6,6 +6,9 @@
  *     L(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) J(q, w) dl,   q = p - l w,
  * with J = [table part at tau = D cos(theta_L), average albedo abar] + C(w, abar) exp(-D) from
  * the light maps (D, abar, lit). `ss` has C = p(w.w_L) and no table part (paper Eq. 5, n = 1).
+ * The table part is I_pp of the slab the point sits in (Eq. 13-14): the point's vertical column
+ * is a homogeneous slab of thickness sigma_t(x) H, and tau is clamped to it; with a density step
+ * the two columns have their own tables (march_params.h), selected by the piece's sigma_t.
  *
  * The ray is cut into pieces at every line where the medium or the maps have a jump or a kink
  * (the step plane x = step_x, the light lines x' = step_x and x' = -W/2). Within a piece sigma_t
@@ -29,18 +32,34 @@ inline double ppb_phi1(double z)
     return fabs(z) < 1e-300 ? 1.0 : expm1(z) / z;
 }
 
-/* The maps at distance l along the march, tau = D cos(theta_L) clamped to the slab. */
+/* One column slab's tables: its tau grid and where its blocks start in the R, S and C arrays. */
+typedef struct ppb_mcol {
+    double tau0, tau_h;
+    int ntau;
+    long tab_off, coef_off;
+} ppb_mcol;
+
+/* Column c of the tables ([ncols][nalb][ndir][ntau[c]], C [ncols][nalb][ndir]). */
+inline ppb_mcol ppb_column(const ppb_march_params *P, int ndir, int c)
+{
+    ppb_mcol m = {P->tau0[c], P->tau_h[c], P->ntau[c], 0, (long)c * P->nalb * ndir};
+    for (int k = 0; k < c; k++)
+        m.tab_off += (long)P->nalb * ndir * P->ntau[k];
+    return m;
+}
+
+/* The maps at distance l along the march, tau = D cos(theta_L) clamped to the column's slab. */
 typedef struct ppb_msample {
     double D, tau, abar, lit;
 } ppb_msample;
 
-inline ppb_msample ppb_sample(const ppb_march_params *P, __global const double *map, double px,
-                              double py, double mx, double my, double l)
+inline ppb_msample ppb_sample(const ppb_march_params *P, __global const double *map, double tau0,
+                              double px, double py, double mx, double my, double l)
 {
     ppb_msample s;
     ppb_map_lookup(map, P->map_xp0, P->map_h, P->map_nx, P->map_ny, P->tan_theta_l, px + l * mx,
                    py + l * my, &s.D, &s.abar, &s.lit);
-    s.tau = clamp(s.D * P->cos_theta_l, 0.0, P->tau0);
+    s.tau = clamp(s.D * P->cos_theta_l, 0.0, tau0);
     return s;
 }
 
@@ -61,17 +80,17 @@ inline ppb_anodes ppb_albedo_nodes(const ppb_march_params *P, double abar)
     return a;
 }
 
-/* Table value at tau, linear in tau and in the albedo nodes. */
-inline double ppb_table(const ppb_march_params *P, __global const double *tab, int ndir, int dir,
-                        ppb_anodes an, double tau)
+/* Table value of column col at tau, linear in tau and in the albedo nodes. */
+inline double ppb_table(__global const double *tab, ppb_mcol col, int ndir, int dir, ppb_anodes an,
+                        double tau)
 {
-    double t = tau / P->tau_h;
-    int k = clamp((int)floor(t), 0, P->ntau - 2);
+    double t = tau / col.tau_h;
+    int k = clamp((int)floor(t), 0, col.ntau - 2);
     double f = clamp(t - k, 0.0, 1.0);
-    __global const double *c = tab + ((long)an.i * ndir + dir) * P->ntau + k;
+    __global const double *c = tab + col.tab_off + ((long)an.i * ndir + dir) * col.ntau + k;
     double v = c[0] + f * (c[1] - c[0]);
     if (an.f > 0.0) {
-        c += (long)ndir * P->ntau;
+        c += (long)ndir * col.ntau;
         v += an.f * (c[0] + f * (c[1] - c[0]) - v);
     }
     return v;
@@ -89,17 +108,19 @@ inline int ppb_slope_ok(double tau1, double tau2, double r0, double sigma_t, dou
     return fabs(tau2 - tau1 - r0 * sigma_t * h) <= 1e-9 * (1.0 + fabs(tau1) + fabs(tau2));
 }
 
-/* Marches one piece [la, lb] of constant sigma_t, alpha; returns its radiance and advances *d. */
+/* Marches one piece [la, lb] of constant sigma_t, alpha inside column col; returns its radiance
+ * and advances *d. */
 inline double ppb_piece(const ppb_march_params *P, __global const double *map,
                         __global const double *tabR, __global const double *tabS,
-                        __global const double *coefC, int ndir, int dir, double r0, double px,
-                        double py, double mx, double my, double la, double lb, double sigma_t,
-                        double alpha, double *d)
+                        __global const double *coefC, ppb_mcol col, int ndir, int dir, double r0,
+                        double px, double py, double mx, double my, double la, double lb,
+                        double sigma_t, double alpha, double *d)
 {
     double len = lb - la, eps = 1e-9 * len;
-    ppb_msample a = ppb_sample(P, map, px, py, mx, my, la + eps);
-    ppb_msample b = ppb_sample(P, map, px, py, mx, my, lb - eps);
-    ppb_msample m = ppb_sample(P, map, px, py, mx, my, 0.5 * (la + lb));
+    coefC += col.coef_off;
+    ppb_msample a = ppb_sample(P, map, col.tau0, px, py, mx, my, la + eps);
+    ppb_msample b = ppb_sample(P, map, col.tau0, px, py, mx, my, lb - eps);
+    ppb_msample m = ppb_sample(P, map, col.tau0, px, py, mx, my, 0.5 * (la + lb));
     double tolD = 1e-9 * (1.0 + a.D + b.D);
     /* Bilinear weights sum to 1 only to an ulp, hence the tolerances. */
     int regular = P->telescope && fabs(a.lit - b.lit) <= 1e-12 && fabs(a.lit - m.lit) <= 1e-12 &&
@@ -117,15 +138,15 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
         sum = C * exp(-(d0 + a.D)) * sigma_t * len * ppb_phi1(-(sigma_t * len + b.D - a.D));
         if (P->with_modes && P->table == PPB_TABLE_S &&
             ppb_slope_ok(a.tau, b.tau, r0, sigma_t, len - 2.0 * eps)) {
-            sum += exp(-*d) * ppb_table(P, tabS, ndir, dir, an, b.tau) -
-                   exp(-d0) * ppb_table(P, tabS, ndir, dir, an, a.tau);
+            sum += exp(-*d) * ppb_table(tabS, col, ndir, dir, an, b.tau) -
+                   exp(-d0) * ppb_table(tabS, col, ndir, dir, an, a.tau);
         } else if (P->with_modes) {
             /* R rule on a linear tau: the midpoints need no map lookups. */
             int n = max(1, (int)ceil(len / P->step));
             double h = len / n, att = exp(-sigma_t * h), e = exp(-(d0 + 0.5 * sigma_t * h));
             for (int i = 0; i < n && d0 + sigma_t * h * i < P->d_cap; i++, e *= att)
                 sum += sigma_t * h * e *
-                       ppb_table(P, tabR, ndir, dir, an, a.tau + (b.tau - a.tau) * (i + 0.5) / n);
+                       ppb_table(tabR, col, ndir, dir, an, a.tau + (b.tau - a.tau) * (i + 0.5) / n);
         }
         return alpha * a.lit * sum;
     }
@@ -138,8 +159,8 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
         if (d1 > P->d_cap)
             break;
         double l1 = la + h * i;
-        ppb_msample s2 = i + 1 == n ? b : ppb_sample(P, map, px, py, mx, my, l1 + h);
-        ppb_msample sm = ppb_sample(P, map, px, py, mx, my, l1 + 0.5 * h);
+        ppb_msample s2 = i + 1 == n ? b : ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + h);
+        ppb_msample sm = ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + 0.5 * h);
         if (sm.lit > 0.0) {
             ppb_anodes an = ppb_albedo_nodes(P, sm.abar);
             double C = ppb_coef(coefC, ndir, dir, an);
@@ -147,11 +168,11 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
             if (P->with_modes) {
                 double hs = (i == 0 ? h - eps : h) - (i + 1 == n ? eps : 0.0);
                 if (P->table == PPB_TABLE_S && ppb_slope_ok(s1.tau, s2.tau, r0, sigma_t, hs))
-                    v += exp(-(d1 + sigma_t * h)) * ppb_table(P, tabS, ndir, dir, an, s2.tau) -
-                         exp(-d1) * ppb_table(P, tabS, ndir, dir, an, s1.tau);
+                    v += exp(-(d1 + sigma_t * h)) * ppb_table(tabS, col, ndir, dir, an, s2.tau) -
+                         exp(-d1) * ppb_table(tabS, col, ndir, dir, an, s1.tau);
                 else
                     v += sigma_t * h * exp(-(d1 + 0.5 * sigma_t * h)) *
-                         ppb_table(P, tabR, ndir, dir, an, sm.tau);
+                         ppb_table(tabR, col, ndir, dir, an, sm.tau);
             }
             sum += sm.lit * v;
         }
@@ -227,8 +248,11 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
         double alpha = P->tube
                            ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
                            : P->albedo;
-        L += ppb_piece(P, map, tabR, tabS, coefC, ndir, dir, r0, px, py, mx, my, la, lb, sigma_t,
-                       alpha, &d);
+        /* The piece lies in one column (pieces are cut at x = step_x): the right column's slab
+         * when its extinction is the right medium's and the tables have that column. */
+        int c = P->ncols > 1 && sigma_t != P->sigma_t;
+        L += ppb_piece(P, map, tabR, tabS, coefC, ppb_column(P, ndir, c), ndir, dir, r0, px, py, mx,
+                       my, la, lb, sigma_t, alpha, &d);
     }
     return L;
 }

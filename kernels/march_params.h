@@ -25,12 +25,19 @@ enum { PPB_TABLE_R = 0, PPB_TABLE_S = 1 };
 enum {
     PPB_MARCH_ARG_PARAMS = 0, /* ppb_march_params by value */
     PPB_MARCH_ARG_MAP = 1,    /* map cells, PPB_MAP_STRIDE doubles each */
-    PPB_MARCH_ARG_TAB_R = 2,  /* R table [nalb][ndir][ntau] (paper Eq. 15) */
-    PPB_MARCH_ARG_TAB_S = 3,  /* S table [nalb][ndir][ntau] (paper Eq. 16-17, corrected) */
-    PPB_MARCH_ARG_COEF_C = 4, /* [nalb][ndir]: coefficient of exp(-D) in the source */
+    PPB_MARCH_ARG_TAB_R = 2,  /* R table [ncols][nalb][ndir][ntau[col]] (paper Eq. 15) */
+    PPB_MARCH_ARG_TAB_S = 3,  /* S table, same layout (paper Eq. 16-17, corrected) */
+    PPB_MARCH_ARG_COEF_C = 4, /* [ncols][nalb][ndir]: coefficient of exp(-D) in the source */
     PPB_MARCH_ARG_OUT = 5,    /* radiance [rows][nbins] */
     PPB_MARCH_NARGS = 6
 };
+
+/* Column slabs: the medium is piecewise constant with its only jump on the vertical plane
+ * x = step_x (SPEC.md section 1), so every vertical column of the tube is a homogeneous slab of
+ * optical thickness tau0 = sigma_t(x) H. The tables hold one slab solution per distinct column
+ * thickness: column 0 is the left medium's (the only one without a density step), column 1 the
+ * right medium's (x >= step_x) when a density step makes it differ. */
+#define PPB_MARCH_MAX_COLS 2
 
 /* Map cell layout: every cell of the light-aligned grid stores its four corner values of each
  * field as limits taken from inside the cell, so a jump that lies on a cell edge (the density or
@@ -55,8 +62,8 @@ typedef struct ppb_march_params {
     /* map: light-aligned grid over x' = x + y tan(theta_L) and depth -y */
     double map_xp0; /* x' of the first node column */
     double map_h;   /* cell size, mfp */
-    /* tables over tau = D cos(theta_L) in [0, tau0] and the average albedo */
-    double tau0, tau_h;
+    /* tables over tau = D cos(theta_L) in [0, tau0[col]] and the average albedo, per column */
+    double tau0[PPB_MARCH_MAX_COLS], tau_h[PPB_MARCH_MAX_COLS];
     double alb0, alb_h;
     /* march */
     double step;  /* ray-march step length, mfp */
@@ -64,7 +71,8 @@ typedef struct ppb_march_params {
     int tube;     /* 1 tube, 0 slab */
     int step_kind;
     int map_nx, map_ny;
-    int ntau, nalb;
+    int ntau[PPB_MARCH_MAX_COLS], nalb;
+    int ncols;      /* column slabs in the tables, 1 or 2 */
     int with_modes; /* 0: single scattering (ss), no tables */
     int table;      /* PPB_TABLE_R or PPB_TABLE_S */
     int telescope;  /* 1: a regular piece's S-table step sum in closed form (exact identity) */

@@ -7,7 +7,7 @@
 
 #include "progress.h"
 
-_Static_assert(sizeof(ppb_march_params) == 19 * sizeof(double) + 22 * sizeof(int),
+_Static_assert(sizeof(ppb_march_params) == 21 * sizeof(double) + 24 * sizeof(int),
                "ppb_march_params: doubles first, an even number of ints, no padding");
 
 static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
@@ -50,8 +50,6 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
         .light_y = wl[1],
         .map_xp0 = maps->xp0,
         .map_h = maps->h,
-        .tau0 = tab->tau0,
-        .tau_h = tab->tau_h,
         .alb0 = tab->alb0,
         .alb_h = tab->alb_h,
         .step = opts->step,
@@ -60,8 +58,8 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
         .step_kind = tube ? sc->step : PPB_STEP_NONE,
         .map_nx = maps->nx,
         .map_ny = maps->ny,
-        .ntau = tab->ntau,
         .nalb = tab->nalb,
+        .ncols = tab->ncols,
         .with_modes = tab->R != NULL,
         .table = (opts->table == PPB_TABLE_S && tab->S) ? PPB_TABLE_S : PPB_TABLE_R,
         .telescope = opts->telescope,
@@ -73,6 +71,11 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
     for (int s = 0; s < PPB_NSURF; s++) {
         P.nseg[s] = lo.nseg[s];
         P.offset[s] = lo.offset[s];
+    }
+    for (int c = 0; c < tab->ncols; c++) {
+        P.tau0[c] = tab->col[c].tau0;
+        P.tau_h[c] = tab->col[c].tau_h;
+        P.ntau[c] = tab->col[c].ntau;
     }
     mr->params = P;
     if (ppb_ocl_build(ocl, "march.cl", "", &mr->prog, err) ||
@@ -88,7 +91,8 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
     mr->tab_s = upload(ocl, tab->S, tsize, "S table", err);
     if (!mr->tab_s)
         goto fail;
-    mr->coef_c = upload(ocl, tab->C, (size_t)tab->nalb * tab->ndir, "beam coefficients", err);
+    mr->coef_c =
+        upload(ocl, tab->C, (size_t)tab->ncols * tab->nalb * tab->ndir, "beam coefficients", err);
     if (!mr->coef_c)
         goto fail;
     cl_int rc;
@@ -219,25 +223,32 @@ int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err 
     if (ppb_ctx_ocl(ctx, &ocl, err))
         return -1;
     ppb_maps maps = {0};
-    ppb_march_tables tab = {0};
+    ppb_march_tables own = {0};
+    const ppb_march_tables *tab = &own;
     if (ppb_maps_build(sc, cfg->pp.map_res, &maps, err))
         return -1;
-    int rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
-                                              &tab, err)
-                        : ppb_march_tables_ss(sc, cfg->samples_dir, &tab, err);
+    int rc;
+    if (ctx->march_cache)
+        /* A sweep's earlier grid point may have built these very tables (byte-identical). */
+        rc = ppb_march_cache_tables(ctx->march_cache, sc, &cfg->pp, cfg->samples_dir,
+                                    PPB_MARCH_TAU_PER_MFP, with_modes, &tab, err);
+    else
+        rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
+                                              &own, err)
+                        : ppb_march_tables_ss(sc, cfg->samples_dir, &own, err);
     if (rc) {
         ppb_maps_free(&maps);
         return -1;
     }
     ppb_march_opts opts = {
         .table = cfg->pp.table, .step = cfg->pp.step, .telescope = 1, .npts = cfg->samples_seg};
-    rc = ppb_march_all(ocl, sc, &maps, &tab, &opts, out->method, ctx->quiet, out->radiance,
+    rc = ppb_march_all(ocl, sc, &maps, tab, &opts, out->method, ctx->quiet, out->radiance,
                        &out->partial, err);
     if (!rc) {
         memset(out->se, 0, out->layout.ncells * sizeof *out->se);
         ppb_march_totals(sc, &out->layout, out->radiance, &out->totals);
     }
-    ppb_march_tables_free(&tab);
+    ppb_march_tables_free(&own);
     ppb_maps_free(&maps);
     return rc;
 }
