@@ -9,7 +9,7 @@
 
 /* Gauss-Legendre nodes and weights on [-1, 1] by Newton on P_q (Golub-Welsch not needed for
  * q <= 16; the iteration converges to machine precision from the Chebyshev guesses). */
-static void gauss_legendre(int q, double *x, double *w)
+void pp_gauss_legendre(int q, double *x, double *w)
 {
     for (int i = 0; i < q; i++) {
         double z = cos(PP_PI * (i + 0.75) / (q + 0.5)), dp = 1.0;
@@ -31,30 +31,33 @@ static void gauss_legendre(int q, double *x, double *w)
     }
 }
 
-/* Cells per ring: a cap of one cell, then collars of equal polar-angle width about the side of
- * a square cell (sqrt(2 pi / N)); counts rounded cumulatively so they sum to N exactly. */
+/* Cells per ring. The polar ring is one cell (the cap) when N is odd, else four quarter-cap
+ * wedges (two when N = 2); every collar below it then has an even count, so that the partition
+ * is closed under w -> -w (the up/down mirror times a half turn; phase.h uses this for g < 0)
+ * and every ring pair is symmetric under a half turn. Collars have equal polar-angle width about
+ * the side of a square cell (sqrt(2 pi / N)); their counts are rounded cumulatively, in steps of
+ * two, so that they sum to N exactly. */
 static int ring_counts(int n, int *count)
 {
-    if (n == 1) {
-        count[0] = 1;
+    int pole = n % 2 ? 1 : (n < 4 ? n : 4);
+    count[0] = pole;
+    if (n == pole)
         return 1;
-    }
-    double theta_cap = acos(1.0 - 1.0 / n), side = sqrt(2.0 * PP_PI / n);
+    double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PP_PI / n);
     int collars = (int)lround((0.5 * PP_PI - theta_cap) / side);
     if (collars < 1)
         collars = 1;
-    if (collars > n - 1)
-        collars = n - 1;
-    count[0] = 1;
-    int done = 1;
+    if (collars > (n - pole) / 2)
+        collars = (n - pole) / 2;
+    int done = pole;
     for (int r = 1; r <= collars; r++) {
         double theta = theta_cap + (0.5 * PP_PI - theta_cap) * r / collars;
-        int cum = r == collars ? n : (int)lround(n * (1.0 - cos(theta)));
-        int left = collars - r; /* later collars need at least one cell each */
-        if (cum > n - left)
-            cum = n - left;
-        if (cum < done + 1)
-            cum = done + 1;
+        int cum = r == collars ? n : pole + 2 * (int)lround(0.5 * (n * (1.0 - cos(theta)) - pole));
+        int left = collars - r; /* later collars need at least two cells each */
+        if (cum > n - 2 * left)
+            cum = n - 2 * left;
+        if (cum < done + 2)
+            cum = done + 2;
         count[r] = cum - done;
         done = cum;
     }
@@ -210,6 +213,16 @@ int pp_dirs_zmirror(const pp_dirs *d, int cell)
     return cell < d->n ? mirror : d->n + mirror;
 }
 
+int pp_dirs_antipode(const pp_dirs *d, int cell)
+{
+    int up = cell < d->n ? cell : cell - d->n, r = d->ring[up];
+    int count = d->ring_first[r + 1] - d->ring_first[r], j = up - d->ring_first[r];
+    if (count > 1 && count % 2)
+        return -1;
+    int anti = d->ring_first[r] + (count > 1 ? (j + count / 2) % count : 0);
+    return cell < d->n ? d->n + anti : anti;
+}
+
 void pp_dirs_bounds(const pp_dirs *d, int cell, double *mu_lo, double *mu_hi, double *phi_lo,
                     double *phi_hi)
 {
@@ -223,7 +236,8 @@ void pp_dirs_bounds(const pp_dirs *d, int cell, double *mu_lo, double *mu_hi, do
 
 /* Nodes of every cell for one q: Gauss in theta (weight sin theta) times Gauss in phi. The
  * theta parametrisation keeps the integrand smooth at the pole, where it is not smooth in mu;
- * the weights are then rescaled so that they sum to the exact |Omega|. */
+ * the weights are then rescaled so that they sum to the exact |Omega|. The product form needs
+ * only q cosines and sines per axis and cell. */
 static int build_nodes(pp_dirs *d, int q)
 {
     int n = d->n, nq = q * q;
@@ -231,26 +245,29 @@ static int build_nodes(pp_dirs *d, int q)
     if (!out)
         return -1;
     double x[PP_QMAX], w[PP_QMAX];
-    gauss_legendre(q, x, w);
+    double ct[PP_QMAX], st[PP_QMAX], wt[PP_QMAX], cp[PP_QMAX], sp[PP_QMAX], wp[PP_QMAX];
+    pp_gauss_legendre(q, x, w);
     for (int i = 0; i < n; i++) {
         int r = d->ring[i];
         double t0 = acos(d->mu_edge[r]), t1 = acos(d->mu_edge[r + 1]);
         double p0 = d->phi_lo[i], p1 = d->phi_hi[i], sum = 0.0;
         int trap = full_circle(d, i);
-        double *row = out + 4 * (size_t)nq * i, *mir = out + 4 * (size_t)nq * (n + i);
         for (int a = 0; a < q; a++) {
             double th = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * x[a];
-            for (int b = 0; b < q; b++, row += 4, mir += 4) {
-                double ph = trap ? p0 + (b + 0.5) * (p1 - p0) / q
-                                 : 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * x[b];
-                double wphi = trap ? (p1 - p0) / q : 0.5 * (p1 - p0) * w[b];
-                set_dir(cos(th), ph, row);
-                row[3] = 0.5 * (t1 - t0) * w[a] * wphi * sin(th);
-                sum += row[3];
+            double ph =
+                trap ? p0 + (a + 0.5) * (p1 - p0) / q : 0.5 * (p0 + p1) + 0.5 * (p1 - p0) * x[a];
+            ct[a] = cos(th), st[a] = sin(th), wt[a] = 0.5 * (t1 - t0) * w[a] * st[a];
+            cp[a] = cos(ph), sp[a] = sin(ph), wp[a] = trap ? (p1 - p0) / q : 0.5 * (p1 - p0) * w[a];
+        }
+        double *row = out + 4 * (size_t)nq * i, *mir = out + 4 * (size_t)nq * (n + i);
+        for (int a = 0; a < q; a++) {
+            for (int b = 0; b < q; b++) {
+                double *node = row + 4 * (a * q + b);
+                node[0] = st[a] * cp[b], node[1] = ct[a], node[2] = st[a] * sp[b];
+                node[3] = wt[a] * wp[b];
+                sum += node[3];
             }
         }
-        row -= 4 * (size_t)nq;
-        mir -= 4 * (size_t)nq;
         for (int m = 0; m < nq; m++) {
             row[4 * m + 3] *= d->solid / sum;
             mir[4 * m] = row[4 * m], mir[4 * m + 1] = -row[4 * m + 1];

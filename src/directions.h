@@ -4,15 +4,19 @@
  * angles |Omega_i| and mean cosines k_i (SPEC.md section 10: k_i = |Omega_i|^-1 integral of
  * mu over the cell), and quadrature nodes inside each cell.
  *
- * Partition: equal-area zonal ("EQSP"-like). Each hemisphere is a polar cap (one cell) and
- * collars of equal polar-angle width, each collar cut into equal azimuth sectors. The counts per
- * collar are rounded from the collars' areas and the collar edges then moved to mu = 1 - C/N
+ * Partition: equal-area zonal ("EQSP"-like). Each hemisphere is a polar ring and collars of
+ * equal polar-angle width, each cut into equal azimuth sectors. The polar ring is one cell (a
+ * cap) for odd N, four quarter-cap wedges for even N (two for N = 2), and every collar has an
+ * even count, rounded from the collars' areas; the collar edges are then moved to mu = 1 - C/N
  * (C = cells above the edge), so every cell has exactly the solid angle 2 pi / N, and since
  * dOmega = dmu dphi, k_i = (mu_top + mu_bottom) / 2 exactly. Why: cells of one size and nearly
  * square shape resolve every direction alike (no crowding at the pole as with a mu x phi
- * grid), any N is allowed, and the (mu, phi) rectangles make solid angles and k_i exact.
- * Sector 0 of every collar is centred on phi = 0 (the beam's azimuth +x), so the partition is
- * mirror symmetric in z (phi -> -phi); cell N + i is the mirror (y -> -y) of cell i.
+ * grid), any N is allowed, and the (mu, phi) rectangles make solid angles and k_i exact. The
+ * even counts make the partition closed under w -> -w (pp_dirs_antipode: the y mirror times a
+ * half turn), which turns the g < 0 phase matrix into a column permutation of the |g| one
+ * (phase.h), and give every ring pair at least a half-turn symmetry (halving the pair
+ * integrals). Sector 0 of every ring is centred on phi = 0 (the beam's azimuth +x), so the
+ * partition is mirror symmetric in z (phi -> -phi); cell N + i is the mirror (y -> -y) of i.
  *
  * Frame (SPEC.md, tube frame): y up, mu = w.y, phi measured from +x toward +z:
  * w = (sin(theta) cos(phi), mu, sin(theta) sin(phi)). Cells 0..N-1 are up (mu > 0). */
@@ -50,9 +54,16 @@ int pp_dirs_cell_of(const pp_dirs *d, const double w[3]);
 /* The mirror image of a cell under z -> -z (phi -> -phi), in the same hemisphere. */
 int pp_dirs_zmirror(const pp_dirs *d, int cell);
 
+/* The antipodal cell, holding -w for every w of the cell (the up/down mirror of the cell half a
+ * turn round in azimuth); -1 if the partition were not closed under w -> -w (it always is). */
+int pp_dirs_antipode(const pp_dirs *d, int cell);
+
 /* The cell's mu range and azimuth range (for down cells mu_lo < mu_hi < 0). */
 void pp_dirs_bounds(const pp_dirs *d, int cell, double *mu_lo, double *mu_hi, double *phi_lo,
                     double *phi_hi);
+
+/* Gauss-Legendre nodes x and weights w on [-1, 1], 1 <= q <= PP_QMAX. */
+void pp_gauss_legendre(int q, double *x, double *w);
 
 /* q x q product Gauss nodes of a cell, q in [1, PP_QMAX]: rows of (x, y, z, weight), weights
  * summing to |Omega| exactly up to rounding. Built on first use for that q (for all cells). */

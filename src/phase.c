@@ -4,6 +4,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #define PP_PI     3.14159265358979323846
 #define PHASE_TOL 1e-8 /* target relative quadrature error of one pair */
@@ -17,7 +20,7 @@ double pp_hg(double g, double cos_theta)
 /* Gauss order per axis for a cell of corner radius h whose nearest point lies theta_min from
  * the HG peak: Gauss-Legendre converges like rho^(-2q), rho the Bernstein ellipse parameter
  * fixed by the distance d = sqrt(D / |g|) of the nearest complex singularity. */
-static int gauss_order(double g, double theta_min, double h)
+static double gauss_order_wanted(double g, double theta_min, double h)
 {
     double ag = fabs(g);
     if (ag < 1e-14)
@@ -25,8 +28,13 @@ static int gauss_order(double g, double theta_min, double h)
     double den = 1.0 + ag * ag - 2.0 * ag * cos(theta_min);
     double ratio = sqrt(den / ag) / h;
     double rho = ratio + sqrt(ratio * ratio + 1.0);
-    int q = (int)ceil(log(1.0 / PHASE_TOL) / (2.0 * log(rho)));
-    return q < 2 ? 2 : (q > PP_QMAX ? PP_QMAX : q);
+    return ceil(log(1.0 / PHASE_TOL) / (2.0 * log(rho)));
+}
+
+static int gauss_order(double g, double theta_min, double h)
+{
+    double q = gauss_order_wanted(g, theta_min, h);
+    return q < 2 ? 2 : (q > PP_QMAX ? PP_QMAX : (int)q);
 }
 
 static double dot3(const double *a, const double *b)
@@ -42,18 +50,42 @@ static double peak_angle(double g, const double *a, const double *b)
     return acos(c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c));
 }
 
-/* Sum over node pairs of w_a w_b p(x_a . x_b). */
+/* Sum over node pairs of w_a w_b p(x_a . x_b). The inner cell's nodes are copied into
+ * columns scaled by 2g (padded to an even count with a zero-weight node) so that the inner loop
+ * runs two nodes at a time with SSE2; a scalar loop does the same elsewhere. */
 static double pair_sum(double g, const double *na, const double *nb, int nq)
 {
+    enum { CAP = PP_QMAX * PP_QMAX + 2 };
+    double y0[CAP], y1[CAP], y2[CAP], yw[CAP];
     double c1 = (1.0 - g * g) / (4.0 * PP_PI), g2 = 1.0 + g * g, tg = 2.0 * g, sum = 0.0;
+    int np = nq + (nq & 1);
+    for (int b = 0; b < np; b++) {
+        const double *y = nb + 4 * (b < nq ? b : 0);
+        y0[b] = tg * y[0], y1[b] = tg * y[1], y2[b] = tg * y[2], yw[b] = b < nq ? y[3] : 0.0;
+    }
     for (int a = 0; a < nq; a++) {
         const double *x = na + 4 * a;
         double inner = 0.0;
-        for (int b = 0; b < nq; b++) {
-            const double *y = nb + 4 * b;
-            double den = g2 - tg * (x[0] * y[0] + x[1] * y[1] + x[2] * y[2]);
-            inner += y[3] / (den * sqrt(den));
+#ifdef __SSE2__
+        __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]);
+        __m128d base = _mm_set1_pd(g2), acc = _mm_setzero_pd();
+        for (int b = 0; b < np; b += 2) {
+            __m128d dot = _mm_add_pd(_mm_add_pd(_mm_mul_pd(x0, _mm_loadu_pd(y0 + b)),
+                                                _mm_mul_pd(x1, _mm_loadu_pd(y1 + b))),
+                                     _mm_mul_pd(x2, _mm_loadu_pd(y2 + b)));
+            __m128d den = _mm_sub_pd(base, dot);
+            acc = _mm_add_pd(acc,
+                             _mm_div_pd(_mm_loadu_pd(yw + b), _mm_mul_pd(den, _mm_sqrt_pd(den))));
         }
+        double lanes[2];
+        _mm_storeu_pd(lanes, acc);
+        inner = lanes[0] + lanes[1];
+#else
+        for (int b = 0; b < np; b++) {
+            double den = g2 - (x[0] * y0[b] + x[1] * y1[b] + x[2] * y2[b]);
+            inner += yw[b] / (den * sqrt(den));
+        }
+#endif
         sum += x[3] * inner;
     }
     return c1 * sum;
@@ -96,6 +128,39 @@ static void set_sym(const pp_dirs *d, double *S, int i, int j, double v)
     S[i * n + j] = S[j * n + i] = S[mi * n + mj] = S[mj * n + mi] = v;
 }
 
+static int gcd(int a, int b)
+{
+    while (b) {
+        int t = a % b;
+        a = b, b = t;
+    }
+    return a;
+}
+
+static int ring_count(const pp_dirs *d, int r)
+{
+    return d->ring_first[r + 1] - d->ring_first[r];
+}
+
+/* Up cell i turned by `steps` sectors of its ring (a one-cell ring stays). */
+static int turn(const pp_dirs *d, int i, int steps)
+{
+    int r = d->ring[i], count = ring_count(d, r);
+    return d->ring_first[r] + (i - d->ring_first[r] + steps) % count;
+}
+
+/* The azimuthal symmetry of the pair of rings holding up cells i and j: turning both cells by
+ * 2 pi / G maps the pair onto another with the same integrals. G = gcd of the sector counts,
+ * or the other ring's count when one ring is a single (rotation invariant) cap. The steps are
+ * in sectors of each ring. */
+static int ring_pair_symmetry(const pp_dirs *d, int i, int j, int *si, int *sj)
+{
+    int ni = ring_count(d, d->ring[i]), nj = ring_count(d, d->ring[j]);
+    int G = ni == 1 ? nj : (nj == 1 ? ni : gcd(ni, nj));
+    *si = ni / G, *sj = nj / G; /* 0 for a cap beside a real ring */
+    return G;
+}
+
 /* Self terms from conservation: what scatters out of cell i is all of |Omega_i|. */
 static void conserve_rows(const pp_dirs *d, double *Sa, const double *Sb)
 {
@@ -108,10 +173,19 @@ static void conserve_rows(const pp_dirs *d, double *Sa, const double *Sb)
     }
 }
 
-int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
+/* Whether every ring is a cap or has an even count, so that w -> -w maps cells onto cells. */
+static int antipodal(const pp_dirs *d)
 {
-    if (check_g(g, err) != 0)
-        return -1;
+    for (int r = 0; r < d->nrings; r++)
+        if (ring_count(d, r) > 1 && ring_count(d, r) % 2)
+            return 0;
+    return 1;
+}
+
+/* The blocks by quadrature: one pair integral per orbit of the ring pair's rotations, the z
+ * mirror and the transpose (each orbit's members are copied, so the symmetries hold exactly). */
+static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
+{
     size_t n = (size_t)d->n;
     unsigned char *done = calloc(n * n, 1);
     if (!done)
@@ -125,16 +199,47 @@ int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
             if (j > i)
                 rc |= pair_integral(d, g, i, j, &va, err);
             rc |= pair_integral(d, g, i, d->n + j, &vb, err);
-            set_sym(d, Sa, i, j, va);
-            set_sym(d, Sb, i, j, vb);
-            int mi = pp_dirs_zmirror(d, i), mj = pp_dirs_zmirror(d, j);
-            done[i * n + j] = done[j * n + i] = done[mi * n + mj] = done[mj * n + mi] = 1;
+            int si, sj, G = ring_pair_symmetry(d, i, j, &si, &sj);
+            for (int t = 0; t < G; t++) {
+                int it = turn(d, i, t * si), jt = turn(d, j, t * sj);
+                set_sym(d, Sa, it, jt, va);
+                set_sym(d, Sb, it, jt, vb);
+                int mi = pp_dirs_zmirror(d, it), mj = pp_dirs_zmirror(d, jt);
+                done[it * n + jt] = done[jt * n + it] = done[mi * n + mj] = done[mj * n + mi] = 1;
+            }
         }
     }
     free(done);
     if (rc == 0)
         conserve_rows(d, Sa, Sb);
     return rc;
+}
+
+int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
+{
+    if (check_g(g, err) != 0)
+        return -1;
+    if (g >= 0 || !antipodal(d))
+        return blocks_by_quadrature(d, g, Sa, Sb, err);
+    /* p(x.y; g) = p(x.(-y); -g): S(i, j; g) = S(i, antipode(j); -g). With a the up cell of
+     * antipode(up j), Sa(g)_ij = Sb(-g)_i,a(j) and Sb(g)_ij = Sa(-g)_i,a(j): the peak of the
+     * backward matrix is the conserved self term of the forward one. */
+    if (blocks_by_quadrature(d, -g, Sa, Sb, err) != 0)
+        return -1;
+    size_t n = (size_t)d->n;
+    for (size_t i = 0; i < n; i++) {
+        double *ra = Sa + i * n, *rb = Sb + i * n;
+        for (int j = 0; j < d->n; j++) {
+            int aj = pp_dirs_antipode(d, j) - d->n;
+            if (aj < j)
+                continue; /* each pair {j, a(j)} swapped once */
+            double t = ra[j];
+            ra[j] = rb[aj], rb[aj] = t;
+            if (aj != j)
+                t = ra[aj], ra[aj] = rb[j], rb[j] = t;
+        }
+    }
+    return 0;
 }
 
 int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err)
@@ -154,17 +259,70 @@ int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err)
     return rc;
 }
 
-int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err)
+static void rect_dir(double theta, double phi, double ysign, double *v)
 {
-    if (check_g(g, err) != 0)
-        return -1;
+    v[0] = sin(theta) * cos(phi), v[1] = ysign * cos(theta), v[2] = sin(theta) * sin(phi);
+}
+
+/* Integral of p(w . y) over y in the (theta, phi) rectangle [t0, t1] x [p0, p1] (theta from
+ * the pole of the rectangle's hemisphere, ysign = -1 for the down one), product Gauss with the
+ * weight sin(theta); the rectangle is cut in four while the peak asks for more than PP_QMAX
+ * nodes per axis (at most RECT_DEPTH times). */
+#define RECT_DEPTH 10
+static double point_rect(double g, const double w[3], double t0, double t1, double p0, double p1,
+                         double ysign, int depth)
+{
+    double c[3], v[3], rad = 0.0, tm = 0.5 * (t0 + t1), pm = 0.5 * (p0 + p1);
+    rect_dir(tm, pm, ysign, c);
+    const double ts[3] = {t0, tm, t1}, ps[3] = {p0, pm, p1};
+    for (int a = 0; a < 3; a += 1)
+        for (int b = 0; b < 3; b += 1) {
+            rect_dir(ts[a], ps[b], ysign, v);
+            double cv = dot3(c, v);
+            rad = fmax(rad, acos(cv > 1.0 ? 1.0 : cv));
+        }
+    double tmin = peak_angle(g, w, c) - rad;
+    double h = fmax(0.5 * (t1 - t0), 0.5 * sin(fmin(t1, 0.5 * PP_PI)) * (p1 - p0));
+    double want = gauss_order_wanted(g, tmin > 0 ? tmin : 0.0, h);
+    if (want > PP_QMAX && depth < RECT_DEPTH)
+        return point_rect(g, w, t0, tm, p0, pm, ysign, depth + 1) +
+               point_rect(g, w, t0, tm, pm, p1, ysign, depth + 1) +
+               point_rect(g, w, tm, t1, p0, pm, ysign, depth + 1) +
+               point_rect(g, w, tm, t1, pm, p1, ysign, depth + 1);
+    int q = want < 2 ? 2 : (want > PP_QMAX ? PP_QMAX : (int)want);
+    double x[PP_QMAX], wt[PP_QMAX], sum = 0.0;
+    pp_gauss_legendre(q, x, wt);
+    for (int a = 0; a < q; a++) {
+        double th = tm + 0.5 * (t1 - t0) * x[a], inner = 0.0;
+        for (int b = 0; b < q; b++) {
+            rect_dir(th, pm + 0.5 * (p1 - p0) * x[b], ysign, v);
+            inner += wt[b] * pp_hg(g, dot3(w, v));
+        }
+        sum += wt[a] * sin(th) * inner;
+    }
+    return 0.25 * (t1 - t0) * (p1 - p0) * sum;
+}
+
+/* F by quadrature; the cell holding w is set by conservation. */
+static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err)
+{
     int m = 2 * d->n, own = pp_dirs_cell_of(d, w);
     double point[4] = {w[0], w[1], w[2], 1.0}, rest = 0.0;
     for (int j = 0; j < m; j++) {
         if (j == own)
             continue;
         double tmin = peak_angle(g, w, d->centre + 3 * j) - cell_radius(d, j);
-        int q = gauss_order(g, tmin > 0 ? tmin : 0.0, cell_half(d, j));
+        tmin = tmin > 0 ? tmin : 0.0;
+        if (gauss_order_wanted(g, tmin, cell_half(d, j)) > PP_QMAX) {
+            /* the peak is too close for one Gauss rule: bisect the cell's rectangle */
+            double mu_lo, mu_hi, p0, p1;
+            pp_dirs_bounds(d, j, &mu_lo, &mu_hi, &p0, &p1);
+            double ys = j < d->n ? 1.0 : -1.0;
+            F[j] = point_rect(g, w, acos(ys * mu_hi), acos(ys * mu_lo), p0, p1, ys, 0);
+            rest += F[j];
+            continue;
+        }
+        int q = gauss_order(g, tmin, cell_half(d, j));
         const double *nj = pp_dirs_nodes(d, j, q, err);
         if (!nj)
             return -1;
@@ -178,5 +336,24 @@ int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *er
         rest += F[j];
     }
     F[own] = 1.0 - rest;
+    return 0;
+}
+
+int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err)
+{
+    if (check_g(g, err) != 0)
+        return -1;
+    if (g >= 0 || !antipodal(d))
+        return row_by_quadrature(d, g, w, F, err);
+    /* F_j(w; g) = F_antipode(j)(w; -g), as for the blocks */
+    if (row_by_quadrature(d, -g, w, F, err) != 0)
+        return -1;
+    for (int j = 0; j < 2 * d->n; j++) {
+        int aj = pp_dirs_antipode(d, j);
+        if (aj > j) {
+            double t = F[j];
+            F[j] = F[aj], F[aj] = t;
+        }
+    }
     return 0;
 }
