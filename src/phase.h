@@ -14,10 +14,17 @@
  * g = 0.95 function get up to 16 x 16 per cell. The self term (and for F the cell holding w)
  * is not integrated: it is set so that rows conserve energy exactly (sum_j S_ij = |Omega_i|,
  * sum_j F_j = 1), which keeps S symmetric and puts the small quadrature residual where the
- * peak sits.
- * Known limitation: for strongly backward g (g < -0.9) the peak lies on the pairs (i, antipode
- * of i), which are integrated, not fixed by conservation, so at coarse N their residual (up to
- * 1e-2 of a row at N = 40, g = -0.95) lands on the diagonal. Rows still sum to 1 exactly. */
+ * peak sits. For F, a cell next to w whose rule would need more than PP_QMAX nodes per axis is
+ * bisected in (theta, phi) until each piece's rule suffices.
+ * Symmetry: S is integrated once per orbit of a ring pair under the rotations that map both
+ * rings onto themselves (turns by 2 pi / gcd of their sector counts, at least a half turn
+ * since collar counts are even), the z mirror and the transpose; the orbit's members are
+ * copied, so these symmetries hold exactly.
+ * Backward scattering: the partition is closed under w -> -w (pp_dirs_antipode), and
+ * p(x.y; g) = p(x.(-y); -g), so for g < 0 S(i, j; g) = S(i, antipode(j); -g): the matrix is a
+ * column permutation of the |g| one and its peak, on the pairs (i, antipode(i)), is the
+ * conserved self term of |g| (non-negative, as resolved as the forward case), not an
+ * under-resolved integral. F is permuted the same way. */
 #ifndef PPB_PHASE_H
 #define PPB_PHASE_H
 

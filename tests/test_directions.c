@@ -1,5 +1,6 @@
 /* test_directions.c: the equal-area direction cells (src/directions.h): exact solid angles and
- * mean cosines, the two mirror symmetries, cell lookup, and the quadrature nodes. */
+ * mean cosines, the two mirror symmetries, closure under w -> -w, cell lookup, and the
+ * quadrature nodes. */
 #include "testutil.h"
 
 #include <math.h>
@@ -74,6 +75,37 @@ static void test_mirror_symmetries(void **state)
     }
 }
 
+/* The partition is closed under w -> -w (directions.h: the polar ring is a cap or four
+ * wedges and every collar count is even): the antipode of a cell holds minus its centre and
+ * minus every one of its nodes, is an involution, and lies in the other hemisphere. */
+static void test_partition_is_antipodal(void **state)
+{
+    (void)state;
+    for (size_t t = 0; t < sizeof sizes / sizeof *sizes; t++) {
+        pp_dirs d;
+        ppb_err err;
+        assert_int_equal(pp_dirs_make(sizes[t], &d, &err), 0);
+        for (int r = 0; r < d.nrings; r++) {
+            int count = d.ring_first[r + 1] - d.ring_first[r];
+            assert_true(count == 1 || count % 2 == 0);
+        }
+        for (int i = 0; i < 2 * d.n; i++) {
+            int a = pp_dirs_antipode(&d, i);
+            assert_true(a >= 0 && a < 2 * d.n && (a < d.n) != (i < d.n));
+            assert_int_equal(pp_dirs_antipode(&d, a), i);
+            const double *c = d.centre + 3 * i;
+            double minus[3] = {-c[0], -c[1], -c[2]};
+            assert_int_equal(pp_dirs_cell_of(&d, minus), a);
+            const double *nodes = pp_dirs_nodes(&d, i, 3, &err);
+            for (int m = 0; m < 9; m++) {
+                double v[3] = {-nodes[4 * m], -nodes[4 * m + 1], -nodes[4 * m + 2]};
+                assert_int_equal(pp_dirs_cell_of(&d, v), a);
+            }
+        }
+        pp_dirs_free(&d);
+    }
+}
+
 /* Every node lies in its own cell, and the lookup of random directions agrees with the
  * bounds. */
 static void test_nodes_lie_in_their_cell(void **state)
@@ -98,6 +130,7 @@ int main(void)
         cmocka_unit_test(test_solid_angles_exact),
         cmocka_unit_test(test_mean_cosines_exact),
         cmocka_unit_test(test_mirror_symmetries),
+        cmocka_unit_test(test_partition_is_antipodal),
         cmocka_unit_test(test_nodes_lie_in_their_cell),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,6 +1,7 @@
 /* test_phase.c: the HG phase matrix (src/phase.h): normalisation and mean cosine of HG, exact
- * row sums and symmetry of the cell matrix up to |g| = 0.95, the isotropic closed form, and the
- * quadrature against an independent fine midpoint rule. */
+ * row sums, symmetry and positivity of the cell matrix up to |g| = 0.95, the backward matrix as
+ * the permuted forward one, the isotropic closed form, and the quadrature against an
+ * independent fine midpoint rule. */
 #include "testutil.h"
 
 #include <math.h>
@@ -28,34 +29,68 @@ static void test_hg_normalised_with_mean_cosine_g(void **state)
     }
 }
 
-/* Rows of P sum to 1 to machine precision and |Omega| P is symmetric (SPEC.md section 10),
- * including the strongly peaked |g| = 0.95. Entries are positive except for g = -0.95 at this
- * coarse N: its backward peak sits on the pairs (i, antipode of i), which the Gauss rule
- * resolves poorly, and the residual lands on the diagonal (a known limitation, phase.h). */
+/* Rows of P sum to 1 to machine precision, |Omega| P is symmetric (SPEC.md section 10) and
+ * every entry is positive, including the strongly peaked |g| = 0.95 (the backward g = -0.95
+ * included: phase.h obtains it from g = +0.95 through the antipodal partition). */
 static void test_rows_conserve_energy(void **state)
 {
     (void)state;
     const double gs[] = {0.0, 0.5, -0.5, 0.95, -0.95};
-    int n = 40, m = 80;
-    double *P = malloc(sizeof(double) * m * m);
-    for (int k = 0; k < 5; k++) {
+    const int ns[] = {40, 41};
+    for (int t = 0; t < 2; t++) {
+        int n = ns[t], m = 2 * n;
+        double *P = malloc(sizeof(double) * m * m);
+        for (int k = 0; k < 5; k++) {
+            pp_dirs d;
+            ppb_err err;
+            assert_int_equal(pp_dirs_make(n, &d, &err), 0);
+            assert_int_equal(pp_phase_matrix(&d, gs[k], P, &err), 0);
+            for (int i = 0; i < m; i++) {
+                double row = 0.0;
+                for (int j = 0; j < m; j++) {
+                    row += P[i * m + j];
+                    assert_true(fabs(P[i * m + j] - P[j * m + i]) < 1e-15);
+                    assert_true(P[i * m + j] > 0.0);
+                }
+                assert_true(fabs(row - 1.0) < 1e-13);
+            }
+            pp_dirs_free(&d);
+        }
+        free(P);
+    }
+}
+
+/* The identity p_HG(mu; -g) = p_HG(-mu; g) on a partition closed under w -> -w gives
+ * P_ij(-g) = P_i,antipode(j)(g): the g = -0.95 matrix is the g = +0.95 one with its columns
+ * permuted, non-negative, with its peak (the conserved self term of +0.95) on the pairs
+ * (i, antipode(i)). Checked for even N (four polar wedges) and odd N (one cap), at the
+ * coarse N = 40 where the old direct quadrature put -1e-2 on the diagonal. */
+static void test_backward_is_permuted_forward(void **state)
+{
+    (void)state;
+    const int ns[] = {40, 41};
+    for (int t = 0; t < 2; t++) {
+        int n = ns[t], m = 2 * n;
+        double *Pf = malloc(sizeof(double) * m * m), *Pb = malloc(sizeof(double) * m * m);
         pp_dirs d;
         ppb_err err;
         assert_int_equal(pp_dirs_make(n, &d, &err), 0);
-        assert_int_equal(pp_phase_matrix(&d, gs[k], P, &err), 0);
+        assert_int_equal(pp_phase_matrix(&d, 0.95, Pf, &err), 0);
+        assert_int_equal(pp_phase_matrix(&d, -0.95, Pb, &err), 0);
         for (int i = 0; i < m; i++) {
-            double row = 0.0;
+            int ai = pp_dirs_antipode(&d, i);
             for (int j = 0; j < m; j++) {
-                row += P[i * m + j];
-                assert_true(fabs(P[i * m + j] - P[j * m + i]) < 1e-15);
-                if (gs[k] > -0.9) /* see the note on g = -0.95 above */
-                    assert_true(P[i * m + j] > 0.0);
+                int aj = pp_dirs_antipode(&d, j);
+                assert_true(Pb[i * m + j] >= 0.0);
+                assert_true(fabs(Pb[i * m + j] - Pf[i * m + aj]) < 1e-15);
+                assert_true(j == ai || Pb[i * m + j] < Pb[i * m + ai]);
             }
-            assert_true(fabs(row - 1.0) < 1e-13);
+            assert_true(Pb[i * m + i] > 0.0);
         }
         pp_dirs_free(&d);
+        free(Pf);
+        free(Pb);
     }
-    free(P);
 }
 
 /* g = 0: p = 1/(4 pi), so P_ij = |Omega_j| / (4 pi) = 1 / (2N) exactly. */
@@ -129,6 +164,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hg_normalised_with_mean_cosine_g),
         cmocka_unit_test(test_rows_conserve_energy),
+        cmocka_unit_test(test_backward_is_permuted_forward),
         cmocka_unit_test(test_isotropic_closed_form),
         cmocka_unit_test(test_row_matches_fine_quadrature),
     };
