@@ -11,6 +11,7 @@
 
 #include "atomic_file.h"
 #include "experiment.h"
+#include "march_tables.h"
 #include "metrics.h"
 #include "progress.h"
 #include "sweep_plot.h"
@@ -227,7 +228,9 @@ static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, i
     static ppb_config pt;
     ppb_progress pr;
     ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
-    ppb_run_ctx ctx = {.device_selector = o->device, .quiet = 1};
+    /* Points that share a medium share the marcher's tables: built once per process. */
+    ppb_run_ctx ctx = {
+        .device_selector = o->device, .quiet = 1, .march_cache = ppb_march_cache_new()};
     long long done = 0;
     int rc = 0;
     for (long long i = part; i < n && rc == 0 && !ppb_interrupted(); i += parts) {
@@ -240,6 +243,7 @@ static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, i
         ppb_progress_update(&pr, (double)++done * parts);
     }
     ppb_ctx_close(&ctx);
+    ppb_march_cache_free(ctx.march_cache);
     ppb_progress_end(&pr, (double)done);
     return rc;
 }
