@@ -20,20 +20,20 @@ double pp_hg(double g, double cos_theta)
 /* Gauss order per axis for a cell of corner radius h whose nearest point lies theta_min from
  * the HG peak: Gauss-Legendre converges like rho^(-2q), rho the Bernstein ellipse parameter
  * fixed by the distance d = sqrt(D / |g|) of the nearest complex singularity. */
-static double gauss_order_wanted(double g, double theta_min, double h)
+static double gauss_order_wanted(double g, double cos_theta_min, double h)
 {
     double ag = fabs(g);
     if (ag < 1e-14)
         return 1; /* isotropic: p is constant */
-    double den = 1.0 + ag * ag - 2.0 * ag * cos(theta_min);
+    double den = 1.0 + ag * ag - 2.0 * ag * cos_theta_min;
     double ratio = sqrt(den / ag) / h;
     double rho = ratio + sqrt(ratio * ratio + 1.0);
     return ceil(log(1.0 / PHASE_TOL) / (2.0 * log(rho)));
 }
 
-static int gauss_order(double g, double theta_min, double h)
+static int gauss_order(double g, double cos_theta_min, double h)
 {
-    double q = gauss_order_wanted(g, theta_min, h);
+    double q = gauss_order_wanted(g, cos_theta_min, h);
     return q < 2 ? 2 : (q > PP_QMAX ? PP_QMAX : (int)q);
 }
 
@@ -100,12 +100,27 @@ static double cell_half(const pp_dirs *d, int cell)
     return d->half[cell % d->n];
 }
 
-/* S between cells a and b (any hemispheres), a != b. */
-static int pair_integral(pp_dirs *d, double g, int a, int b, double *out, ppb_err *err)
+/* Cosine of the angle between the peak seen from a and the nearest point of the cell pair:
+ * cos(max(0, peak_angle - R)), R = the sum of the two corner radii, from the radii's cosines
+ * and sines (no inverse trigonometry in the pair loop). */
+static double cos_gap(double g, const double *a, const double *b, double cos_r, double sin_r)
 {
-    double tmin =
-        peak_angle(g, d->centre + 3 * a, d->centre + 3 * b) - cell_radius(d, a) - cell_radius(d, b);
-    int q = gauss_order(g, tmin > 0 ? tmin : 0.0, fmax(cell_half(d, a), cell_half(d, b)));
+    double c = dot3(a, b) * (g < 0 ? -1.0 : 1.0);
+    c = c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c);
+    if (sin_r < 0.0 || c >= cos_r) /* R >= pi, or the peak within R of the pair */
+        return 1.0;
+    return c * cos_r + sqrt(1.0 - c * c) * sin_r;
+}
+
+/* S between cells a and b (any hemispheres), a != b; cr, sr: cosines and sines of the up
+ * cells' corner radii. */
+static int pair_integral(pp_dirs *d, double g, int a, int b, const double *cr, const double *sr,
+                         double *out, ppb_err *err)
+{
+    int ua = a % d->n, ub = b % d->n;
+    double cos_r = cr[ua] * cr[ub] - sr[ua] * sr[ub], sin_r = sr[ua] * cr[ub] + cr[ua] * sr[ub];
+    double cmin = cos_gap(g, d->centre + 3 * a, d->centre + 3 * b, cos_r, sin_r);
+    int q = gauss_order(g, cmin, fmax(cell_half(d, a), cell_half(d, b)));
     const double *na = pp_dirs_nodes(d, a, q, err), *nb = pp_dirs_nodes(d, b, q, err);
     if (!na || !nb)
         return -1;
@@ -120,11 +135,10 @@ static int check_g(double g, ppb_err *err)
     return 0;
 }
 
-/* Sets S(i, j) in a symmetric block and its images under the transpose and the z mirror. */
-static void set_sym(const pp_dirs *d, double *S, int i, int j, double v)
+/* Sets S(i, j) in a symmetric block and its images under the transpose and the z mirror zm. */
+static void set_sym(size_t n, const int *zm, double *S, int i, int j, double v)
 {
-    size_t n = (size_t)d->n;
-    int mi = pp_dirs_zmirror(d, i), mj = pp_dirs_zmirror(d, j);
+    int mi = zm[i], mj = zm[j];
     S[i * n + j] = S[j * n + i] = S[mi * n + mj] = S[mj * n + mi] = v;
 }
 
@@ -188,8 +202,14 @@ static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, pp
 {
     size_t n = (size_t)d->n;
     unsigned char *done = calloc(n * n, 1);
-    if (!done)
+    int *zm = malloc(n * sizeof(int));
+    double *cr = malloc(n * sizeof(double)), *sr = malloc(n * sizeof(double));
+    if (!done || !zm || !cr || !sr) {
+        free(done), free(zm), free(cr), free(sr);
         return ppb_fail(err, "phase matrix: out of memory");
+    }
+    for (int i = 0; i < d->n; i++)
+        zm[i] = pp_dirs_zmirror(d, i), cr[i] = cos(d->radius[i]), sr[i] = sin(d->radius[i]);
     int rc = 0;
     for (int i = 0; rc == 0 && i < d->n; i++) {
         for (int j = i; rc == 0 && j < d->n; j++) {
@@ -197,18 +217,19 @@ static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, pp
                 continue;
             double va = 0.0, vb = 0.0;
             if (j > i)
-                rc |= pair_integral(d, g, i, j, &va, err);
-            rc |= pair_integral(d, g, i, d->n + j, &vb, err);
+                rc |= pair_integral(d, g, i, j, cr, sr, &va, err);
+            rc |= pair_integral(d, g, i, d->n + j, cr, sr, &vb, err);
             int si, sj, G = ring_pair_symmetry(d, i, j, &si, &sj);
             for (int t = 0; t < G; t++) {
                 int it = turn(d, i, t * si), jt = turn(d, j, t * sj);
-                set_sym(d, Sa, it, jt, va);
-                set_sym(d, Sb, it, jt, vb);
-                int mi = pp_dirs_zmirror(d, it), mj = pp_dirs_zmirror(d, jt);
+                set_sym(n, zm, Sa, it, jt, va);
+                set_sym(n, zm, Sb, it, jt, vb);
+                int mi = zm[it], mj = zm[jt];
                 done[it * n + jt] = done[jt * n + it] = done[mi * n + mj] = done[mj * n + mi] = 1;
             }
         }
     }
+    free(zm), free(cr), free(sr);
     free(done);
     if (rc == 0)
         conserve_rows(d, Sa, Sb);
@@ -283,7 +304,7 @@ static double point_rect(double g, const double w[3], double t0, double t1, doub
         }
     double tmin = peak_angle(g, w, c) - rad;
     double h = fmax(0.5 * (t1 - t0), 0.5 * sin(fmin(t1, 0.5 * PP_PI)) * (p1 - p0));
-    double want = gauss_order_wanted(g, tmin > 0 ? tmin : 0.0, h);
+    double want = gauss_order_wanted(g, tmin > 0 ? cos(tmin) : 1.0, h);
     if (want > PP_QMAX && depth < RECT_DEPTH)
         return point_rect(g, w, t0, tm, p0, pm, ysign, depth + 1) +
                point_rect(g, w, t0, tm, pm, p1, ysign, depth + 1) +
@@ -312,8 +333,8 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
         if (j == own)
             continue;
         double tmin = peak_angle(g, w, d->centre + 3 * j) - cell_radius(d, j);
-        tmin = tmin > 0 ? tmin : 0.0;
-        if (gauss_order_wanted(g, tmin, cell_half(d, j)) > PP_QMAX) {
+        double cmin = tmin > 0 ? cos(tmin) : 1.0;
+        if (gauss_order_wanted(g, cmin, cell_half(d, j)) > PP_QMAX) {
             /* the peak is too close for one Gauss rule: bisect the cell's rectangle */
             double mu_lo, mu_hi, p0, p1;
             pp_dirs_bounds(d, j, &mu_lo, &mu_hi, &p0, &p1);
@@ -322,7 +343,7 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
             rest += F[j];
             continue;
         }
-        int q = gauss_order(g, tmin, cell_half(d, j));
+        int q = gauss_order(g, cmin, cell_half(d, j));
         const double *nj = pp_dirs_nodes(d, j, q, err);
         if (!nj)
             return -1;
