@@ -112,6 +112,38 @@ static double cos_gap(double g, const double *a, const double *b, double cos_r, 
     return c * cos_r + sqrt(1.0 - c * c) * sin_r;
 }
 
+static int ring_count(const pp_dirs *d, int r)
+{
+    return d->ring_first[r + 1] - d->ring_first[r];
+}
+
+/* Gauss order cell a's azimuth rule needs against cell b when a's sector is wide (the polar
+ * ring, narrow collars): there the arc-length estimate of gauss_order fails, because along a
+ * small circle the singularity of p lies acosh(X) away in phi, X = (C - mu_a mu_b) / (s_a s_b),
+ * C = (1 + g^2) / (2|g|), however far the peak. Taken at a's widest circle and at cb, the other
+ * cell's centre or the point of a row; 0 where not needed. */
+#define AZ_WIDE 0.1 /* sector half-widths (radians of phi) checked */
+static int azimuth_order(const pp_dirs *d, double g, int a, const double *cb)
+{
+    int ua = a % d->n, r = d->ring[ua];
+    double H = 0.5 * (d->phi_hi[ua] - d->phi_lo[ua]);
+    if (H < AZ_WIDE || fabs(g) < 1e-14)
+        return 0;
+    double mu_a = (a < d->n ? 1.0 : -1.0) * d->mu_edge[r + 1], s_a = sqrt(1.0 - mu_a * mu_a);
+    double s_b = sqrt(cb[0] * cb[0] + cb[2] * cb[2]), C = (1.0 + g * g) / (2.0 * fabs(g));
+    double X = (C - (g < 0 ? -1.0 : 1.0) * mu_a * cb[1]) / (s_a * s_b);
+    if (!(X > 1.0) || !(X < 1e300))
+        return 0;
+    double y = log(X + sqrt(X * X - 1.0)), q;
+    if (ring_count(d, r) == 1) { /* the cap's periodic trapezoid: error about 2 exp(-q y) */
+        q = ceil(log(2.0 / PHASE_TOL) / y);
+    } else {
+        double ratio = y / H, rho = ratio + sqrt(ratio * ratio + 1.0);
+        q = ceil(log(1.0 / PHASE_TOL) / (2.0 * log(rho)));
+    }
+    return q > PP_QMAX ? PP_QMAX : (int)q;
+}
+
 /* S between cells a and b (any hemispheres), a != b; cr, sr: cosines and sines of the up
  * cells' corner radii. */
 static int pair_integral(pp_dirs *d, double g, int a, int b, const double *cr, const double *sr,
@@ -121,6 +153,10 @@ static int pair_integral(pp_dirs *d, double g, int a, int b, const double *cr, c
     double cos_r = cr[ua] * cr[ub] - sr[ua] * sr[ub], sin_r = sr[ua] * cr[ub] + cr[ua] * sr[ub];
     double cmin = cos_gap(g, d->centre + 3 * a, d->centre + 3 * b, cos_r, sin_r);
     int q = gauss_order(g, cmin, fmax(cell_half(d, a), cell_half(d, b)));
+    int qa = azimuth_order(d, g, a, d->centre + 3 * b),
+        qb = azimuth_order(d, g, b, d->centre + 3 * a);
+    q = q > qa ? q : qa;
+    q = q > qb ? q : qb;
     const double *na = pp_dirs_nodes(d, a, q, err), *nb = pp_dirs_nodes(d, b, q, err);
     if (!na || !nb)
         return -1;
@@ -149,11 +185,6 @@ static int gcd(int a, int b)
         a = b, b = t;
     }
     return a;
-}
-
-static int ring_count(const pp_dirs *d, int r)
-{
-    return d->ring_first[r + 1] - d->ring_first[r];
 }
 
 /* Up cell i turned by `steps` sectors of its ring (a one-cell ring stays). */
@@ -343,7 +374,8 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
             rest += F[j];
             continue;
         }
-        int q = gauss_order(g, cmin, cell_half(d, j));
+        int q = gauss_order(g, cmin, cell_half(d, j)), qz = azimuth_order(d, g, j, w);
+        q = q > qz ? q : qz;
         const double *nj = pp_dirs_nodes(d, j, q, err);
         if (!nj)
             return -1;
