@@ -34,9 +34,11 @@ void pp_gauss_legendre(int q, double *x, double *w)
 /* Cells per ring. The polar ring is one cell (the cap) when N is odd, else four quarter-cap
  * wedges (two when N = 2); every collar below it then has an even count, so that the partition
  * is closed under w -> -w (the up/down mirror times a half turn; phase.h uses this for g < 0)
- * and every ring pair is symmetric under a half turn. Collars have equal polar-angle width about
- * the side of a square cell (sqrt(2 pi / N)); their counts are rounded cumulatively, in steps of
- * two, so that they sum to N exactly. */
+ * and every ring pair is symmetric under a half turn. Collars have equal polar-angle width; as
+ * many as fit below a one-cell cap at about the side of a square cell (sqrt(2 pi / N)), also
+ * under four wedges (with one collar fewer the M = 668 radiance against PythonicDISORT was 8%
+ * worse: 0.152% against 0.131% RMS); their counts are rounded cumulatively, in steps of two, so
+ * that they sum to N exactly. */
 static int ring_counts(int n, int *count)
 {
     int pole = n % 2 ? 1 : (n < 4 ? n : 4);
@@ -44,7 +46,7 @@ static int ring_counts(int n, int *count)
     if (n == pole)
         return 1;
     double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PP_PI / n);
-    int collars = (int)lround((0.5 * PP_PI - theta_cap) / side);
+    int collars = (int)lround((0.5 * PP_PI - acos(1.0 - 1.0 / n)) / side);
     if (collars < 1)
         collars = 1;
     if (collars > (n - pole) / 2)

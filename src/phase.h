@@ -14,8 +14,11 @@
  * g = 0.95 function get up to 16 x 16 per cell. The self term (and for F the cell holding w)
  * is not integrated: it is set so that rows conserve energy exactly (sum_j S_ij = |Omega_i|,
  * sum_j F_j = 1), which keeps S symmetric and puts the small quadrature residual where the
- * peak sits. For F, a cell next to w whose rule would need more than PP_QMAX nodes per axis is
- * bisected in (theta, phi) until each piece's rule suffices.
+ * peak sits. Wide sectors (the polar ring, narrow collars) also get the order their azimuth
+ * rule needs: along a small circle the singularity lies acosh(X) away in phi however far the
+ * peak, which the arc-length estimate misses (far pairs were off by 7e-6; now within 4e-8 of
+ * the converged order-16 rule). For F, a cell next to w whose rule would need more than
+ * PP_QMAX nodes per axis is bisected in (theta, phi) until each piece's rule suffices.
  * Symmetry: S is integrated once per orbit of a ring pair under the rotations that map both
  * rings onto themselves (turns by 2 pi / gcd of their sector counts, at least a half turn
  * since collar counts are even), the z mirror and the transpose; the orbit's members are
