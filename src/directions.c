@@ -31,35 +31,37 @@ void pp_gauss_legendre(int q, double *x, double *w)
     }
 }
 
-/* Cells per ring. The polar ring is one cell (the cap) when N is odd, else four quarter-cap
- * wedges (two when N = 2); every collar below it then has an even count, so that the partition
- * is closed under w -> -w (the up/down mirror times a half turn; phase.h uses this for g < 0)
- * and every ring pair is symmetric under a half turn. Collars have equal polar-angle width; as
- * many as fit below a one-cell cap at about the side of a square cell (sqrt(2 pi / N)), also
- * under four wedges (with one collar fewer the M = 668 radiance against PythonicDISORT was 8%
- * worse: 0.152% against 0.131% RMS); their counts are rounded cumulatively, in steps of two, so
- * that they sum to N exactly. */
-static int ring_counts(int n, int *count)
+/* Cells per ring below a polar ring of `pole` cells (one cap, or four quarter-cap wedges for
+ * the antipodal partition of even N). Every cumulative count below the polar ring has the parity
+ * of N, so every collar is even except the first when the polar ring's parity differs from N's
+ * (a cap with even N): with an even polar ring, or a cap and odd N, the partition is closed
+ * under w -> -w (the up/down mirror times a half turn; phase.h uses it for g < 0), and nearly
+ * every ring pair is symmetric under a half turn. Collars have equal polar-angle width; as many
+ * as fit below a one-cell cap at about the side of a square cell (sqrt(2 pi / N)), also under
+ * the wedges (with one collar fewer the M = 668 radiance against PythonicDISORT was 8% worse:
+ * 0.152% against 0.131% RMS); their counts are rounded cumulatively, in steps of two, so that
+ * they sum to N exactly. */
+static int ring_counts(int n, int pole, int *count)
 {
-    int pole = n % 2 ? 1 : (n < 4 ? n : 4);
     count[0] = pole;
     if (n == pole)
         return 1;
     double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PP_PI / n);
     int collars = (int)lround((0.5 * PP_PI - acos(1.0 - 1.0 / n)) / side);
+    int base = n % 2, first_min = pole % 2 != base ? 1 : 2;
     if (collars < 1)
         collars = 1;
-    if (collars > (n - pole) / 2)
-        collars = (n - pole) / 2;
+    if (collars > 1 + (n - pole - first_min) / 2)
+        collars = 1 + (n - pole - first_min) / 2;
     int done = pole;
     for (int r = 1; r <= collars; r++) {
         double theta = theta_cap + (0.5 * PP_PI - theta_cap) * r / collars;
-        int cum = r == collars ? n : pole + 2 * (int)lround(0.5 * (n * (1.0 - cos(theta)) - pole));
+        int cum = r == collars ? n : base + 2 * (int)lround(0.5 * (n * (1.0 - cos(theta)) - base));
         int left = collars - r; /* later collars need at least two cells each */
         if (cum > n - 2 * left)
             cum = n - 2 * left;
-        if (cum < done + 2)
-            cum = done + 2;
+        if (cum < done + (r == 1 ? first_min : 2))
+            cum = done + (r == 1 ? first_min : 2);
         count[r] = cum - done;
         done = cum;
     }
@@ -136,7 +138,7 @@ static void cell_geometry(pp_dirs *d, int i)
                      : fmax(0.5 * (t1 - t0), 0.5 * sin_max * (d->phi_hi[i] - d->phi_lo[i]));
 }
 
-int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
+static int make(int n, int antipodal, pp_dirs *d, ppb_err *err)
 {
     memset(d, 0, sizeof *d);
     if (n < 1 || n > PP_DIRS_MAX)
@@ -144,7 +146,7 @@ int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
     int *count = calloc((size_t)n + 1, sizeof(int));
     if (!count)
         return ppb_fail(err, "pp directions: out of memory");
-    int nrings = ring_counts(n, count);
+    int nrings = ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, count);
     d->n = n;
     d->nrings = nrings;
     d->solid = 2.0 * PP_PI / n;
@@ -170,6 +172,16 @@ int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
     for (int i = 0; i < n; i++)
         cell_geometry(d, i);
     return 0;
+}
+
+int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
+{
+    return make(n, 0, d, err);
+}
+
+int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err)
+{
+    return make(n, 1, d, err);
 }
 
 void pp_dirs_free(pp_dirs *d)

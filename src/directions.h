@@ -4,19 +4,25 @@
  * angles |Omega_i| and mean cosines k_i (SPEC.md section 10: k_i = |Omega_i|^-1 integral of
  * mu over the cell), and quadrature nodes inside each cell.
  *
- * Partition: equal-area zonal ("EQSP"-like). Each hemisphere is a polar ring and collars of
- * equal polar-angle width, each cut into equal azimuth sectors. The polar ring is one cell (a
- * cap) for odd N, four quarter-cap wedges for even N (two for N = 2), and every collar has an
- * even count, rounded from the collars' areas; the collar edges are then moved to mu = 1 - C/N
- * (C = cells above the edge), so every cell has exactly the solid angle 2 pi / N, and since
- * dOmega = dmu dphi, k_i = (mu_top + mu_bottom) / 2 exactly. Why: cells of one size and nearly
- * square shape resolve every direction alike (no crowding at the pole as with a mu x phi
- * grid), any N is allowed, and the (mu, phi) rectangles make solid angles and k_i exact. The
- * even counts make the partition closed under w -> -w (pp_dirs_antipode: the y mirror times a
- * half turn), which turns the g < 0 phase matrix into a column permutation of the |g| one
- * (phase.h), and give every ring pair at least a half-turn symmetry (halving the pair
- * integrals). Sector 0 of every ring is centred on phi = 0 (the beam's azimuth +x), so the
- * partition is mirror symmetric in z (phi -> -phi); cell N + i is the mirror (y -> -y) of i.
+ * Partition: equal-area zonal ("EQSP"-like). Each hemisphere is a polar cap (one cell) and
+ * collars of equal polar-angle width, each cut into equal azimuth sectors; the collar counts,
+ * rounded from the collars' areas, are even except the first one when N is even. The collar
+ * edges are then moved to mu = 1 - C/N (C = cells above the edge), so every cell has exactly
+ * the solid angle 2 pi / N, and since dOmega = dmu dphi, k_i = (mu_top + mu_bottom) / 2
+ * exactly. Why: cells of one size and nearly square shape resolve every direction alike (no
+ * crowding at the pole as with a mu x phi grid), any N is allowed, and the (mu, phi) rectangles
+ * make solid angles and k_i exact. Even counts give nearly every ring pair a half-turn symmetry
+ * (phase.c integrates each orbit once).
+ * The antipodal variant (pp_dirs_make_antipodal, used for g < 0) is closed under w -> -w
+ * (pp_dirs_antipode: the y mirror times a half turn), which turns the g < 0 phase matrix into
+ * a column permutation of the |g| one (phase.h). It needs every ring even or a single cell: for
+ * odd N it is the same partition; for even N the polar ring is four quarter-cap wedges (two for
+ * N = 2). It is not the default because a split polar ring changes the marcher's S-table sums
+ * (tests/test_march.c: stepped against telescoped 1.4e-8 at N = 32, over its 1e-9 tolerance;
+ * every tried partition with a one-cell cap passes, every one with two or four polar cells
+ * fails; the cause is not found).
+ * Sector 0 of every ring is centred on phi = 0 (the beam's azimuth +x), so the partition is
+ * mirror symmetric in z (phi -> -phi); cell N + i is the mirror (y -> -y) of cell i.
  *
  * Frame (SPEC.md, tube frame): y up, mu = w.y, phi measured from +x toward +z:
  * w = (sin(theta) cos(phi), mu, sin(theta) sin(phi)). Cells 0..N-1 are up (mu > 0). */
@@ -46,6 +52,9 @@ typedef struct pp_dirs {
 
 /* Builds the partition with n cells per hemisphere (1 <= n <= PP_DIRS_MAX). */
 int pp_dirs_make(int n, pp_dirs *d, ppb_err *err);
+
+/* The same, closed under w -> -w for every n (a different partition only for even n). */
+int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err);
 void pp_dirs_free(pp_dirs *d);
 
 /* Cell in [0, 2N) holding direction w (unit vector); w.y = 0 counts as up. */
@@ -55,7 +64,8 @@ int pp_dirs_cell_of(const pp_dirs *d, const double w[3]);
 int pp_dirs_zmirror(const pp_dirs *d, int cell);
 
 /* The antipodal cell, holding -w for every w of the cell (the up/down mirror of the cell half a
- * turn round in azimuth); -1 if the partition were not closed under w -> -w (it always is). */
+ * turn round in azimuth); -1 where the partition is not closed under w -> -w (the default
+ * partition with even n). */
 int pp_dirs_antipode(const pp_dirs *d, int cell);
 
 /* The cell's mu range and azimuth range (for down cells mu_lo < mu_hi < 0). */

@@ -211,10 +211,14 @@ static void conserve_rows(const pp_dirs *d, double *Sa, const double *Sb)
 {
     size_t n = (size_t)d->n;
     for (size_t i = 0; i < n; i++) {
-        double rest = 0.0;
-        for (size_t j = 0; j < n; j++)
-            rest += (j == i ? 0.0 : Sa[i * n + j]) + Sb[i * n + j];
-        Sa[i * n + i] = d->solid - rest;
+        /* Neumaier's compensated sum: the rest to about an ulp, whatever its order */
+        double rest = 0.0, comp = 0.0;
+        for (size_t k = 0; k < 2 * n; k++) {
+            double v = k < n ? (k == i ? 0.0 : Sa[i * n + k]) : Sb[i * n + k - n], t = rest + v;
+            comp += fabs(rest) >= fabs(v) ? (rest - t) + v : (v - t) + rest;
+            rest = t;
+        }
+        Sa[i * n + i] = d->solid - (rest + comp);
     }
 }
 
@@ -369,8 +373,10 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
             /* the peak is too close for one Gauss rule: bisect the cell's rectangle */
             double mu_lo, mu_hi, p0, p1;
             pp_dirs_bounds(d, j, &mu_lo, &mu_hi, &p0, &p1);
-            double ys = j < d->n ? 1.0 : -1.0;
-            F[j] = point_rect(g, w, acos(ys * mu_hi), acos(ys * mu_lo), p0, p1, ys, 0);
+            /* theta from the pole of the cell's own hemisphere */
+            int up = j < d->n;
+            F[j] = point_rect(g, w, acos(up ? mu_hi : -mu_lo), acos(up ? mu_lo : -mu_hi), p0, p1,
+                              up ? 1.0 : -1.0, 0);
             rest += F[j];
             continue;
         }

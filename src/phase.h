@@ -20,14 +20,17 @@
  * the converged order-16 rule). For F, a cell next to w whose rule would need more than
  * PP_QMAX nodes per axis is bisected in (theta, phi) until each piece's rule suffices.
  * Symmetry: S is integrated once per orbit of a ring pair under the rotations that map both
- * rings onto themselves (turns by 2 pi / gcd of their sector counts, at least a half turn
- * since collar counts are even), the z mirror and the transpose; the orbit's members are
- * copied, so these symmetries hold exactly.
- * Backward scattering: the partition is closed under w -> -w (pp_dirs_antipode), and
- * p(x.y; g) = p(x.(-y); -g), so for g < 0 S(i, j; g) = S(i, antipode(j); -g): the matrix is a
- * column permutation of the |g| one and its peak, on the pairs (i, antipode(i)), is the
- * conserved self term of |g| (non-negative, as resolved as the forward case), not an
- * under-resolved integral. F is permuted the same way. */
+ * rings onto themselves (turns by 2 pi / gcd of their sector counts, a half turn or more for
+ * the even collars), the z mirror and the transpose; the orbit's members are copied, so these
+ * symmetries hold exactly. The cap's diagonal term comes from a compensated row sum.
+ * Backward scattering: on a partition closed under w -> -w (pp_dirs_antipode; the solver
+ * builds one for g < 0, pp_dirs_make_antipodal), p(x.y; g) = p(x.(-y); -g) gives
+ * S(i, j; g) = S(i, antipode(j); -g): the matrix is a column permutation of the |g| one and its
+ * peak, on the pairs (i, antipode(i)), is the conserved self term of |g| (non-negative, as
+ * resolved as the forward case), not an under-resolved integral. F is permuted the same way.
+ * On a partition without antipodes (the default one for even N) g < 0 is integrated directly,
+ * with the old limitation: the backward peak's residual lands on the diagonal (-1e-2 of a row
+ * at N = 40, g = -0.95; rows still sum to 1). */
 #ifndef PPB_PHASE_H
 #define PPB_PHASE_H
 

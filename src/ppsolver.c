@@ -506,7 +506,10 @@ int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out,
         s->p.albedo = 1.0;
     s->nmodes = s->conservative ? s->m - 1 : s->m;
     pp_work w;
-    int rc = pp_dirs_make(s->n, &s->dirs, err);
+    /* g < 0: the partition closed under w -> -w, where the backward matrix is the permuted
+     * forward one (phase.h); the same partition as the default for odd N */
+    int rc =
+        p->g < 0 ? pp_dirs_make_antipodal(s->n, &s->dirs, err) : pp_dirs_make(s->n, &s->dirs, err);
     if (rc == 0)
         rc = solution_alloc(s, err);
     if (rc == 0 && work_alloc(&w, (size_t)s->n) != 0)

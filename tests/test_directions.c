@@ -11,15 +11,19 @@
 
 static const int sizes[] = {2, 7, 64, 334, 1000};
 
-/* Every cell 2 pi / N, so the 2N cells cover 4 pi exactly; each ring's mu span times 2 pi is
- * its cells' total (dOmega = dmu dphi: the exact area of a (mu, phi) rectangle). */
+/* Both partitions (default and antipodal): every cell 2 pi / N, so the 2N cells cover 4 pi exactly;
+ * each ring's mu span times 2 pi is its cells' total (dOmega = dmu dphi: the exact area of a (mu,
+ * phi) rectangle). */
 static void test_solid_angles_exact(void **state)
 {
     (void)state;
-    for (size_t t = 0; t < sizeof sizes / sizeof *sizes; t++) {
+    for (size_t t = 0; t < 2 * sizeof sizes / sizeof *sizes; t++) {
         pp_dirs d;
         ppb_err err;
-        assert_int_equal(pp_dirs_make(sizes[t], &d, &err), 0);
+        int n = sizes[t % (sizeof sizes / sizeof *sizes)];
+        assert_int_equal(t < sizeof sizes / sizeof *sizes ? pp_dirs_make(n, &d, &err)
+                                                          : pp_dirs_make_antipodal(n, &d, &err),
+                         0);
         assert_true(fabs(2 * d.n * d.solid - 4 * PI) < 1e-12);
         double mu_sum = 0.0;
         for (int r = 0; r < d.nrings; r++) {
@@ -57,10 +61,13 @@ static void test_mean_cosines_exact(void **state)
 static void test_mirror_symmetries(void **state)
 {
     (void)state;
-    for (size_t t = 0; t < sizeof sizes / sizeof *sizes; t++) {
+    for (size_t t = 0; t < 2 * sizeof sizes / sizeof *sizes; t++) {
         pp_dirs d;
         ppb_err err;
-        assert_int_equal(pp_dirs_make(sizes[t], &d, &err), 0);
+        int n = sizes[t % (sizeof sizes / sizeof *sizes)];
+        assert_int_equal(t < sizeof sizes / sizeof *sizes ? pp_dirs_make(n, &d, &err)
+                                                          : pp_dirs_make_antipodal(n, &d, &err),
+                         0);
         for (int i = 0; i < d.n; i++) {
             const double *c = d.centre + 3 * i;
             double down[3] = {c[0], -c[1], c[2]}, zm[3] = {c[0], c[1], -c[2]};
@@ -75,16 +82,26 @@ static void test_mirror_symmetries(void **state)
     }
 }
 
-/* The partition is closed under w -> -w (directions.h: the polar ring is a cap or four
- * wedges and every collar count is even): the antipode of a cell holds minus its centre and
- * minus every one of its nodes, is an involution, and lies in the other hemisphere. */
+/* The antipodal partition is closed under w -> -w (directions.h: the polar ring is a cap or
+ * four wedges and every collar count is even): the antipode of a cell holds minus its centre
+ * and minus every one of its nodes, is an involution, and lies in the other hemisphere. For odd
+ * N it is the default partition; for even N the default one has no antipodes. */
 static void test_partition_is_antipodal(void **state)
 {
     (void)state;
     for (size_t t = 0; t < sizeof sizes / sizeof *sizes; t++) {
-        pp_dirs d;
+        pp_dirs d, plain;
         ppb_err err;
-        assert_int_equal(pp_dirs_make(sizes[t], &d, &err), 0);
+        assert_int_equal(pp_dirs_make_antipodal(sizes[t], &d, &err), 0);
+        assert_int_equal(pp_dirs_make(sizes[t], &plain, &err), 0);
+        if (sizes[t] % 2) {
+            assert_int_equal(plain.nrings, d.nrings);
+            for (int r = 0; r <= d.nrings; r++)
+                assert_int_equal(plain.ring_first[r], d.ring_first[r]);
+        } else if (sizes[t] > 2) {
+            assert_int_equal(pp_dirs_antipode(&plain, 1), -1);
+        }
+        pp_dirs_free(&plain);
         for (int r = 0; r < d.nrings; r++) {
             int count = d.ring_first[r + 1] - d.ring_first[r];
             assert_true(count == 1 || count % 2 == 0);
