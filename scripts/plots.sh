@@ -12,8 +12,8 @@ mkdir -p "$dir/plots"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-methods=$(awk -F, 'NR > 1 {print $1}' "$dir/rms.csv" | awk '!seen[$0]++')
-for m in $methods; do
+mapfile -t methods < <(awk -F, 'NR > 1 {print $1}' "$dir/rms.csv" | awk '!seen[$0]++')
+for m in "${methods[@]}"; do
   for s in S1 S2; do
     awk -F, -v m="$m" -v s="$s" '$1 == m && $2 == s {print $4, $5, $6}' "$dir/rms.csv" \
       > "$tmp/rms_${m//+/_}_$s.dat"
@@ -21,12 +21,11 @@ for m in $methods; do
 done
 
 plot_rms() {
-  local s=$1 first=1 cmd=""
-  for m in $methods; do
-    cmd+="${first:+}'$tmp/rms_${m//+/_}_$s.dat' using 1:(100*\$2) with linespoints pt 7 ps 0.4 title '$m', "
-    first=
+  local s=$1 cmd="" m
+  for m in "${methods[@]}"; do
+    cmd+="'$tmp/rms_${m//+/_}_$s.dat' using 1:(100*\$2) with linespoints pt 7 ps 0.4 title '$m', "
   done
-  local m0=${methods%% *}
+  local m0=${methods[0]}
   cmd+="'$tmp/rms_${m0//+/_}_$s.dat' using 1:(100*\$3) with lines dt 2 lc rgb 'black' title 'MC noise floor'"
   echo "$cmd"
 }
@@ -51,8 +50,8 @@ mv "$dir/plots/rms_vs_x.png.tmp" "$dir/plots/rms_vs_x.png"
 # In-plane cut at x = 0: the two middle segments, phi bins 0 and nphi-1.
 read -r nt np nseg <<<"$(awk -F, 'NR > 1 && $2 == "S1" {if ($5 > t) t = $5; if ($6 > p) p = $6; if ($3 > s) s = $3}
   END {print t + 1, p + 1, s + 1}' "$dir/radiance.csv")"
-all_methods=$(awk -F, 'NR > 1 {print $1}' "$dir/radiance.csv" | awk '!seen[$0]++')
-for m in $all_methods; do
+mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/radiance.csv" | awk '!seen[$0]++')
+for m in "${all_methods[@]}"; do
   for s in S1 S2; do
     awk -F, -v m="$m" -v s="$s" -v nt="$nt" -v np="$np" -v ns="$nseg" '
       $1 == m && $2 == s && ($3 == int(ns / 2) || $3 == int((ns - 1) / 2)) &&
@@ -64,8 +63,8 @@ for m in $all_methods; do
   done
 done
 plot_ang() {
-  local s=$1 cmd=""
-  for m in $all_methods; do
+  local s=$1 cmd="" m
+  for m in "${all_methods[@]}"; do
     cmd+="'$tmp/ang_${m//+/_}_$s.dat' using 1:2 with linespoints pt 7 ps 0.5 title '$m', "
   done
   echo "${cmd%, }"
