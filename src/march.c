@@ -25,18 +25,15 @@ static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *wha
     return m;
 }
 
-int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
-                     const ppb_march_tables *tab, const ppb_march_opts *opts, ppb_err *err)
+/* The launch parameters the kernel reads (march_params.h), all but row0, which each launch
+ * sets. */
+static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
+                                     const ppb_march_tables *tab, const ppb_march_opts *opts)
 {
-    memset(mr, 0, sizeof *mr);
-    mr->ocl = ocl;
-    ppb_layout lo = ppb_scene_layout(sc);
-    mr->nbins = lo.nbins;
-    mr->rows = (int)(lo.ncells / (size_t)lo.nbins);
     double th = sc->theta_deg * PPB_PI / 180.0, wl[3];
     ppb_scene_light_dir(sc, wl);
     int tube = sc->geometry == PPB_GEOM_TUBE;
-    ppb_march_params P = {
+    return (ppb_march_params){
         .width = sc->width,
         .height = sc->height,
         .sigma_t = sc->sigma_t,
@@ -61,6 +58,7 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
         .nalb = tab->nalb,
         .ncols = tab->ncols,
         .with_modes = tab->R != NULL,
+        /* Without an S table (ss, or R asked for) the kernel marches with R. */
         .table = (opts->table == PPB_TABLE_S && tab->S) ? PPB_TABLE_S : PPB_TABLE_R,
         .telescope = opts->telescope,
         .nsamp = tab->nsamp,
@@ -68,38 +66,53 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
         .ntheta = sc->ntheta,
         .nphi = sc->nphi,
     };
+}
+
+/* The arrays of the parameters: where each surface's cells start in the layout, and the tau
+ * grid of each column slab, which the kernel needs to index the tables. */
+static void march_params_arrays(ppb_march_params *P, const ppb_layout *lo,
+                                const ppb_march_tables *tab)
+{
     for (int s = 0; s < PPB_NSURF; s++) {
-        P.nseg[s] = lo.nseg[s];
-        P.offset[s] = lo.offset[s];
+        P->nseg[s] = lo->nseg[s];
+        P->offset[s] = lo->offset[s];
     }
     for (int c = 0; c < tab->ncols; c++) {
-        P.tau0[c] = tab->col[c].tau0;
-        P.tau_h[c] = tab->col[c].tau_h;
-        P.ntau[c] = tab->col[c].ntau;
+        P->tau0[c] = tab->col[c].tau0;
+        P->tau_h[c] = tab->col[c].tau_h;
+        P->ntau[c] = tab->col[c].ntau;
     }
-    mr->params = P;
-    if (ppb_ocl_build(ocl, "march.cl", "", &mr->prog, err) ||
-        ppb_ocl_kernel(mr->prog, "ppb_march_kernel", &mr->kernel, err))
-        goto fail;
+}
+
+/* The device buffers: the inputs copied once, read by every launch, and the output of every
+ * cell. On failure the ones made so far stay in mr for ppb_marcher_free. */
+static int march_buffers(ppb_marcher *mr, const ppb_maps *maps, const ppb_march_tables *tab,
+                         size_t ncells, ppb_err *err)
+{
+    ppb_ocl *ocl = mr->ocl;
     size_t tsize = (size_t)tab->nalb * tab->ndir * tab->ntau;
     mr->map = upload(ocl, maps->cells, (size_t)maps->nx * maps->ny * PPB_MAP_STRIDE, "map", err);
     if (!mr->map)
-        goto fail;
+        return -1;
     mr->tab_r = upload(ocl, tab->R, tsize, "R table", err);
     if (!mr->tab_r)
-        goto fail;
+        return -1;
     mr->tab_s = upload(ocl, tab->S, tsize, "S table", err);
     if (!mr->tab_s)
-        goto fail;
+        return -1;
     mr->coef_c =
         upload(ocl, tab->C, (size_t)tab->ncols * tab->nalb * tab->ndir, "beam coefficients", err);
     if (!mr->coef_c)
-        goto fail;
+        return -1;
     cl_int rc;
-    mr->out =
-        clCreateBuffer(ocl->context, CL_MEM_WRITE_ONLY, lo.ncells * sizeof(double), NULL, &rc);
-    if (ppb_cl_check(rc, "clCreateBuffer(radiance)", err))
-        goto fail;
+    mr->out = clCreateBuffer(ocl->context, CL_MEM_WRITE_ONLY, ncells * sizeof(double), NULL, &rc);
+    return ppb_cl_check(rc, "clCreateBuffer(radiance)", err);
+}
+
+/* The buffer arguments are fixed for the marcher's life; only the parameters change per launch
+ * (ppb_marcher_run). */
+static int march_bind_buffers(ppb_marcher *mr, ppb_err *err)
+{
     cl_mem args[] = {[PPB_MARCH_ARG_MAP] = mr->map,
                      [PPB_MARCH_ARG_TAB_R] = mr->tab_r,
                      [PPB_MARCH_ARG_TAB_S] = mr->tab_s,
@@ -108,11 +121,27 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
     for (int i = PPB_MARCH_ARG_MAP; i < PPB_MARCH_NARGS; i++)
         if (ppb_cl_check(clSetKernelArg(mr->kernel, i, sizeof(cl_mem), &args[i]),
                          "clSetKernelArg(march)", err))
-            goto fail;
+            return -1;
     return 0;
-fail:
-    ppb_marcher_free(mr);
-    return -1;
+}
+
+int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
+                     const ppb_march_tables *tab, const ppb_march_opts *opts, ppb_err *err)
+{
+    memset(mr, 0, sizeof *mr);
+    mr->ocl = ocl;
+    ppb_layout lo = ppb_scene_layout(sc);
+    mr->nbins = lo.nbins;
+    mr->rows = (int)(lo.ncells / (size_t)lo.nbins);
+    mr->params = march_params(sc, maps, tab, opts);
+    march_params_arrays(&mr->params, &lo, tab);
+    if (ppb_ocl_build(ocl, "march.cl", "", &mr->prog, err) ||
+        ppb_ocl_kernel(mr->prog, "ppb_march_kernel", &mr->kernel, err) ||
+        march_buffers(mr, maps, tab, lo.ncells, err) || march_bind_buffers(mr, err)) {
+        ppb_marcher_free(mr);
+        return -1;
+    }
+    return 0;
 }
 
 int ppb_marcher_run(ppb_marcher *mr, int row0, int nrows, ppb_err *err)

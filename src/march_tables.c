@@ -154,67 +154,220 @@ static double s_term(double lambda, double r0, double delta, double e_tau, doubl
     return -scale * e_far_att * (-expm1(-z)) / z;
 }
 
-/* Tables of one (column, albedo node) block: R and S point at its [ndir][ntau] rows. A is
- * [ndir][ne] (A_k(w)), r0 per direction. */
-static void fill_node(int ndir, const ppb_march_col *col, double *R, double *S, const double *A,
-                      const double *r0, int ne, const double *lambda, const double *tau_ref,
-                      double lin, double *E, double *A2)
+/* One pp build in progress. The scratch is sized by the first slab solution's mode count and
+ * reused by every (column, albedo node) block, and the first solution is kept because its phase
+ * matrix serves every later solve (pp_solve_ex's share). */
+typedef struct pp_build {
+    const ppb_scene *sc;
+    const ppb_pp_settings *pp;
+    ppb_march_tables *t;
+    int want_s, ntau_max;
+    double *wdir;       /* [ndir][3] direction samples */
+    double *r0;         /* [ndir] their slope w_y against the slab */
+    pp_solution *first; /* NULL until a block with scattering is solved */
+    double *A, *A2;     /* [ndir][ne]: A_k(w), and A_k / (lambda_k r0 - 1) for S (NULL without) */
+    double *E;          /* [ntau_max][ne]: e_k at the tau nodes of the current column */
+    double *lambda, *tau_ref, *a; /* [nmodes]: the modes, and pp_source_coeffs' output */
+} pp_build;
+
+/* E[i][k] = e_k(tau_i) at the column's tau nodes: the factor both matrix products share. */
+static void fill_exponentials(const pp_build *b, const ppb_march_col *col, int ne)
 {
-    int ntau = col->ntau;
-    /* E[i][k] = e_k(tau_i) */
-    for (int i = 0; i < ntau; i++)
+    for (int i = 0; i < col->ntau; i++)
         for (int k = 0; k < ne; k++)
-            E[(size_t)i * ne + k] = exp(lambda[k] * (i * col->tau_h - tau_ref[k]));
-    /* Paper Eq. 15: R[dir][i] = sum_k A[dir][k] e_k(tau_i), one matrix product. */
-    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ndir, ntau, ne, 1.0, A, ne, E, ne, 0.0, R,
-                ntau);
+            b->E[(size_t)i * ne + k] = exp(b->lambda[k] * (i * col->tau_h - b->tau_ref[k]));
+}
+
+/* Paper Eq. 15: R[dir][i] = sum_k A[dir][k] e_k(tau_i), one matrix product. */
+static void fill_r(const pp_build *b, const ppb_march_col *col, double *R, int ne, double lin)
+{
+    int ndir = b->t->ndir, ntau = col->ntau;
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ndir, ntau, ne, 1.0, b->A, ne, b->E, ne,
+                0.0, R, ntau);
     /* alpha = 1: the diffusion mode's isotropic linear part lin tau. */
     if (lin != 0.0)
         for (int dir = 0; dir < ndir; dir++)
             for (int i = 0; i < ntau; i++)
                 R[(size_t)dir * ntau + i] += lin * i * col->tau_h;
-    if (!S)
+}
+
+/* Modes within this distance of the pole lambda r0 = 1 leave the matrix product: there the
+ * split of S into e_k(tau) and its far-face term would cancel, so they take s_term instead. */
+#define S_NEAR_POLE 1e-2
+
+/* Completes one direction's S row, which the matrix product of fill_s left holding
+ * sum_k A2_k e_k(tau) over the modes away from the pole. */
+static void s_row(const pp_build *b, const ppb_march_col *col, int dir, int ne, double lin,
+                  const double *R_row, double *row)
+{
+    int ntau = col->ntau;
+    double r = b->r0[dir];
+    const double *A = b->A + (size_t)dir * ne, *A2 = b->A2 + (size_t)dir * ne, *E = b->E;
+    if (fabs(r) < 1e-12) {
+        /* A horizontal ray keeps its tau: S = -R (the linear part included: R holds it). */
+        for (int i = 0; i < ntau; i++)
+            row[i] = -R_row[i];
         return;
-    /* S = sum_k A_k/(lambda_k r0 - 1) [e_k(tau) - e_k(tau*) e^{-delta/r0}]: the first part is
-     * a matrix product; modes within 1e-2 of the pole (where that split would cancel) are summed
-     * term by term with the stable form instead. */
-    const double near = 1e-2;
-    for (int dir = 0; dir < ndir; dir++)
+    }
+    /* The far face of the column's own slab, where this member of S vanishes. */
+    double tau_star = r > 0.0 ? col->tau0 : 0.0;
+    int i_star = r > 0.0 ? ntau - 1 : 0;
+    double c_far = 0.0;
+    for (int k = 0; k < ne; k++)
+        c_far += A2[k] * E[(size_t)i_star * ne + k];
+    for (int i = 0; i < ntau; i++) {
+        double tau = i * col->tau_h, delta = tau_star - tau;
+        double att = exp(-delta / r);
+        /* The linear part's S solves r0 S' - S = lin tau: -lin (tau + r0), plus the
+         * homogeneous term that zeroes it at tau*. */
+        row[i] += -c_far * att - lin * (tau + r) + lin * (tau_star + r) * att;
         for (int k = 0; k < ne; k++) {
-            double den = lambda[k] * r0[dir] - 1.0;
-            A2[(size_t)dir * ne + k] = fabs(den) < near ? 0.0 : A[(size_t)dir * ne + k] / den;
-        }
-    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ndir, ntau, ne, 1.0, A2, ne, E, ne, 0.0, S,
-                ntau);
-    for (int dir = 0; dir < ndir; dir++) {
-        double r = r0[dir], *row = S + (size_t)dir * ntau;
-        if (fabs(r) < 1e-12) {
-            /* A horizontal ray keeps its tau: S = -R. */
-            for (int i = 0; i < ntau; i++)
-                row[i] = -R[(size_t)dir * ntau + i];
-            continue; /* (the linear part included: R holds it) */
-        }
-        /* The far face of the column's own slab. */
-        double tau_star = r > 0.0 ? col->tau0 : 0.0;
-        int i_star = r > 0.0 ? ntau - 1 : 0;
-        double c_far = 0.0;
-        for (int k = 0; k < ne; k++)
-            c_far += A2[(size_t)dir * ne + k] * E[(size_t)i_star * ne + k];
-        for (int i = 0; i < ntau; i++) {
-            double tau = i * col->tau_h, delta = tau_star - tau;
-            double att = exp(-delta / r);
-            /* The linear part's S solves r0 S' - S = lin tau: -lin (tau + r0), plus the
-             * homogeneous term that zeroes it at tau*. */
-            row[i] += -c_far * att - lin * (tau + r) + lin * (tau_star + r) * att;
-            for (int k = 0; k < ne; k++) {
-                double den = lambda[k] * r - 1.0;
-                if (fabs(den) >= near)
-                    continue;
-                double e_tau = E[(size_t)i * ne + k], e_far = E[(size_t)i_star * ne + k];
-                row[i] += A[(size_t)dir * ne + k] * s_term(lambda[k], r, delta, e_tau, e_far * att);
-            }
+            if (fabs(b->lambda[k] * r - 1.0) >= S_NEAR_POLE)
+                continue;
+            double e_tau = E[(size_t)i * ne + k], e_far = E[(size_t)i_star * ne + k];
+            row[i] += A[k] * s_term(b->lambda[k], r, delta, e_tau, e_far * att);
         }
     }
+}
+
+/* S = sum_k A_k/(lambda_k r0 - 1) [e_k(tau) - e_k(tau*) e^{-delta/r0}]: the first part is a
+ * matrix product over the modes away from the pole; s_row adds the rest. */
+static void fill_s(const pp_build *b, const ppb_march_col *col, const double *R, double *S, int ne,
+                   double lin)
+{
+    int ndir = b->t->ndir, ntau = col->ntau;
+    for (int dir = 0; dir < ndir; dir++)
+        for (int k = 0; k < ne; k++) {
+            double den = b->lambda[k] * b->r0[dir] - 1.0;
+            size_t dk = (size_t)dir * ne + k;
+            b->A2[dk] = fabs(den) < S_NEAR_POLE ? 0.0 : b->A[dk] / den;
+        }
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ndir, ntau, ne, 1.0, b->A2, ne, b->E, ne,
+                0.0, S, ntau);
+    for (int dir = 0; dir < ndir; dir++)
+        s_row(b, col, dir, ne, lin, R + (size_t)dir * ntau, S + (size_t)dir * ntau);
+}
+
+/* Allocates R, S and the direction samples; on failure frees what it took and the tables. */
+static int build_begin(pp_build *b, const table_key *key, ppb_err *err)
+{
+    ppb_march_tables *t = b->t;
+    b->want_s = key->want_s;
+    for (int c = 0; c < t->ncols; c++)
+        b->ntau_max = t->col[c].ntau > b->ntau_max ? t->col[c].ntau : b->ntau_max;
+    size_t tsize = (size_t)t->nalb * t->ndir * t->ntau;
+    t->R = calloc(tsize, sizeof *t->R);
+    t->S = b->want_s ? calloc(tsize, sizeof *t->S) : NULL;
+    b->r0 = malloc((size_t)t->ndir * sizeof *b->r0);
+    b->wdir = malloc((size_t)t->ndir * 3 * sizeof *b->wdir);
+    if (!t->R || (b->want_s && !t->S) || !b->r0 || !b->wdir) {
+        free(b->r0);
+        free(b->wdir);
+        ppb_march_tables_free(t);
+        return ppb_fail(err, "march tables: out of memory for %zu entries", tsize);
+    }
+    for (int dir = 0; dir < t->ndir; dir++) {
+        table_dir(b->sc, key->nsamp, dir, b->wdir + 3 * dir);
+        b->r0[dir] = b->wdir[3 * dir + 1];
+    }
+    return 0;
+}
+
+/* Frees the scratch, and the tables too when the build failed. */
+static int build_end(pp_build *b, int rc)
+{
+    if (b->first)
+        pp_free(b->first);
+    double *bufs[] = {b->A, b->A2, b->E, b->lambda, b->tau_ref, b->a, b->r0, b->wdir};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
+        free(bufs[i]);
+    if (rc)
+        ppb_march_tables_free(b->t);
+    return rc;
+}
+
+/* Every block must have the first solution's mode count, since the scratch is sized by it. */
+static int adopt_mode_count(pp_build *b, int nm, ppb_err *err)
+{
+    ppb_march_tables *t = b->t;
+    if (b->A && nm != t->nmodes)
+        return ppb_fail(err, "march tables: the slab solutions disagree on the mode count");
+    t->nmodes = nm;
+    if (b->A)
+        return 0;
+    b->A = malloc((size_t)t->ndir * nm * sizeof *b->A);
+    b->A2 = b->want_s ? malloc((size_t)t->ndir * nm * sizeof *b->A2) : NULL;
+    b->E = malloc((size_t)b->ntau_max * nm * sizeof *b->E);
+    b->lambda = malloc((size_t)nm * sizeof *b->lambda);
+    b->tau_ref = malloc((size_t)nm * sizeof *b->tau_ref);
+    b->a = malloc((size_t)nm * sizeof *b->a);
+    if (!b->A || (b->want_s && !b->A2) || !b->E || !b->lambda || !b->tau_ref || !b->a)
+        return ppb_fail(err, "march tables: out of memory for %d modes", nm);
+    return 0;
+}
+
+/* A_k(w) and C(w) of one block from the slab solution. The slab's J carries its albedo; the
+ * march multiplies by the local sigma_s, hence the division by alb. */
+static void block_coeffs(pp_build *b, const pp_solution *sol, double alb, int ne, double *C)
+{
+    for (int dir = 0; dir < b->t->ndir; dir++) {
+        const double *w = b->wdir + 3 * dir;
+        double bcoef;
+        pp_source_coeffs(sol, w, b->a, &bcoef);
+        for (int k = 0; k < ne; k++)
+            b->A[(size_t)dir * ne + k] = b->a[k] / alb;
+        C[dir] = beam_phase(b->sc, w) + bcoef / alb;
+    }
+}
+
+/* The slab solution of one block, sharing the first solution's phase matrix. */
+static int solve_block(pp_build *b, double tau0, double alb, pp_solution **sol, ppb_err *err)
+{
+    const ppb_scene *sc = b->sc;
+    pp_params prm = {.tau0 = tau0,
+                     .albedo = alb,
+                     .g = sc->g,
+                     .mu0 = cos(sc->theta_deg * PPB_PI / 180.0),
+                     .directions = b->pp->directions};
+    return pp_solve_ex(&prm, b->first, sol, NULL, err);
+}
+
+/* The (column c, albedo node) block: C, and the R and S rows at offset off. */
+static int build_block(pp_build *b, int c, int node, size_t off, ppb_err *err)
+{
+    ppb_march_tables *t = b->t;
+    const ppb_march_col *col = &t->col[c];
+    double alb = t->alb0 + node * t->alb_h;
+    double *C = t->C + ((size_t)c * t->nalb + node) * t->ndir;
+    if (alb <= 0.0) {
+        /* No scattering: no diffuse field; sigma_s = 0 zeroes the source anyway. */
+        for (int dir = 0; dir < t->ndir; dir++)
+            C[dir] = beam_phase(b->sc, b->wdir + 3 * dir);
+        return 0;
+    }
+    pp_solution *sol = NULL;
+    if (solve_block(b, col->tau0, alb, &sol, err))
+        return -1;
+    int nm = pp_nmodes(sol);
+    int ne = b->pp->modes > 0 && b->pp->modes < nm ? b->pp->modes : nm;
+    t->modes_kept = ne;
+    if (adopt_mode_count(b, nm, err)) {
+        if (sol != b->first)
+            pp_free(sol);
+        return -1;
+    }
+    pp_modes(sol, b->lambda, b->tau_ref);
+    block_coeffs(b, sol, alb, ne, C);
+    double lin = pp_source_linear(sol) / alb;
+    if (!b->first)
+        b->first = sol;
+    else
+        pp_free(sol);
+    fill_exponentials(b, col, ne);
+    fill_r(b, col, t->R + off, ne, lin);
+    if (b->want_s)
+        fill_s(b, col, t->R + off, t->S + off, ne, lin);
+    return 0;
 }
 
 int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp, int tau_per_mfp,
@@ -223,105 +376,17 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
     table_key key = plan(sc, pp, nsamp, tau_per_mfp, 1);
     if (alloc_common(sc, &key, t, err))
         return -1;
-    int nalb = t->nalb, ntau_max = 0;
-    for (int c = 0; c < t->ncols; c++)
-        ntau_max = t->col[c].ntau > ntau_max ? t->col[c].ntau : ntau_max;
-    size_t tsize = (size_t)nalb * t->ndir * t->ntau;
-    int want_s = key.want_s;
-    t->R = calloc(tsize, sizeof *t->R);
-    t->S = want_s ? calloc(tsize, sizeof *t->S) : NULL;
-    double *r0 = malloc((size_t)t->ndir * sizeof *r0);
-    double *wdir = malloc((size_t)t->ndir * 3 * sizeof *wdir);
-    if (!t->R || (want_s && !t->S) || !r0 || !wdir) {
-        free(r0);
-        free(wdir);
-        ppb_march_tables_free(t);
-        return ppb_fail(err, "march tables: out of memory for %zu entries", tsize);
-    }
-    for (int dir = 0; dir < t->ndir; dir++) {
-        table_dir(sc, nsamp, dir, wdir + 3 * dir);
-        r0[dir] = wdir[3 * dir + 1];
-    }
-    double *A = NULL, *A2 = NULL, *E = NULL, *lambda = NULL, *tau_ref = NULL, *a = NULL;
-    pp_solution *first = NULL; /* its phase matrix serves every column and albedo node */
+    pp_build b = {.sc = sc, .pp = pp, .t = t};
+    if (build_begin(&b, &key, err))
+        return -1;
     int rc = 0;
     size_t off = 0; /* of the current (column, albedo node) block in R and S */
-    for (int c = 0; c < t->ncols && rc == 0; c++) {
-        const ppb_march_col *col = &t->col[c];
-        for (int node = 0; node < nalb && rc == 0; node++, off += (size_t)t->ndir * col->ntau) {
-            double alb = t->alb0 + node * t->alb_h;
-            double *C = t->C + ((size_t)c * nalb + node) * t->ndir;
-            if (alb <= 0.0) {
-                /* No scattering: no diffuse field; sigma_s = 0 zeroes the source anyway. */
-                for (int dir = 0; dir < t->ndir; dir++)
-                    C[dir] = beam_phase(sc, wdir + 3 * dir);
-                continue;
-            }
-            pp_params prm = {.tau0 = col->tau0,
-                             .albedo = alb,
-                             .g = sc->g,
-                             .mu0 = cos(sc->theta_deg * PPB_PI / 180.0),
-                             .directions = pp->directions};
-            pp_solution *sol = NULL;
-            if (pp_solve_ex(&prm, first, &sol, NULL, err)) {
-                rc = -1;
-                break;
-            }
-            int nm = pp_nmodes(sol);
-            int ne = pp->modes > 0 && pp->modes < nm ? pp->modes : nm;
-            t->modes_kept = ne;
-            if (A && nm != t->nmodes) {
-                if (sol != first)
-                    pp_free(sol);
-                rc = ppb_fail(err, "march tables: the slab solutions disagree on the mode count");
-                break;
-            }
-            t->nmodes = nm;
-            if (!A) {
-                A = malloc((size_t)t->ndir * nm * sizeof *A);
-                A2 = want_s ? malloc((size_t)t->ndir * nm * sizeof *A2) : NULL;
-                E = malloc((size_t)ntau_max * nm * sizeof *E);
-                lambda = malloc((size_t)nm * sizeof *lambda);
-                tau_ref = malloc((size_t)nm * sizeof *tau_ref);
-                a = malloc((size_t)nm * sizeof *a);
-                if (!A || (want_s && !A2) || !E || !lambda || !tau_ref || !a) {
-                    if (sol != first)
-                        pp_free(sol);
-                    rc = ppb_fail(err, "march tables: out of memory for %d modes", nm);
-                    break;
-                }
-            }
-            pp_modes(sol, lambda, tau_ref);
-            for (int dir = 0; dir < t->ndir; dir++) {
-                double b;
-                pp_source_coeffs(sol, wdir + 3 * dir, a, &b);
-                /* The slab's J carries its albedo; the march multiplies by the local sigma_s. */
-                for (int k = 0; k < ne; k++)
-                    A[(size_t)dir * ne + k] = a[k] / alb;
-                C[dir] = beam_phase(sc, wdir + 3 * dir) + b / alb;
-            }
-            double lin = pp_source_linear(sol) / alb;
-            if (!first)
-                first = sol;
-            else
-                pp_free(sol);
-            fill_node(t->ndir, col, t->R + off, want_s ? t->S + off : NULL, A, r0, ne, lambda,
-                      tau_ref, lin, E, A2);
+    for (int c = 0; c < t->ncols && rc == 0; c++)
+        for (int node = 0; node < t->nalb && rc == 0; node++) {
+            rc = build_block(&b, c, node, off, err);
+            off += (size_t)t->ndir * t->col[c].ntau;
         }
-    }
-    if (first)
-        pp_free(first);
-    free(A);
-    free(A2);
-    free(E);
-    free(lambda);
-    free(tau_ref);
-    free(a);
-    free(r0);
-    free(wdir);
-    if (rc)
-        ppb_march_tables_free(t);
-    return rc;
+    return build_end(&b, rc);
 }
 
 /* The cache (march_tables.h): one slot per kind, [0] ss, [1] pp. */
