@@ -103,42 +103,15 @@ static int check_settings(const ppb_config *cfg, long long first, long long coun
     return 0;
 }
 
-/* Reads the device tallies into tmp (zeroed arrays of t's shape). */
-static int read_tallies(ppb_ocl *ocl, const mc_device *d, ppb_mc_tallies *tmp, ppb_err *err)
+/* Sizes of a tallies' arrays (shapes in src/mc_tally.h), the same on the device and the host. */
+static size_t cell_bytes(const ppb_mc_tallies *t)
 {
-    size_t nb = (size_t)tmp->batches;
-    size_t cell_bytes = nb * PPB_MC_NTALLY * tmp->ncells * sizeof(uint64_t);
-    size_t tot_bytes = nb * PPB_MC_NTOT * sizeof(uint64_t);
-    if (ppb_cl_check(clEnqueueReadBuffer(ocl->queue, d->cells, CL_TRUE, 0, cell_bytes, tmp->cells,
-                                         0, NULL, NULL),
-                     "clEnqueueReadBuffer(mc cells)", err) ||
-        ppb_cl_check(clEnqueueReadBuffer(ocl->queue, d->totals, CL_TRUE, 0, tot_bytes, tmp->totals,
-                                         0, NULL, NULL),
-                     "clEnqueueReadBuffer(mc totals)", err))
-        return -1;
-    return 0;
+    return (size_t)t->batches * PPB_MC_NTALLY * t->ncells * sizeof(uint64_t);
 }
 
-/* noise_rel at the x = 0 cells of S1 and S2 (SPEC.md 5, Table 2 cells), the larger of the two,
- * for the tallies so far (t plus the device's). */
-static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tallies *tmp,
-                     double *noise, ppb_err *err)
+static size_t total_bytes(const ppb_mc_tallies *t)
 {
-    const ppb_scene *sc = &cfg->scene;
-    if (ppb_mc_tallies_add(tmp, t, err))
-        return -1;
-    ppb_layout lo = ppb_scene_layout(sc);
-    ppb_result r;
-    if (ppb_result_init(&r, "mc", &lo, err))
-        return -1;
-    ppb_mc_tallies_to_results(tmp, sc, &r, NULL);
-    int segs[2];
-    ppb_mc_x0_segments(sc, segs);
-    double nr = ppb_mc_noise_rel(&r, PPB_S1, segs, 2);
-    double nt = ppb_mc_noise_rel(&r, PPB_S2, segs, 2);
-    *noise = nr > nt ? nr : nt;
-    ppb_result_free(&r);
-    return 0;
+    return (size_t)t->batches * PPB_MC_NTOT * sizeof(uint64_t);
 }
 
 /* How the kernel is laid out on a device: photons side by side per work-item (SIMD lanes on a
@@ -171,27 +144,38 @@ static long long auto_chunk(const mc_shape *shape)
     return shape->items * shape->lanes * 64;
 }
 
-static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape, mc_device *d,
-                           long long first, long long count, ppb_mc_tallies *t,
-                           ppb_mc_trace_info *info, ppb_err *err)
+/* One trace in progress: what every chunk needs, gathered so the helpers below share it. */
+typedef struct mc_run {
+    const ppb_config *cfg;
+    ppb_ocl *ocl;
+    const mc_shape *shape;
+    mc_device *d;
+    size_t local;       /* work-group size */
+    long long chunk;    /* photons per launch */
+    long long first;    /* first photon of the range */
+    ppb_mc_params p;    /* first and count change per launch */
+    ppb_mc_tallies *t;  /* the caller's tallies: the device's are added to them at the end */
+    ppb_mc_tallies tmp; /* host copy of the device's tallies, shaped like t */
+} mc_run;
+
+/* The kernel adds into the device tallies launch after launch, so they start at zero and stay
+ * bound to the kernel for the whole trace. */
+static int create_buffers(mc_run *r, ppb_err *err)
 {
-    const ppb_config *cfg = ctx->cfg;
-    size_t nb = (size_t)t->batches;
-    size_t cell_bytes = nb * PPB_MC_NTALLY * t->ncells * sizeof(uint64_t);
-    size_t tot_bytes = nb * PPB_MC_NTOT * sizeof(uint64_t);
+    size_t cb = cell_bytes(r->t), tb = total_bytes(r->t);
+    mc_device *d = r->d;
     cl_int rc;
-    d->cells = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE, cell_bytes, NULL, &rc);
+    d->cells = clCreateBuffer(r->ocl->context, CL_MEM_READ_WRITE, cb, NULL, &rc);
     if (ppb_cl_check(rc, "clCreateBuffer(mc cells)", err))
         return -1;
-    d->totals = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE, tot_bytes, NULL, &rc);
+    d->totals = clCreateBuffer(r->ocl->context, CL_MEM_READ_WRITE, tb, NULL, &rc);
     if (ppb_cl_check(rc, "clCreateBuffer(mc totals)", err))
         return -1;
     const cl_ulong zero = 0;
-    if (ppb_cl_check(clEnqueueFillBuffer(ocl->queue, d->cells, &zero, sizeof zero, 0, cell_bytes, 0,
-                                         NULL, NULL),
+    cl_command_queue q = r->ocl->queue;
+    if (ppb_cl_check(clEnqueueFillBuffer(q, d->cells, &zero, sizeof zero, 0, cb, 0, NULL, NULL),
                      "clEnqueueFillBuffer(mc cells)", err) ||
-        ppb_cl_check(clEnqueueFillBuffer(ocl->queue, d->totals, &zero, sizeof zero, 0, tot_bytes, 0,
-                                         NULL, NULL),
+        ppb_cl_check(clEnqueueFillBuffer(q, d->totals, &zero, sizeof zero, 0, tb, 0, NULL, NULL),
                      "clEnqueueFillBuffer(mc totals)", err))
         return -1;
     if (ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_CELLS, sizeof d->cells, &d->cells),
@@ -199,87 +183,188 @@ static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape
         ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_TOTALS, sizeof d->totals, &d->totals),
                      "clSetKernelArg(mc totals)", err))
         return -1;
+    return 0;
+}
 
-    /* Work-group size 0 means ppbench picks: 64 work-items keep a group inside one batch and
-     * give PoCL's CPU driver enough groups to balance its cores (its own choice is slower),
-     * and suit GPUs too. */
-    size_t local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 64;
-    if (!cfg->mc.workgroup && local > ocl->max_workgroup)
-        local = ocl->max_workgroup;
-    if (local > ocl->max_workgroup)
-        return ppb_fail(err, "mc: workgroup %zu exceeds the device's maximum %zu", local,
+/* Work-group size 0 means ppbench picks: 64 work-items keep a group inside one batch and give
+ * PoCL's CPU driver enough groups to balance its cores (its own choice is slower), and suit
+ * GPUs too. A size the user asked for is never shrunk silently. */
+static int pick_workgroup(const ppb_config *cfg, const ppb_ocl *ocl, size_t *local, ppb_err *err)
+{
+    *local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 64;
+    if (!cfg->mc.workgroup && *local > ocl->max_workgroup)
+        *local = ocl->max_workgroup;
+    if (*local > ocl->max_workgroup)
+        return ppb_fail(err, "mc: workgroup %zu exceeds the device's maximum %zu", *local,
                         ocl->max_workgroup);
-    long long chunk = cfg->mc.chunk > 0 ? cfg->mc.chunk : auto_chunk(shape);
+    return 0;
+}
 
-    ppb_mc_tallies tmp = {0};
-    tmp.fingerprint = t->fingerprint, tmp.seed = t->seed, tmp.batches = t->batches;
-    tmp.ncells = t->ncells;
-    tmp.photons = calloc(nb, sizeof *tmp.photons);
-    tmp.cells = malloc(cell_bytes);
-    tmp.totals = malloc(tot_bytes);
-    if (!tmp.photons || !tmp.cells || !tmp.totals) {
-        ppb_mc_tallies_free(&tmp);
+/* The host copy is allocated once per trace, not per noise check. Cells and totals need no
+ * zeroing: every read overwrites them whole. */
+static int alloc_host_copy(const ppb_mc_tallies *t, ppb_mc_tallies *tmp, ppb_err *err)
+{
+    *tmp = (ppb_mc_tallies){
+        .fingerprint = t->fingerprint, .seed = t->seed, .batches = t->batches, .ncells = t->ncells};
+    tmp->photons = calloc((size_t)t->batches, sizeof *tmp->photons);
+    tmp->cells = malloc(cell_bytes(t));
+    tmp->totals = malloc(total_bytes(t));
+    if (!tmp->photons || !tmp->cells || !tmp->totals)
         return ppb_fail(err, "mc: out of memory for tallies");
-    }
+    return 0;
+}
 
-    ppb_mc_params p = make_params(cfg);
-    ppb_progress pr;
-    ppb_progress_begin(&pr, "mc", "photons", (double)count, ctx->quiet);
-    double t0 = ppb_now();
-    long long done = 0;
-    int status = 0;
-    while (done < count) {
+/* Everything fixed for the whole trace, settled before the clock starts. */
+static int prepare_run(mc_run *r, ppb_err *err)
+{
+    if (create_buffers(r, err) || pick_workgroup(r->cfg, r->ocl, &r->local, err))
+        return -1;
+    r->chunk = r->cfg->mc.chunk > 0 ? r->cfg->mc.chunk : auto_chunk(r->shape);
+    if (alloc_host_copy(r->t, &r->tmp, err))
+        return -1;
+    r->p = make_params(r->cfg);
+    return 0;
+}
+
+/* Reads the device tallies of photons [first, first + done) into r->tmp. The device counts no
+ * photons, so the per-batch counts are rebuilt from the range (batch = index % batches). */
+static int read_tallies(mc_run *r, long long done, ppb_err *err)
+{
+    ppb_mc_tallies *tmp = &r->tmp;
+    memset(tmp->photons, 0, (size_t)tmp->batches * sizeof *tmp->photons);
+    ppb_mc_tallies_count_range(tmp, (uint64_t)r->first, (uint64_t)done);
+    cl_command_queue q = r->ocl->queue;
+    if (ppb_cl_check(clEnqueueReadBuffer(q, r->d->cells, CL_TRUE, 0, cell_bytes(tmp), tmp->cells, 0,
+                                         NULL, NULL),
+                     "clEnqueueReadBuffer(mc cells)", err) ||
+        ppb_cl_check(clEnqueueReadBuffer(q, r->d->totals, CL_TRUE, 0, total_bytes(tmp), tmp->totals,
+                                         0, NULL, NULL),
+                     "clEnqueueReadBuffer(mc totals)", err))
+        return -1;
+    return 0;
+}
+
+/* noise_rel at the x = 0 cells of S1 and S2 (SPEC.md 5, Table 2 cells), the larger of the two,
+ * for the tallies so far (t plus the device's, already read into tmp). */
+static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tallies *tmp,
+                     double *noise, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    if (ppb_mc_tallies_add(tmp, t, err))
+        return -1;
+    ppb_layout lo = ppb_scene_layout(sc);
+    ppb_result r;
+    if (ppb_result_init(&r, "mc", &lo, err))
+        return -1;
+    ppb_mc_tallies_to_results(tmp, sc, &r, NULL);
+    int segs[2];
+    ppb_mc_x0_segments(sc, segs);
+    double nr = ppb_mc_noise_rel(&r, PPB_S1, segs, 2);
+    double nt = ppb_mc_noise_rel(&r, PPB_S2, segs, 2);
+    *noise = nr > nt ? nr : nt;
+    ppb_result_free(&r);
+    return 0;
+}
+
+/* Whether the first done photons already meet cfg->mc.target_noise. */
+static int noise_reached(mc_run *r, long long done, int *reached, ppb_err *err)
+{
+    double noise;
+    if (read_tallies(r, done, err) || noise_now(r->cfg, r->t, &r->tmp, &noise, err))
+        return -1;
+    *reached = noise < r->cfg->mc.target_noise;
+    return 0;
+}
+
+/* Global size: batches x P work-items, P a multiple of the work-group size, so each work-group
+ * stays inside one batch (see the kernel); about 64 photons per lane, as in auto_chunk. */
+static size_t global_size(const mc_run *r, long long n)
+{
+    size_t nb = (size_t)r->t->batches;
+    long long want = n / (r->shape->lanes * 64) + 1;
+    size_t items = (size_t)(want < r->shape->items ? want : r->shape->items);
+    size_t per_batch = (items + nb - 1) / nb;
+    per_batch = (per_batch + r->local - 1) / r->local * r->local;
+    return per_batch * nb;
+}
+
+/* Traces photons [first, first + n) and waits for them, so that progress, SIGINT and the noise
+ * check between launches always see whole chunks. */
+static int launch_chunk(mc_run *r, long long first, long long n, ppb_err *err)
+{
+    r->p.first = (ppb_u64)first;
+    r->p.count = (ppb_u64)n;
+    size_t global = global_size(r, n);
+    cl_kernel k = r->d->kernel;
+    cl_command_queue q = r->ocl->queue;
+    if (ppb_cl_check(clSetKernelArg(k, PPB_MC_ARG_PARAMS, sizeof r->p, &r->p),
+                     "clSetKernelArg(mc params)", err) ||
+        ppb_cl_check(clEnqueueNDRangeKernel(q, k, 1, NULL, &global, &r->local, 0, NULL, NULL),
+                     "clEnqueueNDRangeKernel(ppb_mc_trace_kernel)", err) ||
+        ppb_cl_check(clFinish(q), "clFinish(mc)", err))
+        return -1;
+    return 0;
+}
+
+/* Launches chunk after chunk until count photons are traced, SIGINT/SIGTERM arrives or the
+ * target noise is met. Stops fall only between chunks, so *done always counts a whole prefix
+ * of the range. The last chunk skips the noise check: nothing would be left to save. */
+static int trace_chunks(mc_run *r, long long count, ppb_progress *pr, long long *done,
+                        ppb_mc_trace_info *info, ppb_err *err)
+{
+    while (*done < count) {
         if (ppb_interrupted()) {
             info->interrupted = 1;
-            break;
+            return 0;
         }
-        long long n = count - done < chunk ? count - done : chunk;
-        p.first = (ppb_u64)(first + done);
-        p.count = (ppb_u64)n;
-        /* Global size: batches x P work-items, P a multiple of the work-group size, so each
-         * work-group stays inside one batch (see the kernel). */
-        size_t nb_sz = (size_t)t->batches;
-        long long want = n / (shape->lanes * 64) + 1; /* about 64 photons per lane */
-        size_t items = (size_t)(want < shape->items ? want : shape->items);
-        size_t per_batch = (items + nb_sz - 1) / nb_sz;
-        per_batch = (per_batch + local - 1) / local * local;
-        size_t global = per_batch * nb_sz;
-        if (ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_PARAMS, sizeof p, &p),
-                         "clSetKernelArg(mc params)", err) ||
-            ppb_cl_check(clEnqueueNDRangeKernel(ocl->queue, d->kernel, 1, NULL, &global, &local, 0,
-                                                NULL, NULL),
-                         "clEnqueueNDRangeKernel(ppb_mc_trace_kernel)", err) ||
-            ppb_cl_check(clFinish(ocl->queue), "clFinish(mc)", err)) {
-            status = -1;
-            break;
-        }
-        done += n;
-        ppb_progress_update(&pr, (double)done);
-        if (cfg->mc.target_noise > 0 && done < count) {
-            double noise;
-            memset(tmp.photons, 0, nb * sizeof *tmp.photons);
-            ppb_mc_tallies_count_range(&tmp, (uint64_t)first, (uint64_t)done);
-            if (read_tallies(ocl, d, &tmp, err) || noise_now(cfg, t, &tmp, &noise, err)) {
-                status = -1;
-                break;
-            }
-            if (noise < cfg->mc.target_noise) {
-                info->reached_noise = 1;
-                break;
-            }
+        long long n = count - *done < r->chunk ? count - *done : r->chunk;
+        if (launch_chunk(r, r->first + *done, n, err))
+            return -1;
+        *done += n;
+        ppb_progress_update(pr, (double)*done);
+        int reached = 0;
+        if (r->cfg->mc.target_noise > 0 && *done < count && noise_reached(r, *done, &reached, err))
+            return -1;
+        if (reached) {
+            info->reached_noise = 1;
+            return 0;
         }
     }
+    return 0;
+}
+
+/* The trace proper, timed for info->seconds and shown as progress; the setup and the final
+ * read stay outside the clock, so perf measures the launches alone. */
+static int trace_timed(mc_run *r, int quiet, long long count, long long *done,
+                       ppb_mc_trace_info *info, ppb_err *err)
+{
+    ppb_progress pr;
+    ppb_progress_begin(&pr, "mc", "photons", (double)count, quiet);
+    double t0 = ppb_now();
+    int status = trace_chunks(r, count, &pr, done, info, err);
     info->seconds = ppb_now() - t0;
-    ppb_progress_end(&pr, (double)done);
+    ppb_progress_end(&pr, (double)*done);
+    return status;
+}
+
+/* The device's tallies reach t in one addition at the end, so a trace that fails on the way
+ * leaves t as it was. */
+static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape, mc_device *d,
+                           long long first, long long count, ppb_mc_tallies *t,
+                           ppb_mc_trace_info *info, ppb_err *err)
+{
+    mc_run r = {.cfg = ctx->cfg, .ocl = ocl, .shape = shape, .d = d, .first = first, .t = t};
+    long long done = 0;
+    int status = prepare_run(&r, err);
+    if (status == 0)
+        status = trace_timed(&r, ctx->quiet, count, &done, info, err);
     if (status == 0) {
-        memset(tmp.photons, 0, nb * sizeof *tmp.photons);
-        ppb_mc_tallies_count_range(&tmp, (uint64_t)first, (uint64_t)done);
-        status = read_tallies(ocl, d, &tmp, err);
-        if (status == 0)
-            status = ppb_mc_tallies_add(t, &tmp, err);
         info->traced = done;
+        status = read_tallies(&r, done, err);
+        if (status == 0)
+            status = ppb_mc_tallies_add(t, &r.tmp, err);
     }
-    ppb_mc_tallies_free(&tmp);
+    ppb_mc_tallies_free(&r.tmp);
     return status;
 }
 
