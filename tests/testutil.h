@@ -22,8 +22,10 @@
 static inline const char *tu_scratch(const char *name)
 {
     static char dir[1024];
-    const char *base = getenv("TMPDIR");
+    /* Absolute, so tests that change directory or hand it to a child still find it. */
+    char *base = realpath(getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", NULL);
     snprintf(dir, sizeof dir, "%s/ppbench-%s-%d", base ? base : "/tmp", name, (int)getpid());
+    free(base);
     char cmd[2200];
     snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", dir, dir);
     if (system(cmd) != 0)
