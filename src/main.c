@@ -136,6 +136,13 @@ static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_err 
     return 0;
 }
 
+/* A config or option the user must fix: printed once, exit code 2. */
+static int usage_error(const ppb_err *err)
+{
+    fprintf(stderr, "ppbench: %s\n", err->msg);
+    return EXIT_USAGE;
+}
+
 static int cmd_run(const cli *c)
 {
     if (c->nargs == 0) {
@@ -146,10 +153,8 @@ static int cmd_run(const cli *c)
     static ppb_experiment ex;
     ppb_err err = {{0}};
     for (int i = 0; i < c->nargs; i++) {
-        if (load_config(c, c->args[i], &cfg, &err)) {
-            fprintf(stderr, "ppbench: %s\n", err.msg);
-            return EXIT_USAGE;
-        }
+        if (load_config(c, c->args[i], &cfg, &err))
+            return usage_error(&err);
         if (cfg.naxes > 0) {
             fprintf(stderr, "ppbench: %s: keys hold lists (a sweep): use `ppbench sweep`\n",
                     cfg.path);
@@ -206,10 +211,8 @@ static int cmd_sweep(const cli *c)
     }
     static ppb_config cfg;
     ppb_err err = {{0}};
-    if (load_config(c, c->args[0], &cfg, &err)) {
-        fprintf(stderr, "ppbench: %s\n", err.msg);
-        return EXIT_USAGE;
-    }
+    if (load_config(c, c->args[0], &cfg, &err))
+        return usage_error(&err);
     ppb_sweep_opts o = {.device = c->device,
                         .quiet = c->quiet,
                         .yes = c->yes,
@@ -251,10 +254,8 @@ static int cmd_mc_shard(const cli *c, int merge)
     }
     static ppb_config cfg;
     ppb_err err = {{0}};
-    if (load_config(c, c->args[0], &cfg, &err)) {
-        fprintf(stderr, "ppbench: %s\n", err.msg);
-        return EXIT_USAGE;
-    }
+    if (load_config(c, c->args[0], &cfg, &err))
+        return usage_error(&err);
     int rc = merge ? ppb_mc_shard_merge(&cfg, c->args + 1, c->nargs - 1, &err)
                    : ppb_mc_shard_run(&cfg, c->device, c->quiet, c->shard_i, c->shard_n, &err);
     if (rc) {
