@@ -84,13 +84,6 @@ typedef struct ppb_march_params {
     int offset[4]; /* first segment row of each surface, as ppb_layout */
 } ppb_march_params;
 
-/* Henyey-Greenstein phase function of the scattering cosine, per steradian (paper Sec. 4.1). */
-PPB_FN double ppb_hg_phase(double g, double cos_angle)
-{
-    double den = 1.0 + g * g - 2.0 * g * cos_angle;
-    return (1.0 - g * g) / (4.0 * PPB_PI * den * sqrt(den));
-}
-
 /* Direction sample (a, b) of bin (itheta, iphi) on surface surf: the stratified midpoints of an
  * n x n grid in (sin^2 theta, phi), i.e. uniform in projected solid angle (SPEC.md section 4). */
 PPB_FN void ppb_march_dir(int surf, int bin, int a, int b, int n, int ntheta, int nphi, double *wx,

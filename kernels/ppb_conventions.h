@@ -2,7 +2,8 @@
  *
  * Owns: surface ids and their local frames (n, b = +z, t = n x b), the direction bins (equal
  * sin^2(theta) theta bins, phi folded to [0, 180] deg), the (surface, segment, bin) cell index
- * of every radiance array, segment centres, and the piecewise-constant medium. Plain C that is
+ * of every radiance array, segment centres, the piecewise-constant medium and the
+ * Henyey-Greenstein phase function. Plain C that is
  * also OpenCL C: the host includes it from src/, kernels with -I kernels. Nothing here
  * allocates or keeps state. */
 #ifndef PPB_CONVENTIONS_H
@@ -123,6 +124,14 @@ PPB_FN double ppb_sigma_t_at(double x, int step, double step_x, double sigma_t,
 PPB_FN double ppb_albedo_at(double x, int step, double step_x, double albedo, double albedo_right)
 {
     return (step == PPB_STEP_ALBEDO && x >= step_x) ? albedo_right : albedo;
+}
+
+/* Henyey-Greenstein phase function of the scattering cosine, per steradian, normalised to 1
+ * over the sphere (SPEC.md section 1; paper Sec. 4.1). */
+PPB_FN double ppb_hg_phase(double g, double cos_angle)
+{
+    double den = 1.0 + g * g - 2.0 * g * cos_angle;
+    return (1.0 - g * g) / (4.0 * PPB_PI * den * sqrt(den));
 }
 
 #endif

@@ -1,6 +1,8 @@
 /* phase.c: HG cell-pair and point-cell integrals by order-adaptive product Gauss (phase.h). */
 #include "phase.h"
 
+#include "../kernels/ppb_conventions.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,8 +15,7 @@
 
 double pp_hg(double g, double cos_theta)
 {
-    double den = 1.0 + g * g - 2.0 * g * cos_theta;
-    return (1.0 - g * g) / (4.0 * PP_PI * den * sqrt(den));
+    return ppb_hg_phase(g, cos_theta);
 }
 
 /* Gauss order per axis for a cell of corner radius h whose nearest point lies theta_min from
