@@ -303,42 +303,6 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
     free(surf), free(sides);
 }
 
-void ppb_mc_x0_segments(const ppb_scene *sc, int segs[2])
-{
-    segs[0] = segs[1] = 0;
-    if (sc->geometry == PPB_GEOM_SLAB)
-        return;
-    double best[2] = {INFINITY, INFINITY};
-    for (int k = 0; k < sc->segments_top; k++) {
-        double x, y;
-        double d =
-            fabs(ppb_segment_centre(PPB_S1, k, sc->segments_top, sc->width, sc->height, &x, &y));
-        if (d < best[0]) {
-            best[1] = best[0], segs[1] = segs[0];
-            best[0] = d, segs[0] = k;
-        } else if (d < best[1]) {
-            best[1] = d, segs[1] = k;
-        }
-    }
-    if (segs[0] > segs[1]) {
-        int s = segs[0];
-        segs[0] = segs[1], segs[1] = s;
-    }
-}
-
-double ppb_mc_noise_rel(const ppb_result *mc, int surf, const int *segs, int nsegs)
-{
-    /* All bins of a layout share one projected solid angle, so w_k cancels (SPEC.md 5). */
-    double num = 0, den = 0;
-    for (int i = 0; i < nsegs; i++)
-        for (int k = 0; k < mc->layout.nbins; k++) {
-            size_t c = ppb_cell(&mc->layout, surf, segs[i], k);
-            num += mc->se[c] * mc->se[c];
-            den += mc->radiance[c] * mc->radiance[c];
-        }
-    return den > 0 ? sqrt(num / den) : INFINITY;
-}
-
 static void cells_to_result(const ppb_mc_tallies *t, const ppb_scene *sc, int once, ppb_result *r)
 {
     const ppb_layout *lo = &r->layout;

@@ -67,11 +67,4 @@ typedef struct ppb_mc_totals_stats {
 void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int once,
                            ppb_mc_totals_stats *st);
 
-/* noise_rel (SPEC.md section 5) of mc over the given segments of one surface. */
-double ppb_mc_noise_rel(const ppb_result *mc, int surf, const int *segs, int nsegs);
-
-/* The two segments of a top surface whose centres lie nearest x = 0 (the Table 2 cells R_x0
- * and T_x0); in slab mode segment 0 twice. */
-void ppb_mc_x0_segments(const ppb_scene *sc, int segs[2]);
-
 #endif

@@ -1,9 +1,11 @@
 #include "method_mc.h"
 
 #include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "metrics.h"
 #include "progress.h"
 
 /* Host and kernel must agree on the parameter block passed by value (kernels/mc_params.h). */
@@ -257,11 +259,11 @@ static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tall
     if (ppb_result_init(&r, "mc", &lo, err))
         return -1;
     ppb_mc_tallies_to_results(tmp, sc, &r, NULL);
-    int segs[2];
-    ppb_mc_x0_segments(sc, segs);
-    double nr = ppb_mc_noise_rel(&r, PPB_S1, segs, 2);
-    double nt = ppb_mc_noise_rel(&r, PPB_S2, segs, 2);
-    *noise = nr > nt ? nr : nt;
+    /* The Table 2 cells (SPEC.md 5); no signal yet counts as not reached. */
+    ppb_point pr[2], pt[2];
+    double nr = ppb_noise_points(&r, pr, ppb_cell_points(&lo, PPB_CELL_R_X0, pr, 2));
+    double nt = ppb_noise_points(&r, pt, ppb_cell_points(&lo, PPB_CELL_T_X0, pt, 2));
+    *noise = (isnan(nr) || isnan(nt)) ? INFINITY : (nr > nt ? nr : nt);
     ppb_result_free(&r);
     return 0;
 }

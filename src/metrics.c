@@ -27,6 +27,18 @@ ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_poi
     return r;
 }
 
+double ppb_noise_points(const ppb_result *r, const ppb_point *pts, int n)
+{
+    double num = 0, den = 0; /* equal w_k cancel, as in ppb_rms_points */
+    for (int p = 0; p < n; p++)
+        for (int k = 0; k < r->layout.nbins; k++) {
+            size_t c = ppb_cell(&r->layout, pts[p].surf, pts[p].seg, k);
+            num += r->se[c] * r->se[c];
+            den += r->radiance[c] * r->radiance[c];
+        }
+    return den > 0 ? sqrt(num / den) : NAN;
+}
+
 const char *ppb_cell_name(int cell)
 {
     static const char *names[PPB_NCELLS] = {"R_x0", "T_x0", "S1_all", "S2_all", "S3_all", "S4_all"};

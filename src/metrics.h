@@ -21,6 +21,10 @@ typedef struct ppb_point {
 
 ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_point *pts, int n);
 
+/* noise_rel of one result over the points: sqrt(sum w_k se^2 / sum w_k L^2); NAN where the
+ * radiance is 0 everywhere. */
+double ppb_noise_points(const ppb_result *r, const ppb_point *pts, int n);
+
 /* The summary cells of SPEC.md section 5, in output order. */
 enum {
     PPB_CELL_R_X0,

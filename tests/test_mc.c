@@ -5,6 +5,8 @@
  * cores); every statistical bound is in units of the run's own standard error. */
 #include "testutil.h"
 
+#include "metrics.h"
+
 #include <math.h>
 #include <signal.h>
 
@@ -462,12 +464,13 @@ static void test_method_entry(void **state)
         fail_msg("%s", err.msg);
     assert_true(out[0].photons < 4000000 && out[0].photons % 50000 == 0);
     assert_int_equal(out[0].partial, 0);
-    int segs[2];
-    ppb_mc_x0_segments(&f.cfg.scene, segs);
-    assert_int_equal(segs[0], 63); /* the segments either side of x = 0 of 128 */
-    assert_int_equal(segs[1], 64);
-    assert_true(ppb_mc_noise_rel(&out[0], PPB_S1, segs, 2) < 0.2);
-    assert_true(ppb_mc_noise_rel(&out[0], PPB_S2, segs, 2) < 0.2);
+    ppb_point pr[2], pt[2];
+    assert_int_equal(ppb_cell_points(&out[0].layout, PPB_CELL_R_X0, pr, 2), 2);
+    assert_int_equal(pr[0].seg, 63); /* the segments either side of x = 0 of 128 */
+    assert_int_equal(pr[1].seg, 64);
+    assert_int_equal(ppb_cell_points(&out[0].layout, PPB_CELL_T_X0, pt, 2), 2);
+    assert_true(ppb_noise_points(&out[0], pr, 2) < 0.2);
+    assert_true(ppb_noise_points(&out[0], pt, 2) < 0.2);
     ppb_result_free(&out[0]), ppb_result_free(&out[1]);
     ppb_ctx_close(&f.ctx);
 }
