@@ -1,18 +1,18 @@
 /* directions.c: the equal-area zonal partition of directions.h and its quadrature nodes. */
 #include "directions.h"
 
+#include "../kernels/ppb_conventions.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define PP_PI 3.14159265358979323846
 
 /* Gauss-Legendre nodes and weights on [-1, 1] by Newton on P_q (Golub-Welsch not needed for
  * q <= 16; the iteration converges to machine precision from the Chebyshev guesses). */
 void pp_gauss_legendre(int q, double *x, double *w)
 {
     for (int i = 0; i < q; i++) {
-        double z = cos(PP_PI * (i + 0.75) / (q + 0.5)), dp = 1.0;
+        double z = cos(PPB_PI * (i + 0.75) / (q + 0.5)), dp = 1.0;
         for (int it = 0; it < 100; it++) {
             double p0 = 1.0, p1 = z;
             for (int l = 2; l <= q; l++) {
@@ -46,8 +46,8 @@ static int ring_counts(int n, int pole, int *count)
     count[0] = pole;
     if (n == pole)
         return 1;
-    double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PP_PI / n);
-    int collars = (int)lround((0.5 * PP_PI - acos(1.0 - 1.0 / n)) / side);
+    double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PPB_PI / n);
+    int collars = (int)lround((0.5 * PPB_PI - acos(1.0 - 1.0 / n)) / side);
     int base = n % 2, first_min = pole % 2 != base ? 1 : 2;
     if (collars < 1)
         collars = 1;
@@ -55,7 +55,7 @@ static int ring_counts(int n, int pole, int *count)
         collars = 1 + (n - pole - first_min) / 2;
     int done = pole;
     for (int r = 1; r <= collars; r++) {
-        double theta = theta_cap + (0.5 * PP_PI - theta_cap) * r / collars;
+        double theta = theta_cap + (0.5 * PPB_PI - theta_cap) * r / collars;
         int cum = r == collars ? n : base + 2 * (int)lround(0.5 * (n * (1.0 - cos(theta)) - base));
         int left = collars - r; /* later collars need at least two cells each */
         if (cum > n - 2 * left)
@@ -149,7 +149,7 @@ static int make(int n, int antipodal, pp_dirs *d, ppb_err *err)
     int nrings = ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, count);
     d->n = n;
     d->nrings = nrings;
-    d->solid = 2.0 * PP_PI / n;
+    d->solid = 2.0 * PPB_PI / n;
     if (alloc_all(d, n, nrings) != 0) {
         free(count);
         pp_dirs_free(d);
@@ -158,7 +158,7 @@ static int make(int n, int antipodal, pp_dirs *d, ppb_err *err)
     d->mu_edge[0] = 1.0;
     for (int r = 0, cell = 0; r < nrings; r++) {
         d->ring_first[r] = cell;
-        double dphi = 2.0 * PP_PI / count[r];
+        double dphi = 2.0 * PPB_PI / count[r];
         for (int j = 0; j < count[r]; j++, cell++) {
             d->ring[cell] = r;
             d->phi_lo[cell] = (j - 0.5) * dphi;
@@ -212,7 +212,7 @@ int pp_dirs_cell_of(const pp_dirs *d, const double w[3])
             lo = mid + 1;
     }
     int count = d->ring_first[lo + 1] - d->ring_first[lo];
-    double phi = atan2(w[2], w[0]), dphi = 2.0 * PP_PI / count;
+    double phi = atan2(w[2], w[0]), dphi = 2.0 * PPB_PI / count;
     int j = (int)floor(phi / dphi + 0.5);
     j = ((j % count) + count) % count;
     int cell = d->ring_first[lo] + j;

@@ -1,6 +1,8 @@
 /* perf_pp.c: benchmark of the plane-parallel solver (perf_pp.h). */
 #include "perf_pp.h"
 
+#include "../kernels/ppb_conventions.h"
+
 #include <cblas.h>
 #include <math.h>
 #include <stdlib.h>
@@ -35,7 +37,7 @@ static int bench_one(FILE *out, int directions, ppb_err *err)
 {
     double phase[PERF_RUNS], eigen[PERF_RUNS], bound[PERF_RUNS], total[PERF_RUNS];
     double eval[PERF_RUNS];
-    pp_params p = {3.0, 0.95, 0.5, cos(45.0 * 3.14159265358979323846 / 180.0), directions};
+    pp_params p = {3.0, 0.95, 0.5, cos(45.0 * PPB_PI / 180.0), directions};
     for (int r = 0; r < PERF_RUNS; r++) {
         pp_solution *s;
         pp_timing t;

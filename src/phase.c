@@ -10,7 +10,6 @@
 #include <emmintrin.h>
 #endif
 
-#define PP_PI     3.14159265358979323846
 #define PHASE_TOL 1e-8 /* target relative quadrature error of one pair */
 
 double pp_hg(double g, double cos_theta)
@@ -58,7 +57,7 @@ static double pair_sum(double g, const double *na, const double *nb, int nq)
 {
     enum { CAP = PP_QMAX * PP_QMAX + 2 };
     double y0[CAP], y1[CAP], y2[CAP], yw[CAP];
-    double c1 = (1.0 - g * g) / (4.0 * PP_PI), g2 = 1.0 + g * g, tg = 2.0 * g, sum = 0.0;
+    double c1 = (1.0 - g * g) / (4.0 * PPB_PI), g2 = 1.0 + g * g, tg = 2.0 * g, sum = 0.0;
     int np = nq + (nq & 1);
     for (int b = 0; b < np; b++) {
         const double *y = nb + 4 * (b < nq ? b : 0);
@@ -339,7 +338,7 @@ static double point_rect(double g, const double w[3], double t0, double t1, doub
             rad = fmax(rad, acos(cv > 1.0 ? 1.0 : cv));
         }
     double tmin = peak_angle(g, w, c) - rad;
-    double h = fmax(0.5 * (t1 - t0), 0.5 * sin(fmin(t1, 0.5 * PP_PI)) * (p1 - p0));
+    double h = fmax(0.5 * (t1 - t0), 0.5 * sin(fmin(t1, 0.5 * PPB_PI)) * (p1 - p0));
     double want = gauss_order_wanted(g, tmin > 0 ? cos(tmin) : 1.0, h);
     if (want > PP_QMAX && depth < RECT_DEPTH)
         return point_rect(g, w, t0, tm, p0, pm, ysign, depth + 1) +
@@ -387,7 +386,7 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
         if (!nj)
             return -1;
         /* point-to-cell: one outer node of weight 1, q x q inner nodes */
-        double c1 = (1.0 - g * g) / (4.0 * PP_PI), sum = 0.0;
+        double c1 = (1.0 - g * g) / (4.0 * PPB_PI), sum = 0.0;
         for (int b = 0; b < q * q; b++) {
             double den = 1.0 + g * g - 2.0 * g * dot3(point, nj + 4 * b);
             sum += nj[4 * b + 3] / (den * sqrt(den));
