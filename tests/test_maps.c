@@ -6,14 +6,6 @@
 
 #include "maps.h"
 
-/* cmocka's assert_float_equal compares floats; these checks need doubles. */
-#define assert_close(a, b, tol)                                                                    \
-    do {                                                                                           \
-        double a_ = (a), b_ = (b);                                                                 \
-        if (!(fabs(a_ - b_) <= (tol)))                                                             \
-            fail_msg("%s = %.15g, expected %.15g (tol %g)", #a, a_, b_, (double)(tol));            \
-    } while (0)
-
 /* The map at 16 cells per mfp: every study case's jumps lie on cell edges, so the bilinear
  * lookup must reproduce the closed forms to rounding wherever it is read. */
 #define RES 16

@@ -10,13 +10,6 @@
 #include "march.h"
 #include "ppsolver.h"
 
-#define assert_close(a, b, tol)                                                                    \
-    do {                                                                                           \
-        double a_ = (a), b_ = (b);                                                                 \
-        if (!(fabs(a_ - b_) <= (tol)))                                                             \
-            fail_msg("%s = %.15g, expected %.15g (tol %g)", #a, a_, b_, (double)(tol));            \
-    } while (0)
-
 static ppb_ocl g_ocl;
 
 static int open_device(void **state)

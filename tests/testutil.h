@@ -18,6 +18,14 @@
 
 #include "scene.h"
 
+/* cmocka's assert_float_equal compares floats; these checks need doubles. */
+#define assert_close(a, b, tol)                                                                    \
+    do {                                                                                           \
+        double a_ = (a), b_ = (b);                                                                 \
+        if (!(fabs(a_ - b_) <= (tol)))                                                             \
+            fail_msg("%s = %.15g, expected %.15g (tol %g)", #a, a_, b_, (double)(tol));            \
+    } while (0)
+
 /* A fresh scratch directory for one test, named after it; returns a static buffer. */
 static inline const char *tu_scratch(const char *name)
 {
