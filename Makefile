@@ -9,11 +9,14 @@ OPT     ?= -O2 -g
 WARN    := -Wall -Wextra $(if $(WERROR),-Werror)
 SAN     ?=
 CFLAGS  += -std=c11 $(OPT) $(WARN) $(SAN) -fno-strict-aliasing
-CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc \
+# Includes name their layer (#include "physics/maps.h", "kernels/ppb_conventions.h").
+CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc -I. \
             -DPPB_KERNEL_DIR='"$(CURDIR)/kernels"'
 LDFLAGS += $(SAN)
 
-SRC   := $(filter-out src/main.c,$(wildcard src/*.c))
+# src/<layer>/<module>.c; the layers and their order are in README.md (Layout) and checked by
+# scripts/check_layers.sh.
+SRC   := $(filter-out src/drivers/main.c,$(wildcard src/*/*.c))
 OBJ   := $(SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
@@ -43,7 +46,7 @@ $(LIB): $(OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(BIN): $(BUILD)/obj/main.o $(LIB)
+$(BIN): $(BUILD)/obj/drivers/main.o $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $^ $(PKG_LIBS)
 
 $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
@@ -73,12 +76,12 @@ perf: $(BIN)
 	@./ppbench perf
 
 format:
-	clang-format -i src/*.c src/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
+	clang-format -i src/*/*.c src/*/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
 
 format-check:
-	clang-format --dry-run --Werror src/*.c src/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
+	clang-format --dry-run --Werror src/*/*.c src/*/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
 
 clean:
 	rm -rf build build-asan ppbench
 
--include $(OBJ:.o=.d) $(BUILD)/obj/main.d
+-include $(OBJ:.o=.d) $(BUILD)/obj/drivers/main.d

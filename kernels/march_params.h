@@ -1,5 +1,5 @@
 /* march_params.h: the one definition of what the ray-marching kernel (march.cl) receives, shared
- * by the host (src/maps.c, src/march_tables.c, src/march.c) and the kernel.
+ * by the host (src/physics/maps.c, src/physics/march_tables.c, src/methods/march.c) and the kernel.
  *
  * Owns: the launch parameters passed by value, the kernel argument indices, the layout of the
  * light maps (paper Sec. 3.1 and 3.3: optical depth D along the light path and average albedo)

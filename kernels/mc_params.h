@@ -1,5 +1,5 @@
 /* mc_params.h: the one definition of what the photon Monte Carlo kernel (mc.cl) receives, shared
- * by the host (src/method_mc.c) and the kernel, and the fixed-point tally conventions.
+ * by the host (src/methods/method_mc.c) and the kernel, and the fixed-point tally conventions.
  *
  * Owns: the parameter struct passed by value, the kernel argument indices, the layout of the
  * integer tally buffers and their fixed-point scale. Tallies are integers so that their sums do

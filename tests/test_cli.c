@@ -74,7 +74,7 @@ static void test_devices_and_keys(void **state)
     expect("devices", 0, "0: ");
     expect("keys", 0, "| mc | photons |");
     /* configs/README.md documents every key: it must hold the table `ppbench keys` prints
-     * (the source of both is the key table in src/config.c). */
+     * (the source of both is the key table in src/model/config.c). */
     char cmd[1400];
     const char *b = getenv("PPBENCH");
     snprintf(cmd, sizeof cmd,

@@ -2,7 +2,7 @@
  * as file:line: key: reason. Expected values are the literal text of each config. */
 #include "testutil.h"
 
-#include "config.h"
+#include "model/config.h"
 
 static const char *write_cfg(const char *name, const char *text)
 {

@@ -1,11 +1,11 @@
-/* test_directions.c: the equal-area direction cells (src/directions.h): exact solid angles and
- * mean cosines, the two mirror symmetries, closure under w -> -w, cell lookup, and the
+/* test_directions.c: the equal-area direction cells (src/physics/directions.h): exact solid angles
+ * and mean cosines, the two mirror symmetries, closure under w -> -w, cell lookup, and the
  * quadrature nodes. */
 #include "testutil.h"
 
 #include <math.h>
 
-#include "directions.h"
+#include "physics/directions.h"
 
 #define PI 3.14159265358979323846
 

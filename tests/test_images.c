@@ -8,11 +8,11 @@
 #include <math.h>
 #include <sys/stat.h>
 
-#include "experiment.h"
-#include "image_exr.h"
-#include "image_png.h"
-#include "images.h"
-#include "render_tube.h"
+#include "drivers/experiment.h"
+#include "io/image_exr.h"
+#include "io/image_png.h"
+#include "io/images.h"
+#include "io/render_tube.h"
 
 /* cmocka 1.1.5 has no double comparison; this one prints both values. */
 static void near_at(double a, double b, double tol, int line)

@@ -1,10 +1,10 @@
-/* test_maps.c: the light maps (src/maps.h) against closed forms of SPEC.md sections 1-3 for the
- * uniform tube, the three step cases and oblique light, and the exact ballistic fraction. */
+/* test_maps.c: the light maps (src/physics/maps.h) against closed forms of SPEC.md sections 1-3 for
+ * the uniform tube, the three step cases and oblique light, and the exact ballistic fraction. */
 #include "testutil.h"
 
 #include <math.h>
 
-#include "maps.h"
+#include "physics/maps.h"
 
 /* The map at 16 cells per mfp: every study case's jumps lie on cell edges, so the bilinear
  * lookup must reproduce the closed forms to rounding wherever it is read. */

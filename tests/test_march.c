@@ -1,14 +1,14 @@
-/* test_march.c: the ray marcher of `pp` and `ss` (src/march.h, kernels/march.cl) on the device:
- * `ss` against the closed-form single-scattering slab, `pp` against the plane-parallel solver's
- * own exit radiance, the R and S tables' convergence in the step length, mirror symmetry of the
- * tube at normal incidence, the totals' bookkeeping, the column slabs of a density step (each
- * vertical column reads its own slab's solution) and the table cache of sweeps. */
+/* test_march.c: the ray marcher of `pp` and `ss` (src/methods/march.h, kernels/march.cl) on the
+ * device: `ss` against the closed-form single-scattering slab, `pp` against the plane-parallel
+ * solver's own exit radiance, the R and S tables' convergence in the step length, mirror symmetry
+ * of the tube at normal incidence, the totals' bookkeeping, the column slabs of a density step
+ * (each vertical column reads its own slab's solution) and the table cache of sweeps. */
 #include "testutil.h"
 
 #include <math.h>
 
-#include "march.h"
-#include "ppsolver.h"
+#include "methods/march.h"
+#include "physics/ppsolver.h"
 
 static ppb_ocl g_ocl;
 

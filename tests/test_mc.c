@@ -5,15 +5,15 @@
  * cores); every statistical bound is in units of the run's own standard error. */
 #include "testutil.h"
 
-#include "metrics.h"
+#include "model/metrics.h"
 
 #include <math.h>
 #include <signal.h>
 
-#include "mc_tally.h"
-#include "method_mc.h"
-#include "method_ppslab.h"
-#include "progress.h"
+#include "methods/mc_tally.h"
+#include "methods/method_mc.h"
+#include "methods/method_ppslab.h"
+#include "base/progress.h"
 
 /* One run context per test, on the default device ($PPBENCH_DEVICE or 0). */
 typedef struct mc_fixture {

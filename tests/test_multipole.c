@@ -1,15 +1,15 @@
-/* test_multipole.c: the multipole diffusion model (src/multipole.c) against Jensen et al. 2001's
- * closed-form total diffuse reflectance, its own closed-form plane integrals, pair convergence,
- * the z-integrated line kernel against brute-force quadrature, and the `mp` method on the tube
- * (mirror symmetry, the paper's 'bright belt' on the sides, run time) and in slab mode. */
+/* test_multipole.c: the multipole diffusion model (src/physics/multipole.c) against Jensen et al.
+ * 2001's closed-form total diffuse reflectance, its own closed-form plane integrals, pair
+ * convergence, the z-integrated line kernel against brute-force quadrature, and the `mp` method on
+ * the tube (mirror symmetry, the paper's 'bright belt' on the sides, run time) and in slab mode. */
 #include "testutil.h"
 
 #include <math.h>
 #include <time.h>
 
-#include "config.h"
-#include "method_mp.h"
-#include "multipole.h"
+#include "model/config.h"
+#include "methods/method_mp.h"
+#include "physics/multipole.h"
 
 /* 2 pi int_0^inf r f(r) dr by 8-point-per-panel midpoint-free Gauss-Legendre on geometric
  * panels [0, 1e-3], then x1.05 per panel out to r = 2000 (profiles decay like exp(-0.1 r) at

@@ -2,7 +2,7 @@
  * the shared conventions header (expected values: the same functions evaluated on the host). */
 #include "testutil.h"
 
-#include "ocl.h"
+#include "runtime/ocl.h"
 
 static void test_error_names(void **state)
 {

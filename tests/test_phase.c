@@ -1,12 +1,12 @@
-/* test_phase.c: the HG phase matrix (src/phase.h): normalisation and mean cosine of HG, exact
- * row sums, symmetry and positivity of the cell matrix up to |g| = 0.95, the backward matrix as
- * the permuted forward one, the isotropic closed form, and the quadrature against an
- * independent fine midpoint rule and against a converged order-16 rule. */
+/* test_phase.c: the HG phase matrix (src/physics/phase.h): normalisation and mean cosine of HG,
+ * exact row sums, symmetry and positivity of the cell matrix up to |g| = 0.95, the backward matrix
+ * as the permuted forward one, the isotropic closed form, and the quadrature against an independent
+ * fine midpoint rule and against a converged order-16 rule. */
 #include "testutil.h"
 
 #include <math.h>
 
-#include "phase.h"
+#include "physics/phase.h"
 
 #define PI 3.14159265358979323846
 

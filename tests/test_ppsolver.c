@@ -1,4 +1,4 @@
-/* test_ppsolver.c: the plane-parallel slab solver (src/ppsolver.h): conservation, boundary
+/* test_ppsolver.c: the plane-parallel slab solver (src/physics/ppsolver.h): conservation, boundary
  * conditions, reciprocity, convergence in M, thin-slab single scattering, agreement with an
  * independent discrete-ordinates solver (PythonicDISORT, tests/data/gen_ppslab_ref.py), no
  * NaN over the parameter grid, the resonant beam, and rejection of invalid parameters. */
@@ -6,7 +6,7 @@
 
 #include <math.h>
 
-#include "ppsolver.h"
+#include "physics/ppsolver.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 

@@ -16,7 +16,7 @@
 
 #include <math.h>
 
-#include "scene.h"
+#include "model/scene.h"
 
 /* cmocka's assert_float_equal compares floats; these checks need doubles. */
 #define assert_close(a, b, tol)                                                                    \

@@ -1,0 +1,77 @@
+#include "base/progress.h"
+
+#include <signal.h>
+#include <stdio.h>
+#include <time.h>
+
+static volatile sig_atomic_t interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
+void ppb_progress_install_signals(void)
+{
+    struct sigaction sa = {0};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+int ppb_interrupted(void)
+{
+    return interrupted != 0;
+}
+void ppb_interrupt_reset(void)
+{
+    interrupted = 0;
+}
+
+double ppb_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void ppb_progress_begin(ppb_progress *p, const char *label, const char *unit, double total,
+                        int quiet)
+{
+    p->label = label;
+    p->unit = unit;
+    p->total = total;
+    p->t0 = p->last = ppb_now();
+    p->quiet = quiet;
+}
+
+static void print_line(const ppb_progress *p, double done, double now, const char *end)
+{
+    double dt = now - p->t0;
+    double rate = dt > 0 ? done / dt : 0;
+    double pct = p->total > 0 ? 100.0 * done / p->total : 100.0;
+    double eta = rate > 0 ? (p->total - done) / rate : 0;
+    fprintf(stderr, "\r%s: %5.1f%%  %.3g %s/s  ETA %.0f s%s", p->label, pct, rate, p->unit, eta,
+            end);
+    fflush(stderr);
+}
+
+void ppb_progress_update(ppb_progress *p, double done)
+{
+    double now = ppb_now();
+    if (p->quiet || now - p->last < 0.5)
+        return;
+    p->last = now;
+    print_line(p, done, now, "   ");
+}
+
+void ppb_progress_end(ppb_progress *p, double done)
+{
+    if (p->quiet)
+        return;
+    double now = ppb_now();
+    fprintf(stderr, "\r%s: %.3g %s in %.2f s%s\n", p->label, done, p->unit, now - p->t0,
+            ppb_interrupted() ? " (interrupted)" : "                ");
+}

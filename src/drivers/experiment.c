@@ -1,0 +1,193 @@
+#include "drivers/experiment.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "base/atomic_file.h"
+#include "io/csv.h"
+#include "io/images.h"
+#include "base/progress.h"
+
+#ifndef PPB_VERSION
+#define PPB_VERSION "unknown"
+#endif
+
+static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx, ppb_err *err)
+{
+    int nout = m->also ? 2 : 1;
+    if (ex->n + nout > PPB_MAX_RESULTS)
+        return ppb_fail(err, "too many results");
+    ppb_layout lo = ppb_scene_layout(&ex->cfg->scene);
+    ppb_result *out = &ex->res[ex->n];
+    if (ppb_result_init(&out[0], m->id, &lo, err))
+        return -1;
+    if (nout == 2 && ppb_result_init(&out[1], m->also, &lo, err)) {
+        ppb_result_free(&out[0]);
+        return -1;
+    }
+    ex->n += nout;
+    if (!ctx->quiet)
+        fprintf(stderr, "%s: %s ...\n", ex->cfg->name, m->id);
+    double t0 = ppb_now();
+    if (m->run(ctx, out, err))
+        return -1;
+    for (int i = 0; i < nout; i++) {
+        ex->seconds[ex->n - nout + i] = ppb_now() - t0;
+        ex->partial |= out[i].partial;
+    }
+    return 0;
+}
+
+int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx *ctx,
+                           ppb_err *err)
+{
+    memset(ex, 0, sizeof *ex);
+    ex->cfg = cfg;
+    ctx->cfg = cfg;
+    for (int i = 0; i < cfg->nmethods && !ppb_interrupted(); i++)
+        if (run_method(ex, ppb_method_find(cfg->methods[i]), ctx, err))
+            return -1;
+    if (ppb_interrupted())
+        ex->partial = 1;
+    if (ctx->ocl_open)
+        snprintf(ex->device, sizeof ex->device, "%s", ctx->ocl.name);
+    return 0;
+}
+
+void ppb_experiment_free(ppb_experiment *ex)
+{
+    for (int i = 0; i < ex->n; i++)
+        ppb_result_free(&ex->res[i]);
+    ex->n = 0;
+}
+
+const ppb_result *ppb_experiment_find(const ppb_experiment *ex, const char *id)
+{
+    for (int i = 0; i < ex->n; i++)
+        if (strcmp(ex->res[i].method, id) == 0)
+            return &ex->res[i];
+    return NULL;
+}
+
+const ppb_result *ppb_experiment_reference(const ppb_experiment *ex)
+{
+    for (int i = 0; i < ex->n; i++) {
+        const ppb_method *m = ppb_method_find(ex->res[i].method);
+        if (m && m->reference == 1)
+            return &ex->res[i];
+    }
+    return NULL;
+}
+
+/* The registry entry whose companion result is `id` (mc for mc1), or NULL. */
+static const ppb_method *parent_of(const char *id)
+{
+    for (int i = 0; i < ppb_method_count(); i++) {
+        const ppb_method *m = ppb_method_at(i);
+        if (m->also && strcmp(m->also, id) == 0)
+            return m;
+    }
+    return NULL;
+}
+
+/* Secondary references: exact answers other methods are also checked against -- a reference's
+ * companion (mc1) and the slab solution (ppslab, reference == 2). */
+static int is_secondary(const char *id)
+{
+    const ppb_method *m = ppb_method_find(id);
+    const ppb_method *p = parent_of(id);
+    return (m && m->reference == 2) || (p && p->reference == 1);
+}
+
+/* The result left out when measuring against ref: its companion, or its parent. */
+static const char *skip_for(const ppb_result *ref)
+{
+    const ppb_method *m = ppb_method_find(ref->method);
+    if (m && m->also)
+        return m->also;
+    const ppb_method *p = parent_of(ref->method);
+    return p ? p->id : NULL;
+}
+
+static void out_path(const ppb_experiment *ex, const char *file, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s/%s", ex->cfg->out_dir, file);
+}
+
+static int write_timings(const ppb_experiment *ex, ppb_err *err)
+{
+    char path[1200];
+    out_path(ex, "timings.csv", path, sizeof path);
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    fprintf(af.f, "method,seconds\n");
+    for (int i = 0; i < ex->n; i++)
+        fprintf(af.f, "%s,%.4f\n", ex->res[i].method, ex->seconds[i]);
+    return ppb_afile_commit(&af, err);
+}
+
+static int write_provenance(const ppb_experiment *ex, ppb_err *err)
+{
+    char path[1200], when[64];
+    out_path(ex, "provenance.txt", path, sizeof path);
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    time_t now = time(NULL);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
+    fprintf(af.f, "# ppbench provenance: what produced the files beside this one\n");
+    fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
+            when);
+    fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
+            ex->partial);
+    for (int i = 0; i < ex->n; i++)
+        if (ex->res[i].photons)
+            fprintf(af.f, "%s.photons_traced = %lld\n", ex->res[i].method, ex->res[i].photons);
+    for (int i = 0; i < ex->n; i++)
+        fprintf(af.f, "%s.seconds = %.4f\n", ex->res[i].method, ex->seconds[i]);
+    ppb_config_write_resolved(ex->cfg, af.f);
+    return ppb_afile_commit(&af, err);
+}
+
+static int write_comparisons(const ppb_experiment *ex, ppb_err *err)
+{
+    const ppb_scene *sc = &ex->cfg->scene;
+    char path[1200];
+    const ppb_result *ref = ppb_experiment_reference(ex);
+    if (ref) {
+        out_path(ex, "rms.csv", path, sizeof path);
+        if (ppb_write_rms_csv(path, sc, ex->res, ex->n, ref, skip_for(ref), err))
+            return -1;
+        out_path(ex, "summary.csv", path, sizeof path);
+        if (ppb_write_summary_csv(path, ex->res, ex->n, ref, skip_for(ref), err))
+            return -1;
+    }
+    for (int i = 0; i < ex->n; i++) {
+        if (!is_secondary(ex->res[i].method))
+            continue;
+        char file[128];
+        snprintf(file, sizeof file, "summary_%s.csv", ex->res[i].method);
+        out_path(ex, file, path, sizeof path);
+        if (ppb_write_summary_csv(path, ex->res, ex->n, &ex->res[i], skip_for(&ex->res[i]), err))
+            return -1;
+    }
+    return 0;
+}
+
+int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
+{
+    char path[1200];
+    if (ppb_mkdirs(ex->cfg->out_dir, err))
+        return -1;
+    out_path(ex, "radiance.csv", path, sizeof path);
+    if (ppb_write_radiance_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
+        return -1;
+    out_path(ex, "totals.csv", path, sizeof path);
+    if (ppb_write_totals_csv(path, ex->res, ex->n, err))
+        return -1;
+    if (write_comparisons(ex, err) || write_timings(ex, err) || write_provenance(ex, err))
+        return -1;
+    return ppb_images_write(ex, err);
+}

@@ -1,0 +1,36 @@
+/* experiment.h: one experiment: run every method of a config, then write SPEC.md section 8's
+ * outputs (CSVs, timings, provenance, images) under the output directory.
+ *
+ * Computing and writing are separate so that a sweep can take the in-memory results of each
+ * grid point. The Monte Carlo (`reference` in the method registry) is what rms.csv and
+ * summary.csv measure against; the exact answers `mc1` (the tube's single scattering) and
+ * `ppslab` (the slab) get their own summary_<id>.csv, the basis of CI's regression gate. */
+#ifndef PPB_EXPERIMENT_H
+#define PPB_EXPERIMENT_H
+
+#include "model/config.h"
+#include "methods/method.h"
+#include "model/result.h"
+
+#define PPB_MAX_RESULTS (2 * PPB_MAX_METHODS)
+
+typedef struct ppb_experiment {
+    const ppb_config *cfg;
+    int n;
+    ppb_result res[PPB_MAX_RESULTS];
+    double seconds[PPB_MAX_RESULTS]; /* wall time of the method run that produced it */
+    char device[512];                /* "" when no method used OpenCL */
+    int partial;                     /* interrupted: results are incomplete */
+} ppb_experiment;
+
+int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx *ctx,
+                           ppb_err *err);
+int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err);
+void ppb_experiment_free(ppb_experiment *ex);
+
+const ppb_result *ppb_experiment_find(const ppb_experiment *ex, const char *id);
+
+/* The result every other one is measured against (mc), or NULL. */
+const ppb_result *ppb_experiment_reference(const ppb_experiment *ex);
+
+#endif

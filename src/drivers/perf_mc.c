@@ -1,0 +1,161 @@
+#include "drivers/perf_mc.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "methods/method_mc.h"
+
+/* Photons per timed case: enough for a few seconds on a 2-core CPU (the launches then dominate
+ * the fixed costs); $PPBENCH_PERF_MC_PHOTONS overrides it for quick or long runs. */
+#define PERF_MC_PHOTONS 10000000LL
+
+/* The experiment's scene and MC settings with the given g (under `ppbench perf`, src/drivers/perf.c
+ * passes the study defaults: SPEC.md section 6's uniform tube), so no default is coded twice.
+ * The photon range is the timed one and a target noise would cut the timing short. */
+static int perf_config(const ppb_run_ctx *ctx, double g, ppb_config *cfg, ppb_err *err)
+{
+    if (ctx->cfg)
+        *cfg = *ctx->cfg;
+    else if (ppb_config_defaults(cfg, err))
+        return -1;
+    cfg->scene.g = g;
+    cfg->mc.first = 0, cfg->mc.target_noise = 0;
+    return 0;
+}
+
+/* Traces count photons; returns wall seconds and scattering events through the pointers. */
+static int perf_trace(ppb_run_ctx *ctx, const ppb_config *cfg, long long count, double *seconds,
+                      double *events, ppb_err *err)
+{
+    ppb_run_ctx sub = *ctx;
+    sub.cfg = cfg;
+    sub.quiet = 1;
+    ppb_mc_tallies t;
+    if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
+        return -1;
+    ppb_mc_trace_info info;
+    int rc = ppb_mc_trace(&sub, 0, count, &t, &info, err);
+    if (rc == 0) {
+        ppb_mc_totals_stats st;
+        ppb_mc_tallies_totals(&t, &cfg->scene, 0, &st);
+        *seconds = info.seconds;
+        *events = st.events_per_photon * (double)info.traced;
+    }
+    ppb_mc_tallies_free(&t);
+    return rc;
+}
+
+/* MCX-CL (pmcxcl, Fang et al.) on the equivalent homogeneous slab: a 100 x 100 x 3 grid of
+ * 1 mm voxels with mu_a = 0.05, mu_s = 0.95 /mm (sigma_t = 1, alpha = 0.95, tau = 3), HG g,
+ * n = 1 inside and out (no reflection), a pencil beam at normal incidence. It runs in a Python
+ * child; pmcxcl builds its kernel on PoCL only with libstdc++ preloaded, and reports its
+ * statistics only with the fluence output on, so both are set. Its own device choice is the
+ * first OpenCL device (gpuid 1), which it names. Returns photons/s, or 0 when pmcxcl is not
+ * installed or fails (then why goes into note). */
+static double mcx_photons_per_s(double g, long long photons, char *device, size_t cap, char *note,
+                                size_t note_cap)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd,
+             "LD_PRELOAD=/usr/lib/x86_64-linux-gnu/libstdc++.so.6 python3 -c '"
+             "import numpy as np, pmcxcl\n"
+             "cfg = {\"nphoton\": %lld, \"vol\": np.ones((100, 100, 3), dtype=\"uint8\"),"
+             " \"tstart\": 0, \"tend\": 1e-8, \"tstep\": 1e-8,"
+             " \"srcpos\": [50, 50, 0], \"srcdir\": [0, 0, 1],"
+             " \"prop\": [[0, 0, 1, 1], [0.05, 0.95, %.17g, 1]], \"isreflect\": 0,"
+             " \"gpuid\": 1, \"autopilot\": 1, \"issave2pt\": 1}\n"
+             "pmcxcl.run(dict(cfg, nphoton=10000))\n"
+             "r = pmcxcl.run(cfg)\n"
+             "print(\"PPB_MCX\", r[\"stat\"][\"nphoton\"], r[\"stat\"][\"runtime\"],"
+             " pmcxcl.gpuinfo()[0][\"name\"])\n"
+             "' 2>/dev/null",
+             photons, g);
+    FILE *p = popen(cmd, "r");
+    if (!p) {
+        snprintf(note, note_cap, "cannot start python3");
+        return 0;
+    }
+    char line[1024];
+    double rate = 0;
+    snprintf(note, note_cap, "pmcxcl not installed or failed");
+    while (fgets(line, sizeof line, p)) {
+        long long n;
+        double ms;
+        int at = 0;
+        if (sscanf(line, "PPB_MCX %lld %lf %n", &n, &ms, &at) == 2 && ms > 0) {
+            rate = (double)n / (ms * 1e-3);
+            snprintf(device, cap, "%s", line + at);
+            device[strcspn(device, "\n")] = 0;
+        }
+    }
+    pclose(p);
+    return rate;
+}
+
+/* pmcxcl is optional: probed with a plain import. */
+static int have_pmcxcl(void)
+{
+    return system("python3 -c 'import pmcxcl' >/dev/null 2>&1") == 0;
+}
+
+int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
+{
+    ppb_ocl *ocl;
+    if (ppb_ctx_ocl(ctx, &ocl, err)) /* opened here so the sub-contexts share it */
+        return -1;
+    long long photons = PERF_MC_PHOTONS;
+    const char *env = getenv("PPBENCH_PERF_MC_PHOTONS");
+    if (env && atoll(env) > 0)
+        photons = atoll(env);
+    fprintf(out, "device: %s\n", ocl->name);
+    fprintf(out, "%-28s %12s %14s %16s %10s\n", "case", "photons", "photons/s", "events/s",
+            "events/ph");
+    const double gs[2] = {0.0, 0.5};
+    for (int i = 0; i < 2; i++) {
+        ppb_config cfg;
+        double sec, ev;
+        if (perf_config(ctx, gs[i], &cfg, err))
+            return -1;
+        /* Warm-up: the first launch compiles the kernel for its work-group size. */
+        if (perf_trace(ctx, &cfg, 20000, &sec, &ev, err) ||
+            perf_trace(ctx, &cfg, photons, &sec, &ev, err))
+            return -1;
+        char name[64];
+        snprintf(name, sizeof name, "tube uniform g=%.1f", gs[i]);
+        fprintf(out, "%-28s %12lld %14.4g %16.4g %10.3f  %s\n", name, photons,
+                (double)photons / sec, ev / sec, ev / (double)photons,
+                ev / sec >= 20e6 ? "(>= 20 M events/s target)"
+                                 : "(below the 20 M events/s target)");
+    }
+
+    /* MCX-CL on the same device, same run, on the equivalent slab: ours in slab mode (the
+     * same medium, thickness and beam), photons/s against photons/s. */
+    if (!have_pmcxcl()) {
+        fprintf(out, "MCX-CL comparison skipped: the Python package pmcxcl is not installed\n");
+        return 0;
+    }
+    const long long mcx_photons = 1000000;
+    for (int i = 0; i < 2; i++) {
+        ppb_config cfg;
+        double sec, ev;
+        if (perf_config(ctx, gs[i], &cfg, err))
+            return -1;
+        cfg.scene.geometry = PPB_GEOM_SLAB;
+        if (perf_trace(ctx, &cfg, photons, &sec, &ev, err))
+            return -1;
+        char device[512] = "?", note[128];
+        double mcx =
+            mcx_photons_per_s(gs[i], mcx_photons, device, sizeof device, note, sizeof note);
+        double ours = (double)photons / sec;
+        if (mcx <= 0) {
+            fprintf(out, "slab tau=3 g=%.1f: ppbench %.4g photons/s; MCX-CL: %s\n", gs[i], ours,
+                    note);
+            continue;
+        }
+        fprintf(out,
+                "slab tau=3 g=%.1f: ppbench %.4g photons/s, MCX-CL (pmcxcl on %s) %.4g "
+                "photons/s: ratio %.2f\n",
+                gs[i], ours, device, mcx, ours / mcx);
+    }
+    return 0;
+}

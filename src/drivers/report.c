@@ -1,0 +1,172 @@
+#include "drivers/report.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/atomic_file.h"
+
+/* Shinya et al. 2009, Table 2: RMS error against MC in percent, per case and cell, for the
+ * proposed method (pp), MP (mp), MP+S (mp+ss) and S (ss). */
+typedef struct paper_row {
+    const char *case_name, *cell;
+    double pp, mp, mpss, ss;
+} paper_row;
+
+static const paper_row paper[] = {
+    {"uniform_g0_normal", "R_x0", 13, 13, 23, 65},
+    {"uniform_g0_normal", "T_x0", 4, 72, 24, 56},
+    {"uniform_g0_oblique", "R_x0", 10, 43, 101, 57},
+    {"uniform_g0_oblique", "T_x0", 8, 210, 302, 89},
+    {"uniform_gm05_normal", "R_x0", 20, 23, 51, 48},
+    {"uniform_gm05_normal", "T_x0", 5, 84, 189, 47},
+    {"uniform_gp05_normal", "R_x0", 24, 19, 6, 81},
+    {"uniform_gp05_normal", "T_x0", 7, 58, 26, 66},
+};
+
+static double paper_value(const char *case_name, const char *cell, const char *method)
+{
+    for (size_t i = 0; i < sizeof paper / sizeof paper[0]; i++) {
+        const paper_row *r = &paper[i];
+        if (strcmp(r->case_name, case_name) || strcmp(r->cell, cell))
+            continue;
+        if (!strcmp(method, "pp"))
+            return r->pp;
+        if (!strcmp(method, "mp"))
+            return r->mp;
+        if (!strcmp(method, "mp+ss"))
+            return r->mpss;
+        if (!strcmp(method, "ss"))
+            return r->ss;
+    }
+    return NAN;
+}
+
+typedef struct summary_row {
+    char method[32], cell[16];
+    double rms, noise, excess;
+} summary_row;
+
+/* Reads <dir>/<case>/summary.csv; returns the row count or -1. */
+static int read_summary(const char *dir, const char *name, summary_row *rows, int cap, ppb_err *err)
+{
+    char path[1200], line[512];
+    snprintf(path, sizeof path, "%s/%s/summary.csv", dir, name);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return ppb_fail(err, "%s: cannot open (did the case run with mc?)", path);
+    int n = 0;
+    if (!fgets(line, sizeof line, f)) {
+        fclose(f);
+        return ppb_fail(err, "%s: empty", path);
+    }
+    while (n < cap && fgets(line, sizeof line, f)) {
+        summary_row *r = &rows[n];
+        if (sscanf(line, "%31[^,],%15[^,],%lf,%lf,%lf", r->method, r->cell, &r->rms, &r->noise,
+                   &r->excess) == 5)
+            n++;
+    }
+    fclose(f);
+    return n;
+}
+
+static void md_cell(FILE *f, double v)
+{
+    fprintf(f, isnan(v) ? " - |" : " %.1f |", v);
+}
+
+static int write_tables(const char *dir, const char *const *cases, int ncases, ppb_err *err)
+{
+    char path[1200];
+    ppb_afile csv, md;
+    snprintf(path, sizeof path, "%s/table2.csv", dir);
+    if (ppb_afile_open(&csv, path, err))
+        return -1;
+    snprintf(path, sizeof path, "%s/table2.md", dir);
+    if (ppb_afile_open(&md, path, err)) {
+        ppb_afile_abort(&csv);
+        return -1;
+    }
+    fprintf(csv.f, "case,cell,method,rms_rel,noise_rel,rms_excess,paper_rms_rel\n");
+    fputs("| case | cell | method | RMS % | noise floor % | excess % | paper % |\n", md.f);
+    fprintf(md.f, "|---|---|---|---|---|---|---|\n");
+    static summary_row rows[512];
+    for (int c = 0; c < ncases; c++) {
+        int n = read_summary(dir, cases[c], rows, 512, err);
+        if (n < 0) {
+            ppb_afile_abort(&csv);
+            ppb_afile_abort(&md);
+            return -1;
+        }
+        for (int i = 0; i < n; i++) {
+            const summary_row *r = &rows[i];
+            if (strcmp(r->cell, "R_x0") && strcmp(r->cell, "T_x0"))
+                continue;
+            double pv = paper_value(cases[c], r->cell, r->method);
+            fprintf(csv.f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g\n", cases[c], r->cell, r->method, r->rms,
+                    r->noise, r->excess, pv / 100);
+            fprintf(md.f, "| %s | %c | %s |", cases[c], r->cell[0], r->method);
+            md_cell(md.f, 100 * r->rms);
+            md_cell(md.f, 100 * r->noise);
+            md_cell(md.f, 100 * r->excess);
+            md_cell(md.f, pv);
+            fputc('\n', md.f);
+        }
+    }
+    if (ppb_afile_commit(&csv, err)) {
+        ppb_afile_abort(&md);
+        return -1;
+    }
+    return ppb_afile_commit(&md, err);
+}
+
+static void copy_file(FILE *dst, const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char buf[4096];
+    size_t n;
+    if (!f)
+        return;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        fwrite(buf, 1, n, dst);
+    fclose(f);
+}
+
+static int write_readme(const char *dir, const char *const *cases, int ncases, ppb_err *err)
+{
+    char path[1200];
+    ppb_afile af;
+    snprintf(path, sizeof path, "%s/README.md", dir);
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    FILE *f = af.f;
+    fprintf(f, "# The accuracy study (written by `make bench`)\n\n");
+    fprintf(f, "RMS error against the Monte Carlo (SPEC.md section 5) at the two segments next "
+               "to x = 0 on S1 (R) and S2 (T), beside the paper's Table 2 and the Monte "
+               "Carlo's own noise floor. `excess` removes the noise: sqrt(rms^2 - noise^2).\n\n");
+    snprintf(path, sizeof path, "%s/table2.md", dir);
+    copy_file(f, path);
+    snprintf(path, sizeof path, "%s/notes.md", dir);
+    copy_file(f, path);
+    fprintf(f, "\n## Plots\n\n");
+    fprintf(f, "RMS versus x (paper Fig. 8) and in-plane angular distributions at x = 0 (Fig. "
+               "5):\n\n");
+    for (int c = 0; c < ncases; c++)
+        fprintf(f, "- %s: ![rms](%s/plots/rms_vs_x.png) ![angular](%s/plots/angular_x0.png)\n",
+                cases[c], cases[c], cases[c]);
+    fprintf(f, "\n## Images (paper Fig. 6-7)\n\n");
+    for (int c = 0; c < ncases; c++)
+        fprintf(f, "- %s: ![all methods](%s/images/all.png)\n", cases[c], cases[c]);
+    fprintf(f, "\nEach case's directory holds radiance.csv, rms.csv, summary.csv, totals.csv, "
+               "summary_mc1.csv, timings.csv and provenance.txt (config, seed, photons, "
+               "device, version, timings).\n");
+    return ppb_afile_commit(&af, err);
+}
+
+int ppb_report_write(const char *dir, const char *const *cases, int ncases, ppb_err *err)
+{
+    if (write_tables(dir, cases, ncases, err))
+        return -1;
+    return write_readme(dir, cases, ncases, err);
+}

@@ -1,0 +1,32 @@
+/* sweep.h: parameter grid sweeps (`ppbench sweep`, `ppbench merge`).
+ *
+ * A config whose numeric keys hold lists expands into the Cartesian product of its values.
+ * Every grid point runs every method; its row of sweep.csv (parameters, RMS at x = 0 and per
+ * surface, noise floor, totals) is written atomically to points/<hash>.csv, the hash being
+ * that of the point's resolved settings, so a re-run skips finished points and recomputes
+ * changed ones. --shard I/N takes the points with index % N == I - 1; merge concatenates
+ * shard directories' points in grid order into one sweep.csv, byte-identical to a whole run.
+ * Timings go to timings.csv beside it, never into sweep.csv. --jobs J runs J processes on
+ * this machine, each taking every J-th point of the shard. */
+#ifndef PPB_SWEEP_H
+#define PPB_SWEEP_H
+
+#include "model/config.h"
+#include "base/err.h"
+
+#define PPB_SWEEP_BAD_CONFIG 2
+#define PPB_SWEEP_MAX_POINTS 10000 /* larger grids need --yes */
+
+typedef struct ppb_sweep_opts {
+    const char *device;
+    int quiet, yes;
+    int shard_i, shard_n; /* 1-based part of n */
+    int jobs;             /* processes on this machine (each opens the device), 1 = serial */
+} ppb_sweep_opts;
+
+/* Returns 0, -1 on a run failure, PPB_SWEEP_BAD_CONFIG when the grid is refused before any
+ * work starts. */
+int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err);
+int ppb_sweep_merge(const char *const *dirs, int n, const char *out_dir, ppb_err *err);
+
+#endif

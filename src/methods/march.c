@@ -1,0 +1,283 @@
+/* march.c: host side of the ray marcher (march.h). */
+#include "methods/march.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/progress.h"
+
+_Static_assert(sizeof(ppb_march_params) == 21 * sizeof(double) + 24 * sizeof(int),
+               "ppb_march_params: doubles first, an even number of ints, no padding");
+
+static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
+{
+    static const double zero = 0.0;
+    cl_int rc;
+    /* A zero-length buffer is not allowed: unused tables get one element. */
+    cl_mem m = clCreateBuffer(ocl->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                              (data ? n : 1) * sizeof(double), (void *)(data ? data : &zero), &rc);
+    if (rc != CL_SUCCESS) {
+        ppb_fail(err, "OpenCL: clCreateBuffer(%s, %zu doubles) failed: %s", what, n,
+                 ppb_cl_errname(rc));
+        return NULL;
+    }
+    return m;
+}
+
+/* The launch parameters the kernel reads (march_params.h), all but row0, which each launch
+ * sets. */
+static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
+                                     const ppb_march_tables *tab, const ppb_march_opts *opts)
+{
+    double th = sc->theta_deg * PPB_PI / 180.0, wl[3];
+    ppb_scene_light_dir(sc, wl);
+    int tube = sc->geometry == PPB_GEOM_TUBE;
+    return (ppb_march_params){
+        .width = sc->width,
+        .height = sc->height,
+        .sigma_t = sc->sigma_t,
+        .sigma_t_right = sc->sigma_t_right,
+        .albedo = sc->albedo,
+        .albedo_right = sc->albedo_right,
+        .step_x = sc->step_x,
+        .tan_theta_l = tan(th),
+        .cos_theta_l = cos(th),
+        .light_x = wl[0],
+        .light_y = wl[1],
+        .map_xp0 = maps->xp0,
+        .map_h = maps->h,
+        .alb0 = tab->alb0,
+        .alb_h = tab->alb_h,
+        .step = opts->step,
+        .d_cap = opts->d_cap > 0.0 ? opts->d_cap : 40.0,
+        .tube = tube,
+        .step_kind = tube ? sc->step : PPB_STEP_NONE,
+        .map_nx = maps->nx,
+        .map_ny = maps->ny,
+        .nalb = tab->nalb,
+        .ncols = tab->ncols,
+        .with_modes = tab->R != NULL,
+        /* Without an S table (ss, or R asked for) the kernel marches with R. */
+        .table = (opts->table == PPB_TABLE_S && tab->S) ? PPB_TABLE_S : PPB_TABLE_R,
+        .telescope = opts->telescope,
+        .nsamp = tab->nsamp,
+        .npts = opts->npts < 1 ? 1 : opts->npts,
+        .ntheta = sc->ntheta,
+        .nphi = sc->nphi,
+    };
+}
+
+/* The arrays of the parameters: where each surface's cells start in the layout, and the tau
+ * grid of each column slab, which the kernel needs to index the tables. */
+static void march_params_arrays(ppb_march_params *P, const ppb_layout *lo,
+                                const ppb_march_tables *tab)
+{
+    for (int s = 0; s < PPB_NSURF; s++) {
+        P->nseg[s] = lo->nseg[s];
+        P->offset[s] = lo->offset[s];
+    }
+    for (int c = 0; c < tab->ncols; c++) {
+        P->tau0[c] = tab->col[c].tau0;
+        P->tau_h[c] = tab->col[c].tau_h;
+        P->ntau[c] = tab->col[c].ntau;
+    }
+}
+
+/* The device buffers: the inputs copied once, read by every launch, and the output of every
+ * cell. On failure the ones made so far stay in mr for ppb_marcher_free. */
+static int march_buffers(ppb_marcher *mr, const ppb_maps *maps, const ppb_march_tables *tab,
+                         size_t ncells, ppb_err *err)
+{
+    ppb_ocl *ocl = mr->ocl;
+    size_t tsize = (size_t)tab->nalb * tab->ndir * tab->ntau;
+    mr->map = upload(ocl, maps->cells, (size_t)maps->nx * maps->ny * PPB_MAP_STRIDE, "map", err);
+    if (!mr->map)
+        return -1;
+    mr->tab_r = upload(ocl, tab->R, tsize, "R table", err);
+    if (!mr->tab_r)
+        return -1;
+    mr->tab_s = upload(ocl, tab->S, tsize, "S table", err);
+    if (!mr->tab_s)
+        return -1;
+    mr->coef_c =
+        upload(ocl, tab->C, (size_t)tab->ncols * tab->nalb * tab->ndir, "beam coefficients", err);
+    if (!mr->coef_c)
+        return -1;
+    cl_int rc;
+    mr->out = clCreateBuffer(ocl->context, CL_MEM_WRITE_ONLY, ncells * sizeof(double), NULL, &rc);
+    return ppb_cl_check(rc, "clCreateBuffer(radiance)", err);
+}
+
+/* The buffer arguments are fixed for the marcher's life; only the parameters change per launch
+ * (ppb_marcher_run). */
+static int march_bind_buffers(ppb_marcher *mr, ppb_err *err)
+{
+    cl_mem args[] = {[PPB_MARCH_ARG_MAP] = mr->map,
+                     [PPB_MARCH_ARG_TAB_R] = mr->tab_r,
+                     [PPB_MARCH_ARG_TAB_S] = mr->tab_s,
+                     [PPB_MARCH_ARG_COEF_C] = mr->coef_c,
+                     [PPB_MARCH_ARG_OUT] = mr->out};
+    for (int i = PPB_MARCH_ARG_MAP; i < PPB_MARCH_NARGS; i++)
+        if (ppb_cl_check(clSetKernelArg(mr->kernel, i, sizeof(cl_mem), &args[i]),
+                         "clSetKernelArg(march)", err))
+            return -1;
+    return 0;
+}
+
+int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
+                     const ppb_march_tables *tab, const ppb_march_opts *opts, ppb_err *err)
+{
+    memset(mr, 0, sizeof *mr);
+    mr->ocl = ocl;
+    ppb_layout lo = ppb_scene_layout(sc);
+    mr->nbins = lo.nbins;
+    mr->rows = (int)(lo.ncells / (size_t)lo.nbins);
+    mr->params = march_params(sc, maps, tab, opts);
+    march_params_arrays(&mr->params, &lo, tab);
+    if (ppb_ocl_build(ocl, "march.cl", "", &mr->prog, err) ||
+        ppb_ocl_kernel(mr->prog, "ppb_march_kernel", &mr->kernel, err) ||
+        march_buffers(mr, maps, tab, lo.ncells, err) || march_bind_buffers(mr, err)) {
+        ppb_marcher_free(mr);
+        return -1;
+    }
+    return 0;
+}
+
+int ppb_marcher_run(ppb_marcher *mr, int row0, int nrows, ppb_err *err)
+{
+    if (nrows <= 0)
+        return 0;
+    mr->params.row0 = row0;
+    if (ppb_cl_check(
+            clSetKernelArg(mr->kernel, PPB_MARCH_ARG_PARAMS, sizeof mr->params, &mr->params),
+            "clSetKernelArg(march params)", err))
+        return -1;
+    size_t global = (size_t)nrows * (size_t)mr->nbins;
+    if (ppb_cl_check(clEnqueueNDRangeKernel(mr->ocl->queue, mr->kernel, 1, NULL, &global, NULL, 0,
+                                            NULL, NULL),
+                     "clEnqueueNDRangeKernel(march)", err))
+        return -1;
+    return ppb_cl_check(clFinish(mr->ocl->queue), "clFinish(march)", err);
+}
+
+int ppb_marcher_read(ppb_marcher *mr, double *radiance, ppb_err *err)
+{
+    size_t n = (size_t)mr->rows * (size_t)mr->nbins;
+    return ppb_cl_check(clEnqueueReadBuffer(mr->ocl->queue, mr->out, CL_TRUE, 0, n * sizeof(double),
+                                            radiance, 0, NULL, NULL),
+                        "clEnqueueReadBuffer(march radiance)", err);
+}
+
+void ppb_marcher_free(ppb_marcher *mr)
+{
+    cl_mem bufs[] = {mr->map, mr->tab_r, mr->tab_s, mr->coef_c, mr->out};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
+        if (bufs[i])
+            clReleaseMemObject(bufs[i]);
+    if (mr->kernel)
+        clReleaseKernel(mr->kernel);
+    if (mr->prog)
+        clReleaseProgram(mr->prog);
+    memset(mr, 0, sizeof *mr);
+}
+
+int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
+                  const ppb_march_tables *tab, const ppb_march_opts *opts, const char *label,
+                  int quiet, double *radiance, int *partial, ppb_err *err)
+{
+    ppb_marcher mr;
+    if (ppb_marcher_init(&mr, ocl, sc, maps, tab, opts, err))
+        return -1;
+    /* Launches of a few rows each let progress lines and Ctrl-C through; a row is 64 cells. */
+    const int chunk = 16;
+    ppb_progress pr;
+    ppb_progress_begin(&pr, label, "rows", mr.rows, quiet);
+    int done = 0, rc = 0;
+    *partial = 0;
+    while (done < mr.rows) {
+        if (ppb_interrupted()) {
+            *partial = 1;
+            break;
+        }
+        int n = mr.rows - done < chunk ? mr.rows - done : chunk;
+        if ((rc = ppb_marcher_run(&mr, done, n, err)))
+            break;
+        done += n;
+        ppb_progress_update(&pr, done);
+    }
+    ppb_progress_end(&pr, done);
+    if (!rc) {
+        /* Rows never marched read as zero. */
+        memset(radiance, 0, (size_t)mr.rows * mr.nbins * sizeof *radiance);
+        rc = ppb_marcher_read(&mr, radiance, err);
+        if (*partial)
+            memset(radiance + (size_t)done * mr.nbins, 0,
+                   (size_t)(mr.rows - done) * mr.nbins * sizeof *radiance);
+    }
+    ppb_marcher_free(&mr);
+    return rc;
+}
+
+void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
+                      ppb_totals *t)
+{
+    int tube = sc->geometry == PPB_GEOM_TUBE;
+    double psa = ppb_bin_proj_solid_angle(sc->ntheta, sc->nphi);
+    double flux[PPB_NSURF] = {0};
+    for (int s = 0; s < lo->nsurf; s++) {
+        double seglen =
+            !tube ? 1.0 : (s == PPB_S1 || s == PPB_S2 ? sc->width : sc->height) / lo->nseg[s];
+        for (int seg = 0; seg < lo->nseg[s]; seg++)
+            for (int b = 0; b < lo->nbins; b++)
+                flux[s] += radiance[ppb_cell(lo, s, seg, b)] * psa * seglen;
+    }
+    double entering = ppb_scene_lit_width(sc) * cos(sc->theta_deg * PPB_PI / 180.0);
+    memset(t, 0, sizeof *t);
+    if (entering > 0.0) {
+        t->R = flux[PPB_S1] / entering;
+        t->T = flux[PPB_S2] / entering;
+        t->sides = (flux[PPB_S3] + flux[PPB_S4]) / entering;
+    }
+    t->ballistic = ppb_ballistic_fraction(sc);
+    t->absorbed_tracked = 0;
+    ppb_totals_complete(t);
+}
+
+int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err)
+{
+    const ppb_config *cfg = ctx->cfg;
+    const ppb_scene *sc = &cfg->scene;
+    ppb_ocl *ocl;
+    if (ppb_ctx_ocl(ctx, &ocl, err))
+        return -1;
+    ppb_maps maps = {0};
+    ppb_march_tables own = {0};
+    const ppb_march_tables *tab = &own;
+    if (ppb_maps_build(sc, cfg->pp.map_res, &maps, err))
+        return -1;
+    int rc;
+    if (ctx->march_cache)
+        /* A sweep's earlier grid point may have built these very tables (byte-identical). */
+        rc = ppb_march_cache_tables(ctx->march_cache, sc, &cfg->pp, cfg->samples_dir,
+                                    PPB_MARCH_TAU_PER_MFP, with_modes, &tab, err);
+    else
+        rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
+                                              &own, err)
+                        : ppb_march_tables_ss(sc, cfg->samples_dir, &own, err);
+    if (rc) {
+        ppb_maps_free(&maps);
+        return -1;
+    }
+    ppb_march_opts opts = {
+        .table = cfg->pp.table, .step = cfg->pp.step, .telescope = 1, .npts = cfg->samples_seg};
+    rc = ppb_march_all(ocl, sc, &maps, tab, &opts, out->method, ctx->quiet, out->radiance,
+                       &out->partial, err);
+    if (!rc) {
+        memset(out->se, 0, out->layout.ncells * sizeof *out->se);
+        ppb_march_totals(sc, &out->layout, out->radiance, &out->totals);
+    }
+    ppb_march_tables_free(&own);
+    ppb_maps_free(&maps);
+    return rc;
+}

@@ -1,0 +1,70 @@
+/* mc_tally.h: the photon Monte Carlo's integer tallies and what is derived from them.
+ *
+ * Owns: the per-batch fixed-point tallies (mc: all scattered exits, mc1: once-scattered exits,
+ * per (surface, segment, bin); totals), their binary file form, their merge (plain integer
+ * addition, so shards merged in any order give the same bytes as one run with the whole
+ * budget), and the conversion to radiance with standard errors from the batch means
+ * (SPEC.md sections 4, 5 and 7). Layout and scale: kernels/mc_params.h. */
+#ifndef PPB_MC_TALLY_H
+#define PPB_MC_TALLY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "kernels/mc_params.h"
+#include "base/err.h"
+#include "model/result.h"
+#include "model/scene.h"
+
+typedef struct ppb_mc_tallies {
+    uint64_t fingerprint; /* hash of the scene and bin settings: merges refuse a mismatch */
+    uint64_t seed;
+    int batches;
+    size_t ncells;
+    uint64_t *photons; /* [batches]: photons traced in each batch */
+    uint64_t *cells;   /* [batches][PPB_MC_NTALLY][ncells], fixed point (PPB_MC_FIXED_SCALE) */
+    uint64_t *totals;  /* [batches][PPB_MC_NTOT] */
+} ppb_mc_tallies;
+
+/* Zeroed tallies for a scene, seed and batch count. */
+int ppb_mc_tallies_init(ppb_mc_tallies *t, const ppb_scene *sc, uint64_t seed, int batches,
+                        ppb_err *err);
+void ppb_mc_tallies_free(ppb_mc_tallies *t);
+
+/* Hash of everything that changes what a photon does or where it is tallied. */
+uint64_t ppb_mc_scene_fingerprint(const ppb_scene *sc);
+
+/* Total photons over all batches. */
+uint64_t ppb_mc_tallies_photons(const ppb_mc_tallies *t);
+
+/* Records photons [first, first + count) as traced: adds them to their batches (i % batches). */
+void ppb_mc_tallies_count_range(ppb_mc_tallies *t, uint64_t first, uint64_t count);
+
+/* dst += src, refusing tallies of another scene, seed or batch count, and overflow. */
+int ppb_mc_tallies_add(ppb_mc_tallies *dst, const ppb_mc_tallies *src, ppb_err *err);
+
+/* Binary file: magic "PPBMCT01", then the header fields and the arrays as little-endian
+ * uint64. Written to path.tmp and renamed, so a kill never leaves half a file. */
+int ppb_mc_tallies_save(const ppb_mc_tallies *t, const char *path, ppb_err *err);
+/* Loads into an uninitialised t (allocates). */
+int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err);
+
+/* Radiance (1/sr per E_perp) and standard error per cell, and totals, of mc (all scattered
+ * exits) and mc1 (once-scattered exits). Either pointer may be NULL. Both results must have
+ * been initialised with the scene's layout. */
+void ppb_mc_tallies_to_results(const ppb_mc_tallies *t, const ppb_scene *sc, ppb_result *mc,
+                               ppb_result *mc1);
+
+/* Totals of mc (once = 0) or mc1 (once = 1) and their standard errors from the batch means.
+ * absorbed is tracked (capture plus the roulette balance); roulette is the roulette balance
+ * alone (loss - gain), zero in expectation. */
+typedef struct ppb_mc_totals_stats {
+    ppb_totals mean, se;
+    double roulette, roulette_se;
+    double capture, capture_se; /* implicit capture alone */
+    double events_per_photon;
+} ppb_mc_totals_stats;
+void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int once,
+                           ppb_mc_totals_stats *st);
+
+#endif

@@ -1,0 +1,48 @@
+/* method.h: the one interface every method implements, and the registry of method ids.
+ *
+ * A method, given the experiment (scene and settings), fills radiance per (surface, segment,
+ * bin) and its totals. A method may also produce a second result in the same run (mc writes
+ * its once-scattered part as mc1). The runner, metrics and writers never special-case one. */
+#ifndef PPB_METHOD_H
+#define PPB_METHOD_H
+
+#include "model/config.h"
+#include "runtime/ocl.h"
+#include "model/result.h"
+
+struct ppb_march_cache;
+
+/* What a method gets: the experiment, an OpenCL device opened on first use, and caches that
+ * outlive one experiment (a sweep reuses the marcher's tables across grid points). */
+typedef struct ppb_run_ctx {
+    const ppb_config *cfg;
+    const char *device_selector; /* --device, or NULL */
+    ppb_ocl ocl;
+    int ocl_open;
+    int quiet;                           /* no progress lines */
+    struct ppb_march_cache *march_cache; /* owned by the caller; NULL = build afresh */
+} ppb_run_ctx;
+
+/* The device, opened on first call and shared by every method of the run. */
+int ppb_ctx_ocl(ppb_run_ctx *ctx, ppb_ocl **ocl, ppb_err *err);
+void ppb_ctx_close(ppb_run_ctx *ctx);
+
+/* out[0] is the method's result, out[1] its companion when `also` is set; both are already
+ * initialised to zero with the scene's layout and their ids. */
+typedef int (*ppb_method_fn)(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+typedef struct ppb_method {
+    const char *id;
+    const char *also; /* id of a companion result, or NULL */
+    int slab_only;    /* ppslab */
+    int reference;    /* 1: the Monte Carlo, which every other method is measured against;
+                         2: an exact answer methods are also checked against (ppslab) */
+    const char *summary;
+    ppb_method_fn run;
+} ppb_method;
+
+const ppb_method *ppb_method_find(const char *id);
+int ppb_method_count(void);
+const ppb_method *ppb_method_at(int i);
+
+#endif

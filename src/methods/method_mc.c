@@ -1,0 +1,425 @@
+#include "methods/method_mc.h"
+
+#include <stdio.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/metrics.h"
+#include "base/progress.h"
+
+/* Host and kernel must agree on the parameter block passed by value (kernels/mc_params.h). */
+_Static_assert(sizeof(ppb_mc_params) == 136, "ppb_mc_params layout changed: check mc.cl");
+
+/* Everything one trace holds on the device, released by one NULL-safe cleanup. */
+typedef struct mc_device {
+    cl_program prog;
+    cl_kernel kernel;
+    cl_mem cells, totals;
+} mc_device;
+
+static void mc_device_release(mc_device *d)
+{
+    if (d->cells)
+        clReleaseMemObject(d->cells);
+    if (d->totals)
+        clReleaseMemObject(d->totals);
+    if (d->kernel)
+        clReleaseKernel(d->kernel);
+    if (d->prog)
+        clReleaseProgram(d->prog);
+    memset(d, 0, sizeof *d);
+}
+
+static int device_has(cl_device_id dev, const char *ext, ppb_err *err, int *has)
+{
+    size_t n = 0;
+    if (ppb_cl_check(clGetDeviceInfo(dev, CL_DEVICE_EXTENSIONS, 0, NULL, &n),
+                     "clGetDeviceInfo(CL_DEVICE_EXTENSIONS)", err))
+        return -1;
+    char *s = malloc(n + 1);
+    if (!s)
+        return ppb_fail(err, "mc: out of memory");
+    cl_int rc = clGetDeviceInfo(dev, CL_DEVICE_EXTENSIONS, n, s, NULL);
+    s[n] = 0;
+    *has = rc == CL_SUCCESS && strstr(s, ext) != NULL;
+    free(s);
+    return ppb_cl_check(rc, "clGetDeviceInfo(CL_DEVICE_EXTENSIONS)", err);
+}
+
+static ppb_mc_params make_params(const ppb_config *cfg)
+{
+    const ppb_scene *sc = &cfg->scene;
+    ppb_layout lo = ppb_scene_layout(sc);
+    double wl[3];
+    ppb_scene_light_dir(sc, wl);
+    ppb_mc_params p = {
+        .seed = (ppb_u64)cfg->mc.seed,
+        .ncells = (ppb_u64)lo.ncells,
+        .batches = cfg->mc.batches,
+        .tube = sc->geometry == PPB_GEOM_TUBE,
+        .step = sc->step,
+        .ntheta = sc->ntheta,
+        .nphi = sc->nphi,
+        .width = (float)sc->width,
+        .height = (float)sc->height,
+        .sigma_t = (float)sc->sigma_t,
+        .sigma_t_right = (float)sc->sigma_t_right,
+        .albedo = (float)sc->albedo,
+        .albedo_right = (float)sc->albedo_right,
+        .step_x = (float)sc->step_x,
+        .g = (float)sc->g,
+        .light_x = (float)wl[0],
+        .light_y = (float)wl[1],
+        .enter_x0 = (float)(-0.5 * sc->width),
+        .enter_width = (float)ppb_scene_lit_width(sc),
+    };
+    for (int s = 0; s < PPB_NSURF; s++) {
+        p.nseg[s] = lo.nseg[s];
+        p.offset[s] = lo.offset[s];
+    }
+    return p;
+}
+
+static int check_settings(const ppb_config *cfg, long long first, long long count,
+                          const ppb_mc_tallies *t, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    if (first < 0 || count < 0)
+        return ppb_fail(err, "mc: photon range [%lld, +%lld) is negative", first, count);
+    if (cfg->mc.batches != t->batches || (uint64_t)cfg->mc.seed != t->seed ||
+        ppb_mc_scene_fingerprint(sc) != t->fingerprint)
+        return ppb_fail(err, "mc: tallies were made for another scene, seed or batch count");
+    if (sc->geometry == PPB_GEOM_SLAB && sc->step != PPB_STEP_NONE)
+        return ppb_fail(err, "mc: steps are not defined in slab mode (SPEC.md section 2)");
+    if (sc->theta_deg < 0 || sc->theta_deg >= 90)
+        return ppb_fail(err, "mc: theta_deg must lie in [0, 90) (got %g)", sc->theta_deg);
+    if (sc->sigma_t <= 0 || (sc->step == PPB_STEP_DENSITY && sc->sigma_t_right <= 0))
+        return ppb_fail(err, "mc: sigma_t must be positive");
+    /* Fixed-point headroom (kernels/mc_params.h): fewer than 2^31 photons per batch. */
+    uint64_t per_batch = (uint64_t)count / (uint64_t)t->batches + 1;
+    for (int b = 0; b < t->batches; b++)
+        if (t->photons[b] + per_batch >= ((uint64_t)1 << 31))
+            return ppb_fail(err, "mc: more than 2^31 photons per batch would overflow the "
+                                 "fixed-point tallies; raise [mc] batches");
+    return 0;
+}
+
+/* Sizes of a tallies' arrays (shapes in src/methods/mc_tally.h), the same on the device and the
+ * host. */
+static size_t cell_bytes(const ppb_mc_tallies *t)
+{
+    return (size_t)t->batches * PPB_MC_NTALLY * t->ncells * sizeof(uint64_t);
+}
+
+static size_t total_bytes(const ppb_mc_tallies *t)
+{
+    return (size_t)t->batches * PPB_MC_NTOT * sizeof(uint64_t);
+}
+
+/* How the kernel is laid out on a device: photons side by side per work-item (SIMD lanes on a
+ * CPU, where nothing vectorises across work-items; 2 on a GPU, whose SIMD is the work-items)
+ * and work-items per launch (enough to fill a GPU's compute units, 2048 resident threads each,
+ * or to balance a CPU's cores). None of it changes a photon's path. */
+typedef struct mc_shape {
+    int lanes;
+    long long items;
+} mc_shape;
+
+static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
+{
+    cl_device_type type = 0;
+    if (ppb_cl_check(clGetDeviceInfo(ocl->device, CL_DEVICE_TYPE, sizeof type, &type, NULL),
+                     "clGetDeviceInfo(CL_DEVICE_TYPE)", err))
+        return -1;
+    long long units = ocl->compute_units ? (long long)ocl->compute_units : 1;
+    int cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
+    shape->lanes = cpu ? 8 : 2;
+    shape->items = units * (cpu ? 1024 : 2048);
+    return 0;
+}
+
+/* Photons per launch: 64 per lane keeps the lanes busy to the end and the launch overhead
+ * below a percent. Fixed by the device, never by timing, so a target-noise run stops at the
+ * same photon count every time on the same device. */
+static long long auto_chunk(const mc_shape *shape)
+{
+    return shape->items * shape->lanes * 64;
+}
+
+/* One trace in progress: what every chunk needs, gathered so the helpers below share it. */
+typedef struct mc_run {
+    const ppb_config *cfg;
+    ppb_ocl *ocl;
+    const mc_shape *shape;
+    mc_device *d;
+    size_t local;       /* work-group size */
+    long long chunk;    /* photons per launch */
+    long long first;    /* first photon of the range */
+    ppb_mc_params p;    /* first and count change per launch */
+    ppb_mc_tallies *t;  /* the caller's tallies: the device's are added to them at the end */
+    ppb_mc_tallies tmp; /* host copy of the device's tallies, shaped like t */
+} mc_run;
+
+/* The kernel adds into the device tallies launch after launch, so they start at zero and stay
+ * bound to the kernel for the whole trace. */
+static int create_buffers(mc_run *r, ppb_err *err)
+{
+    size_t cb = cell_bytes(r->t), tb = total_bytes(r->t);
+    mc_device *d = r->d;
+    cl_int rc;
+    d->cells = clCreateBuffer(r->ocl->context, CL_MEM_READ_WRITE, cb, NULL, &rc);
+    if (ppb_cl_check(rc, "clCreateBuffer(mc cells)", err))
+        return -1;
+    d->totals = clCreateBuffer(r->ocl->context, CL_MEM_READ_WRITE, tb, NULL, &rc);
+    if (ppb_cl_check(rc, "clCreateBuffer(mc totals)", err))
+        return -1;
+    const cl_ulong zero = 0;
+    cl_command_queue q = r->ocl->queue;
+    if (ppb_cl_check(clEnqueueFillBuffer(q, d->cells, &zero, sizeof zero, 0, cb, 0, NULL, NULL),
+                     "clEnqueueFillBuffer(mc cells)", err) ||
+        ppb_cl_check(clEnqueueFillBuffer(q, d->totals, &zero, sizeof zero, 0, tb, 0, NULL, NULL),
+                     "clEnqueueFillBuffer(mc totals)", err))
+        return -1;
+    if (ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_CELLS, sizeof d->cells, &d->cells),
+                     "clSetKernelArg(mc cells)", err) ||
+        ppb_cl_check(clSetKernelArg(d->kernel, PPB_MC_ARG_TOTALS, sizeof d->totals, &d->totals),
+                     "clSetKernelArg(mc totals)", err))
+        return -1;
+    return 0;
+}
+
+/* Work-group size 0 means ppbench picks: 64 work-items keep a group inside one batch and give
+ * PoCL's CPU driver enough groups to balance its cores (its own choice is slower), and suit
+ * GPUs too. A size the user asked for is never shrunk silently. */
+static int pick_workgroup(const ppb_config *cfg, const ppb_ocl *ocl, size_t *local, ppb_err *err)
+{
+    *local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 64;
+    if (!cfg->mc.workgroup && *local > ocl->max_workgroup)
+        *local = ocl->max_workgroup;
+    if (*local > ocl->max_workgroup)
+        return ppb_fail(err, "mc: workgroup %zu exceeds the device's maximum %zu", *local,
+                        ocl->max_workgroup);
+    return 0;
+}
+
+/* The host copy is allocated once per trace, not per noise check. Cells and totals need no
+ * zeroing: every read overwrites them whole. */
+static int alloc_host_copy(const ppb_mc_tallies *t, ppb_mc_tallies *tmp, ppb_err *err)
+{
+    *tmp = (ppb_mc_tallies){
+        .fingerprint = t->fingerprint, .seed = t->seed, .batches = t->batches, .ncells = t->ncells};
+    tmp->photons = calloc((size_t)t->batches, sizeof *tmp->photons);
+    tmp->cells = malloc(cell_bytes(t));
+    tmp->totals = malloc(total_bytes(t));
+    if (!tmp->photons || !tmp->cells || !tmp->totals)
+        return ppb_fail(err, "mc: out of memory for tallies");
+    return 0;
+}
+
+/* Everything fixed for the whole trace, settled before the clock starts. */
+static int prepare_run(mc_run *r, ppb_err *err)
+{
+    if (create_buffers(r, err) || pick_workgroup(r->cfg, r->ocl, &r->local, err))
+        return -1;
+    r->chunk = r->cfg->mc.chunk > 0 ? r->cfg->mc.chunk : auto_chunk(r->shape);
+    if (alloc_host_copy(r->t, &r->tmp, err))
+        return -1;
+    r->p = make_params(r->cfg);
+    return 0;
+}
+
+/* Reads the device tallies of photons [first, first + done) into r->tmp. The device counts no
+ * photons, so the per-batch counts are rebuilt from the range (batch = index % batches). */
+static int read_tallies(mc_run *r, long long done, ppb_err *err)
+{
+    ppb_mc_tallies *tmp = &r->tmp;
+    memset(tmp->photons, 0, (size_t)tmp->batches * sizeof *tmp->photons);
+    ppb_mc_tallies_count_range(tmp, (uint64_t)r->first, (uint64_t)done);
+    cl_command_queue q = r->ocl->queue;
+    if (ppb_cl_check(clEnqueueReadBuffer(q, r->d->cells, CL_TRUE, 0, cell_bytes(tmp), tmp->cells, 0,
+                                         NULL, NULL),
+                     "clEnqueueReadBuffer(mc cells)", err) ||
+        ppb_cl_check(clEnqueueReadBuffer(q, r->d->totals, CL_TRUE, 0, total_bytes(tmp), tmp->totals,
+                                         0, NULL, NULL),
+                     "clEnqueueReadBuffer(mc totals)", err))
+        return -1;
+    return 0;
+}
+
+/* noise_rel at the x = 0 cells of S1 and S2 (SPEC.md 5, Table 2 cells), the larger of the two,
+ * for the tallies so far (t plus the device's, already read into tmp). */
+static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tallies *tmp,
+                     double *noise, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    if (ppb_mc_tallies_add(tmp, t, err))
+        return -1;
+    ppb_layout lo = ppb_scene_layout(sc);
+    ppb_result r;
+    if (ppb_result_init(&r, "mc", &lo, err))
+        return -1;
+    ppb_mc_tallies_to_results(tmp, sc, &r, NULL);
+    /* The Table 2 cells (SPEC.md 5); no signal yet counts as not reached. */
+    ppb_point pr[2], pt[2];
+    double nr = ppb_noise_points(&r, pr, ppb_cell_points(&lo, PPB_CELL_R_X0, pr, 2));
+    double nt = ppb_noise_points(&r, pt, ppb_cell_points(&lo, PPB_CELL_T_X0, pt, 2));
+    *noise = (isnan(nr) || isnan(nt)) ? INFINITY : (nr > nt ? nr : nt);
+    ppb_result_free(&r);
+    return 0;
+}
+
+/* Whether the first done photons already meet cfg->mc.target_noise. */
+static int noise_reached(mc_run *r, long long done, int *reached, ppb_err *err)
+{
+    double noise;
+    if (read_tallies(r, done, err) || noise_now(r->cfg, r->t, &r->tmp, &noise, err))
+        return -1;
+    *reached = noise < r->cfg->mc.target_noise;
+    return 0;
+}
+
+/* Global size: batches x P work-items, P a multiple of the work-group size, so each work-group
+ * stays inside one batch (see the kernel); about 64 photons per lane, as in auto_chunk. */
+static size_t global_size(const mc_run *r, long long n)
+{
+    size_t nb = (size_t)r->t->batches;
+    long long want = n / (r->shape->lanes * 64) + 1;
+    size_t items = (size_t)(want < r->shape->items ? want : r->shape->items);
+    size_t per_batch = (items + nb - 1) / nb;
+    per_batch = (per_batch + r->local - 1) / r->local * r->local;
+    return per_batch * nb;
+}
+
+/* Traces photons [first, first + n) and waits for them, so that progress, SIGINT and the noise
+ * check between launches always see whole chunks. */
+static int launch_chunk(mc_run *r, long long first, long long n, ppb_err *err)
+{
+    r->p.first = (ppb_u64)first;
+    r->p.count = (ppb_u64)n;
+    size_t global = global_size(r, n);
+    cl_kernel k = r->d->kernel;
+    cl_command_queue q = r->ocl->queue;
+    if (ppb_cl_check(clSetKernelArg(k, PPB_MC_ARG_PARAMS, sizeof r->p, &r->p),
+                     "clSetKernelArg(mc params)", err) ||
+        ppb_cl_check(clEnqueueNDRangeKernel(q, k, 1, NULL, &global, &r->local, 0, NULL, NULL),
+                     "clEnqueueNDRangeKernel(ppb_mc_trace_kernel)", err) ||
+        ppb_cl_check(clFinish(q), "clFinish(mc)", err))
+        return -1;
+    return 0;
+}
+
+/* Launches chunk after chunk until count photons are traced, SIGINT/SIGTERM arrives or the
+ * target noise is met. Stops fall only between chunks, so *done always counts a whole prefix
+ * of the range. The last chunk skips the noise check: nothing would be left to save. */
+static int trace_chunks(mc_run *r, long long count, ppb_progress *pr, long long *done,
+                        ppb_mc_trace_info *info, ppb_err *err)
+{
+    while (*done < count) {
+        if (ppb_interrupted()) {
+            info->interrupted = 1;
+            return 0;
+        }
+        long long n = count - *done < r->chunk ? count - *done : r->chunk;
+        if (launch_chunk(r, r->first + *done, n, err))
+            return -1;
+        *done += n;
+        ppb_progress_update(pr, (double)*done);
+        int reached = 0;
+        if (r->cfg->mc.target_noise > 0 && *done < count && noise_reached(r, *done, &reached, err))
+            return -1;
+        if (reached) {
+            info->reached_noise = 1;
+            return 0;
+        }
+    }
+    return 0;
+}
+
+/* The trace proper, timed for info->seconds and shown as progress; the setup and the final
+ * read stay outside the clock, so perf measures the launches alone. */
+static int trace_timed(mc_run *r, int quiet, long long count, long long *done,
+                       ppb_mc_trace_info *info, ppb_err *err)
+{
+    ppb_progress pr;
+    ppb_progress_begin(&pr, "mc", "photons", (double)count, quiet);
+    double t0 = ppb_now();
+    int status = trace_chunks(r, count, &pr, done, info, err);
+    info->seconds = ppb_now() - t0;
+    ppb_progress_end(&pr, (double)*done);
+    return status;
+}
+
+/* The device's tallies reach t in one addition at the end, so a trace that fails on the way
+ * leaves t as it was. */
+static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape, mc_device *d,
+                           long long first, long long count, ppb_mc_tallies *t,
+                           ppb_mc_trace_info *info, ppb_err *err)
+{
+    mc_run r = {.cfg = ctx->cfg, .ocl = ocl, .shape = shape, .d = d, .first = first, .t = t};
+    long long done = 0;
+    int status = prepare_run(&r, err);
+    if (status == 0)
+        status = trace_timed(&r, ctx->quiet, count, &done, info, err);
+    if (status == 0) {
+        info->traced = done;
+        status = read_tallies(&r, done, err);
+        if (status == 0)
+            status = ppb_mc_tallies_add(t, &r.tmp, err);
+    }
+    ppb_mc_tallies_free(&r.tmp);
+    return status;
+}
+
+int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
+                 ppb_mc_trace_info *info, ppb_err *err)
+{
+    ppb_mc_trace_info local_info;
+    if (!info)
+        info = &local_info;
+    memset(info, 0, sizeof *info);
+    if (check_settings(ctx->cfg, first, count, t, err))
+        return -1;
+    ppb_ocl *ocl;
+    if (ppb_ctx_ocl(ctx, &ocl, err))
+        return -1;
+    int has64 = 0, hasfp64 = 0;
+    if (device_has(ocl->device, "cl_khr_int64_base_atomics", err, &has64) ||
+        device_has(ocl->device, "cl_khr_fp64", err, &hasfp64))
+        return -1;
+    if (!has64 || !hasfp64)
+        return ppb_fail(err, "mc: device %s lacks %s, needed for the bit-reproducible tallies",
+                        ocl->name, !has64 ? "cl_khr_int64_base_atomics" : "cl_khr_fp64");
+    mc_shape shape;
+    if (device_shape(ocl, &shape, err))
+        return -1;
+    char opts[64];
+    snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d", shape.lanes);
+    mc_device d = {0};
+    int status = ppb_ocl_build(ocl, "mc.cl", opts, &d.prog, err);
+    if (status == 0)
+        status = ppb_ocl_kernel(d.prog, "ppb_mc_trace_kernel", &d.kernel, err);
+    if (status == 0)
+        status = trace_on_device(ctx, ocl, &shape, &d, first, count, t, info, err);
+    mc_device_release(&d);
+    return status;
+}
+
+int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
+{
+    const ppb_config *cfg = ctx->cfg;
+    ppb_mc_tallies t;
+    if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
+        return -1;
+    ppb_mc_trace_info info;
+    int status = ppb_mc_trace(ctx, cfg->mc.first, cfg->mc.photons, &t, &info, err);
+    if (status == 0) {
+        ppb_mc_tallies_to_results(&t, &cfg->scene, &out[0], &out[1]);
+        for (int i = 0; i < 2; i++) {
+            out[i].partial = info.interrupted;
+            out[i].photons = info.traced;
+        }
+    }
+    ppb_mc_tallies_free(&t);
+    return status;
+}

@@ -1,0 +1,35 @@
+/* method_mc.h: the photon Monte Carlo reference (SPEC.md section 7, `mc` and `mc1`): runs
+ * kernels/mc.cl over a photon range in chunks, with progress, SIGINT and a target noise.
+ *
+ * ppb_method_mc is the registry entry; ppb_mc_trace is the building block that sweeps use to
+ * trace one shard of a point's photons into integer tallies (src/methods/mc_tally.h), which merge
+ * bit-identically. */
+#ifndef PPB_METHOD_MC_H
+#define PPB_METHOD_MC_H
+
+#include "methods/mc_tally.h"
+#include "methods/method.h"
+
+/* The method: traces cfg->mc.photons photons starting at cfg->mc.first and fills out[0] (mc)
+ * and out[1] (mc1). Interrupted runs are marked partial with the photons actually traced. */
+int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+/* How a trace ended. */
+typedef struct ppb_mc_trace_info {
+    long long traced;  /* photons traced: always a prefix [first, first + traced) */
+    int interrupted;   /* SIGINT or SIGTERM stopped it after a chunk */
+    int reached_noise; /* stopped early at cfg->mc.target_noise */
+    double seconds;    /* wall time of the launches */
+} ppb_mc_trace_info;
+
+/* Traces photons [first, first + count) of ctx->cfg's scene with ctx->cfg->mc's seed, batches,
+ * work-group size (0: 64) and chunk (0: sized to the device, 2^19 photons per compute unit on a
+ * CPU), adding them to t (from ppb_mc_tallies_init with the same scene, seed and batches).
+ * Stops after the current chunk on SIGINT/SIGTERM (ppb_interrupted) or once noise_rel at the
+ * x = 0 cells of S1 and S2 is below cfg->mc.target_noise (checked after every chunk); what was
+ * traced is always the prefix [first, first + info->traced), so the result is bit-identical to
+ * a run of that many photons. info may be NULL. */
+int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
+                 ppb_mc_trace_info *info, ppb_err *err);
+
+#endif

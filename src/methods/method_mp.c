@@ -1,0 +1,191 @@
+/* method_mp.c: the `mp` and `mp+ss` methods (SPEC.md section 7), the paper's multipole baseline.
+ *
+ * Slab mode: the multipole's plane-integrated R and T (Donner & Jensen 2005) as a Lambertian
+ * exit radiance cos(theta_L) R / pi on S1 and cos(theta_L) T / pi on S2.
+ * Tube: the multipole of a slab of the tube's thickness H is placed below every lit point of S1
+ * (below the entry point, at every incidence angle: Jensen et al. 2001's placement, not a
+ * refracted-direction one), with the medium coefficients of the entry point; each sample point
+ * of S1..S4 takes the diffusive flux through its own surface from the 3-D source-to-point
+ * vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged over the
+ * segment (its 1/rho^2 part exactly, the smooth rest on samples_seg points); radiance = flux / pi
+ * in every direction bin. */
+#include "methods/method_mp.h"
+
+#include <math.h>
+
+#include "methods/method_ss.h"
+#include "physics/multipole.h"
+
+/* A stretch of the lit strip of S1 with one set of medium coefficients. */
+typedef struct mp_piece {
+    double xa, xb;
+    ppb_multipole mp;
+} mp_piece;
+
+/* The lit strip, cut at the step when the medium changes there: at most two pieces. */
+static int mp_pieces(const ppb_config *cfg, mp_piece piece[2], int *npiece, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    double xa = -0.5 * sc->width, xb = 0.5 * sc->width;
+    if (sc->step == PPB_STEP_SHADOW)
+        xb = fmin(xb, sc->step_x);
+    double cut[3] = {xa, xb, xb};
+    int n = 1;
+    if ((sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO) && sc->step_x > xa &&
+        sc->step_x < xb) {
+        cut[1] = sc->step_x;
+        n = 2;
+    }
+    *npiece = 0;
+    for (int i = 0; i < n; i++) {
+        if (!(cut[i + 1] > cut[i]))
+            continue;
+        double x = 0.5 * (cut[i] + cut[i + 1]); /* the piece's coefficients: at its entry points */
+        mp_piece *p = &piece[(*npiece)++];
+        p->xa = cut[i];
+        p->xb = cut[i + 1];
+        double st = ppb_sigma_t_at(x, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
+        double al = ppb_albedo_at(x, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+        if (ppb_multipole_init(&p->mp, st, al, sc->g, sc->height, cfg->mp.pairs, err))
+            return -1;
+    }
+    return 0;
+}
+
+/* Segment-averaged flux per unit irradiance on S1 (multipole.h: the singular part averaged in
+ * closed form, the smooth rest on samples_seg points). */
+static double mp_segment_flux(const ppb_config *cfg, const mp_piece *piece, int npiece, int surf,
+                              int seg, double seg_len)
+{
+    double x, y;
+    ppb_scene_sample_point(&cfg->scene, surf, seg, &x, &y);
+    int along_x = surf == PPB_S1 || surf == PPB_S2;
+    double dx = along_x ? 0.5 * seg_len : 0, dy = along_x ? 0 : 0.5 * seg_len, sum = 0;
+    for (int i = 0; i < npiece; i++)
+        sum += ppb_multipole_segment_flux(&piece[i].mp, x - dx, y - dy, x + dx, y + dy,
+                                          ppb_normal_x(surf), ppb_normal_y(surf), piece[i].xa,
+                                          piece[i].xb, cfg->mp.samples, cfg->samples_seg);
+    return sum;
+}
+
+static void fill_bins(ppb_result *out, int surf, int seg, double radiance)
+{
+    for (int b = 0; b < out->layout.nbins; b++)
+        out->radiance[ppb_cell(&out->layout, surf, seg, b)] = radiance;
+}
+
+/* Optical depth of the unscattered beam from the entry point x0 on S1 to where it leaves the
+ * tube (S2, or a side at oblique incidence); sigma_t steps at step_x for the density step. */
+static double beam_depth(const ppb_scene *sc, double x0)
+{
+    double t = sc->theta_deg * PPB_PI / 180.0, st = sin(t), ct = cos(t);
+    double half = 0.5 * sc->width, x1 = x0 + sc->height * st / ct;
+    x1 = fmax(-half, fmin(half, x1)); /* the side it leaves through, if it gets there first */
+    double len = fabs(st) > 0 ? fabs(x1 - x0) / fabs(st) : sc->height;
+    if (sc->step != PPB_STEP_DENSITY || fabs(st) == 0)
+        return len * ppb_sigma_t_at(x0, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
+    double lo = fmin(x0, x1), hi = fmax(x0, x1);
+    double left = (fmax(lo, fmin(hi, sc->step_x)) - lo) / fabs(st); /* path length at x < step */
+    return left * sc->sigma_t + (len - left) * sc->sigma_t_right;
+}
+
+/* Ballistic (unscattered) fraction of the power entering the lit S1: exact geometry, integrated
+ * over the entry points by Gauss-Legendre on pieces where the path depth is linear in x0. */
+static double tube_ballistic(const ppb_scene *sc, double xa, double xb)
+{
+    double t = sc->theta_deg * PPB_PI / 180.0, shift = sc->height * tan(t);
+    double cuts[4] = {xa, sc->step_x, (shift > 0 ? 0.5 : -0.5) * sc->width - shift, xb};
+    for (int i = 1; i < 4; i++) /* sort the four cuts (insertion) */
+        for (int j = i; j > 0 && cuts[j] < cuts[j - 1]; j--) {
+            double tmp = cuts[j];
+            cuts[j] = cuts[j - 1];
+            cuts[j - 1] = tmp;
+        }
+    static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+    static const double weight[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+    double sum = 0;
+    for (int i = 0; i < 3; i++) {
+        double a = fmax(xa, cuts[i]), b = fmin(xb, cuts[i + 1]);
+        int panels = (int)ceil((b - a) * 8.0);
+        for (int p = 0; p < panels; p++) {
+            double h = (b - a) / panels, mid = a + (p + 0.5) * h;
+            for (int j = 0; j < 3; j++)
+                sum += 0.5 * h * weight[j] * exp(-beam_depth(sc, mid + 0.5 * h * node[j]));
+        }
+    }
+    return xb > xa ? sum / (xb - xa) : 0.0;
+}
+
+static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    mp_piece piece[2];
+    int npiece;
+    if (mp_pieces(cfg, piece, &npiece, err))
+        return -1;
+    double cos_l = cos(sc->theta_deg * PPB_PI / 180.0);
+    double power = ppb_scene_lit_width(sc) * cos_l; /* entering the lit S1 per unit z */
+    double surface_power[PPB_NSURF] = {0};
+    for (int surf = 0; surf < PPB_NSURF; surf++) {
+        int nseg = out->layout.nseg[surf];
+        double len = (surf <= PPB_S2 ? sc->width : sc->height) / nseg;
+        for (int seg = 0; seg < nseg; seg++) {
+            double flux = cos_l * mp_segment_flux(cfg, piece, npiece, surf, seg, len);
+            fill_bins(out, surf, seg, flux / PPB_PI);
+            surface_power[surf] += flux * len;
+        }
+    }
+    double scale = power > 0 ? 1.0 / power : 0.0;
+    out->totals.R = surface_power[PPB_S1] * scale;
+    out->totals.T = surface_power[PPB_S2] * scale;
+    out->totals.sides = (surface_power[PPB_S3] + surface_power[PPB_S4]) * scale;
+    out->totals.ballistic = npiece ? tube_ballistic(sc, piece[0].xa, piece[npiece - 1].xb) : 0;
+    return 0;
+}
+
+static int mp_slab(const ppb_config *cfg, ppb_result *out, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    ppb_multipole mp;
+    if (ppb_multipole_init(&mp, sc->sigma_t, sc->albedo, sc->g, sc->height, cfg->mp.pairs, err))
+        return -1;
+    double cos_l = cos(sc->theta_deg * PPB_PI / 180.0);
+    out->totals.R = ppb_multipole_total_R(&mp);
+    out->totals.T = ppb_multipole_total_T(&mp);
+    out->totals.sides = 0;
+    out->totals.ballistic = exp(-sc->sigma_t * sc->height / cos_l);
+    fill_bins(out, PPB_S1, 0, cos_l * out->totals.R / PPB_PI);
+    fill_bins(out, PPB_S2, 0, cos_l * out->totals.T / PPB_PI);
+    return 0;
+}
+
+int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
+{
+    const ppb_config *cfg = ctx->cfg;
+    if (cfg->mp.samples < 1)
+        return ppb_fail(err, "mp: mp.samples = %d, needs >= 1", cfg->mp.samples);
+    out->totals.absorbed_tracked = 0; /* absorbed = 1 - the rest, by the writer */
+    if (cfg->scene.geometry == PPB_GEOM_SLAB)
+        return mp_slab(cfg, out, err);
+    return mp_tube(cfg, out, err);
+}
+
+int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
+{
+    if (ppb_method_mp(ctx, out, err))
+        return -1;
+    ppb_result ss;
+    if (ppb_result_init(&ss, "ss", &out->layout, err))
+        return -1;
+    if (ppb_method_ss(ctx, &ss, err)) {
+        ppb_result_free(&ss);
+        return -1;
+    }
+    for (size_t i = 0; i < out->layout.ncells; i++)
+        out->radiance[i] += ss.radiance[i];
+    out->totals.R += ss.totals.R; /* the diffusion already holds single scattering: MP+S counts */
+    out->totals.T += ss.totals.T; /* it twice, as the paper's energy remark says */
+    out->totals.sides += ss.totals.sides;
+    ppb_result_free(&ss);
+    return 0;
+}

@@ -1,0 +1,15 @@
+/* method_mp.h: the multipole diffusion baseline of the paper's comparison (SPEC.md section 7):
+ * method ids `mp` (Donner & Jensen 2005 multipole for a slab of the tube's thickness, applied
+ * to the tube from 3-D source-to-point distances) and `mp+ss` (mp plus the `ss` radiance). */
+#ifndef PPB_METHOD_MP_H
+#define PPB_METHOD_MP_H
+
+#include "methods/method.h"
+
+/* `mp`: fills out[0] (already initialised with the scene's layout). */
+int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+/* `mp+ss`: `mp` plus ppb_method_ss's radiance, cell by cell. */
+int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+#endif

@@ -1,0 +1,52 @@
+/* method_ppslab.c: the plane-parallel solution evaluated at the slab's faces (SPEC.md
+ * section 9; paper Sec. 2.2 through src/physics/ppsolver.h). */
+#include "methods/method_ppslab.h"
+
+#include <math.h>
+
+#include "physics/ppsolver.h"
+
+/* Bin average over samples x samples directions uniform in projected solid angle (SPEC.md
+ * section 4), through ppb_bin_direction so the bins match every other method's. */
+static double bin_average(const pp_solution *s, const ppb_scene *sc, int surf, int bin, int samples,
+                          double tau)
+{
+    int itheta = bin / sc->nphi, iphi = bin % sc->nphi;
+    double sum = 0.0;
+    for (int a = 0; a < samples; a++)
+        for (int b = 0; b < samples; b++) {
+            double w[3];
+            ppb_bin_direction(surf, itheta, iphi, (a + 0.5) / samples, (b + 0.5) / samples,
+                              sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            sum += pp_radiance(s, tau, w);
+        }
+    return sum / ((double)samples * samples);
+}
+
+int ppb_method_ppslab(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
+{
+    const ppb_config *cfg = ctx->cfg;
+    const ppb_scene *sc = &cfg->scene;
+    if (sc->geometry != PPB_GEOM_SLAB)
+        return ppb_fail(err, "ppslab: needs geometry = slab (it is the slab's own solution)");
+    double tau0 = sc->height * sc->sigma_t;
+    pp_params p = {tau0, sc->albedo, sc->g, cos(sc->theta_deg * PPB_PI / 180.0),
+                   cfg->pp.directions};
+    pp_solution *s = NULL;
+    if (pp_solve(&p, &s, err) != 0)
+        return -1;
+    int samples = cfg->samples_dir > 0 ? cfg->samples_dir : 1;
+    for (int bin = 0; bin < out->layout.nbins; bin++) {
+        out->radiance[ppb_cell(&out->layout, PPB_S1, 0, bin)] =
+            bin_average(s, sc, PPB_S1, bin, samples, 0.0);
+        out->radiance[ppb_cell(&out->layout, PPB_S2, 0, bin)] =
+            bin_average(s, sc, PPB_S2, bin, samples, tau0);
+    }
+    ppb_totals *t = &out->totals;
+    pp_totals(s, &t->R, &t->T, &t->ballistic);
+    t->sides = 0.0;
+    t->absorbed = pp_absorbed(s);
+    t->absorbed_tracked = 1;
+    pp_free(s);
+    return 0;
+}

@@ -1,0 +1,68 @@
+#include "model/metrics.h"
+
+#include <math.h>
+
+ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_point *pts, int n)
+{
+    const ppb_layout *lo = &ref->layout;
+    /* Every bin has the same projected solid angle (SPEC.md 4), so w_k is a common factor;
+     * it is kept so that unequal bins would only need this line changed. */
+    double wk = 1.0;
+    double num = 0, den = 0, noise = 0;
+    for (int p = 0; p < n; p++)
+        for (int k = 0; k < lo->nbins; k++) {
+            size_t c = ppb_cell(lo, pts[p].surf, pts[p].seg, k);
+            double d = m->radiance[c] - ref->radiance[c];
+            num += wk * d * d;
+            den += wk * ref->radiance[c] * ref->radiance[c];
+            noise += wk * (ref->se[c] * ref->se[c] + m->se[c] * m->se[c]);
+        }
+    ppb_rms r = {NAN, NAN, NAN};
+    if (den > 0) {
+        r.rms_rel = sqrt(num / den);
+        r.noise_rel = sqrt(noise / den);
+        double ex = r.rms_rel * r.rms_rel - r.noise_rel * r.noise_rel;
+        r.rms_excess = sqrt(ex > 0 ? ex : 0);
+    }
+    return r;
+}
+
+double ppb_noise_points(const ppb_result *r, const ppb_point *pts, int n)
+{
+    double num = 0, den = 0; /* equal w_k cancel, as in ppb_rms_points */
+    for (int p = 0; p < n; p++)
+        for (int k = 0; k < r->layout.nbins; k++) {
+            size_t c = ppb_cell(&r->layout, pts[p].surf, pts[p].seg, k);
+            num += r->se[c] * r->se[c];
+            den += r->radiance[c] * r->radiance[c];
+        }
+    return den > 0 ? sqrt(num / den) : NAN;
+}
+
+const char *ppb_cell_name(int cell)
+{
+    static const char *names[PPB_NCELLS] = {"R_x0", "T_x0", "S1_all", "S2_all", "S3_all", "S4_all"};
+    return (cell >= 0 && cell < PPB_NCELLS) ? names[cell] : "?";
+}
+
+int ppb_cell_points(const ppb_layout *lo, int cell, ppb_point *pts, int cap)
+{
+    if (cell == PPB_CELL_R_X0 || cell == PPB_CELL_T_X0) {
+        int surf = cell == PPB_CELL_R_X0 ? PPB_S1 : PPB_S2;
+        int n = lo->nseg[surf];
+        /* The two segments whose centres flank x = 0; the middle one when n is odd. */
+        int count = 0;
+        if (n % 2 == 0 && n >= 2 && cap >= 2) {
+            pts[count++] = (ppb_point){surf, n / 2 - 1};
+            pts[count++] = (ppb_point){surf, n / 2};
+        } else if (n >= 1 && cap >= 1) {
+            pts[count++] = (ppb_point){surf, n / 2};
+        }
+        return count;
+    }
+    int surf = cell - PPB_CELL_S1_ALL;
+    int n = lo->nseg[surf] < cap ? lo->nseg[surf] : cap;
+    for (int i = 0; i < n; i++)
+        pts[i] = (ppb_point){surf, i};
+    return n;
+}

@@ -1,0 +1,32 @@
+#include "model/result.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int ppb_result_init(ppb_result *r, const char *method, const ppb_layout *lo, ppb_err *err)
+{
+    memset(r, 0, sizeof *r);
+    snprintf(r->method, sizeof r->method, "%s", method);
+    r->layout = *lo;
+    r->radiance = calloc(lo->ncells, sizeof *r->radiance);
+    r->se = calloc(lo->ncells, sizeof *r->se);
+    if (!r->radiance || !r->se) {
+        ppb_result_free(r);
+        return ppb_fail(err, "%s: out of memory for %zu radiance cells", method, lo->ncells);
+    }
+    return 0;
+}
+
+void ppb_result_free(ppb_result *r)
+{
+    free(r->radiance);
+    free(r->se);
+    r->radiance = r->se = NULL;
+}
+
+void ppb_totals_complete(ppb_totals *t)
+{
+    if (!t->absorbed_tracked)
+        t->absorbed = 1.0 - (t->R + t->T + t->sides + t->ballistic);
+}

@@ -1,0 +1,31 @@
+/* result.h: what every method produces: radiance per (surface, segment, bin) with its standard
+ * error, and the totals of SPEC.md section 4. The runner, metrics and writers only ever see
+ * this struct, whatever method filled it. */
+#ifndef PPB_RESULT_H
+#define PPB_RESULT_H
+
+#include "base/err.h"
+#include "model/scene.h"
+
+typedef struct ppb_totals {
+    double R, T, sides, absorbed, ballistic; /* fractions of the power entering the lit S1 */
+    int absorbed_tracked; /* 0: the writer reports absorbed = 1 - the rest (SPEC.md 4) */
+} ppb_totals;
+
+typedef struct ppb_result {
+    char method[32];
+    ppb_layout layout;
+    double *radiance; /* [layout.ncells], 1/sr per E_perp, scattered light only */
+    double *se;       /* [layout.ncells], standard error; 0 for deterministic methods */
+    ppb_totals totals;
+    int partial;       /* 1: interrupted before the full budget (Monte Carlo) */
+    long long photons; /* Monte Carlo photons traced; 0 otherwise */
+} ppb_result;
+
+int ppb_result_init(ppb_result *r, const char *method, const ppb_layout *lo, ppb_err *err);
+void ppb_result_free(ppb_result *r);
+
+/* Sets absorbed = 1 - (R + T + sides + ballistic) when the method does not track it. */
+void ppb_totals_complete(ppb_totals *t);
+
+#endif

@@ -1,0 +1,56 @@
+/* scene.h: what is being simulated (SPEC.md sections 1-4): geometry, medium, light, bins, and
+ * the layout of every radiance array over (surface, segment, bin).
+ *
+ * Conventions themselves (frames, bin edges, segment centres, the medium step) live in
+ * kernels/ppb_conventions.h so host and kernels share them; this header adds the host-side
+ * struct and the layout. */
+#ifndef PPB_SCENE_H
+#define PPB_SCENE_H
+
+#include <stddef.h>
+
+#include "kernels/ppb_conventions.h"
+
+typedef enum { PPB_GEOM_TUBE = 0, PPB_GEOM_SLAB = 1 } ppb_geometry;
+
+typedef struct ppb_scene {
+    ppb_geometry geometry;
+    double width, height; /* mfp; width unused in slab mode */
+    int segments_top, segments_side;
+    double sigma_t, albedo, g;
+    int step; /* PPB_STEP_* */
+    double step_x, sigma_t_right, albedo_right;
+    double theta_deg; /* light incidence from the S1 normal */
+    int ntheta, nphi;
+} ppb_scene;
+
+/* Where each surface's segments sit in a flat radiance array. */
+typedef struct ppb_layout {
+    int nsurf;             /* 4 for the tube, 2 for the slab */
+    int nseg[PPB_NSURF];   /* 0 for surfaces that do not exist */
+    int offset[PPB_NSURF]; /* first segment row of each surface */
+    int nbins;             /* ntheta * nphi */
+    size_t ncells;         /* total rows * nbins */
+} ppb_layout;
+
+ppb_layout ppb_scene_layout(const ppb_scene *sc);
+
+/* Flat index of (surface, segment, bin); bin = theta_bin * nphi + phi_bin. */
+static inline size_t ppb_cell(const ppb_layout *lo, int surf, int seg, int bin)
+{
+    return ((size_t)lo->offset[surf] + (size_t)seg) * (size_t)lo->nbins + (size_t)bin;
+}
+
+/* Segment centre and coordinate s along the surface (s = 0 in slab mode). */
+double ppb_scene_sample_point(const ppb_scene *sc, int surf, int seg, double *x, double *y);
+
+/* The light direction w_L = (sin theta_L, -cos theta_L, 0). */
+void ppb_scene_light_dir(const ppb_scene *sc, double w[3]);
+
+/* Width of the lit part of S1 (tube) -- the shadow step lights x < step_x only; 1 in slab mode
+ * (per unit area). Used to normalise totals (SPEC.md section 4). */
+double ppb_scene_lit_width(const ppb_scene *sc);
+
+const char *ppb_surface_name(int surf);
+
+#endif

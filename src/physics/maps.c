@@ -1,0 +1,173 @@
+/* maps.c: the light maps and the exact light-path quantities behind them (maps.h). */
+#include "physics/maps.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "kernels/march_params.h"
+
+/* Fraction of a straight path whose x runs from x0 to x1 that lies right of the step
+ * (x >= step_x); a vertical path is wholly on one side. */
+static double right_fraction(double x0, double x1, double step_x)
+{
+    double lo = fmin(x0, x1), hi = fmax(x0, x1);
+    if (hi - lo <= 0.0)
+        return lo >= step_x ? 1.0 : 0.0;
+    double f = (hi - fmax(lo, step_x)) / (hi - lo);
+    return f < 0.0 ? 0.0 : (f > 1.0 ? 1.0 : f);
+}
+
+double ppb_segment_optical_depth(const ppb_scene *sc, double x0, double y0, double x1, double y1)
+{
+    double len = hypot(x1 - x0, y1 - y0);
+    if (sc->geometry == PPB_GEOM_TUBE && sc->step == PPB_STEP_DENSITY) {
+        double f = right_fraction(x0, x1, sc->step_x);
+        return len * ((1.0 - f) * sc->sigma_t + f * sc->sigma_t_right);
+    }
+    return len * sc->sigma_t;
+}
+
+void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, double *abar,
+                          int *lit)
+{
+    double th = sc->theta_deg * PPB_PI / 180.0;
+    double depth = y < 0.0 ? -y : 0.0;
+    if (sc->geometry == PPB_GEOM_SLAB) {
+        *D = sc->sigma_t * depth / cos(th);
+        *abar = sc->albedo;
+        *lit = 1;
+        return;
+    }
+    /* The path runs from (x, y) along -w_L to S1 at x' = x + y tan(theta_L). */
+    double xp = x - depth * tan(th);
+    *D = ppb_segment_optical_depth(sc, x, -depth, xp, 0.0);
+    *abar = sc->albedo;
+    if (sc->step == PPB_STEP_ALBEDO) {
+        /* Paper Sec. 3.3: the length average of alpha from the entry point to x. */
+        double f = right_fraction(x, xp, sc->step_x);
+        *abar = (1.0 - f) * sc->albedo + f * sc->albedo_right;
+    }
+    /* SPEC.md section 3: lit only if the path meets S1 inside its lit part; for theta_L >= 0 a
+     * path that would meet S1's plane left of -W/2 leaves through S3 first. */
+    *lit = xp >= -0.5 * sc->width && xp <= 0.5 * sc->width &&
+           !(sc->step == PPB_STEP_SHADOW && xp >= sc->step_x);
+}
+
+int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err)
+{
+    if (map_res < 1)
+        return ppb_fail(err, "maps: map_res must be at least 1 (got %d)", map_res);
+    double th = sc->theta_deg * PPB_PI / 180.0;
+    m->tube = sc->geometry == PPB_GEOM_TUBE;
+    m->tan_theta_l = tan(th);
+    m->h = 1.0 / map_res;
+    m->ny = (int)ceil(sc->height * map_res - 1e-9);
+    if (m->ny < 1)
+        m->ny = 1;
+    if (m->tube) {
+        /* Columns start at x' = -W/2 (a shadow edge for oblique light) and reach left far enough
+         * for the paths of S3's lower end; step_x = 0 then lies on a column edge too. */
+        int left = (int)ceil(sc->height * m->tan_theta_l * map_res - 1e-9);
+        m->xp0 = -0.5 * sc->width - left * m->h;
+        m->nx = left + (int)ceil(sc->width * map_res - 1e-9);
+    } else {
+        m->xp0 = -0.5 * m->h;
+        m->nx = 1;
+    }
+    m->cells = malloc((size_t)m->nx * (size_t)m->ny * PPB_MAP_STRIDE * sizeof *m->cells);
+    if (!m->cells)
+        return ppb_fail(err, "maps: out of memory for %d x %d cells", m->nx, m->ny);
+    /* Corners are evaluated a hair inside their cell: the limit from inside, which keeps a jump
+     * on the cell edge sharp; 1e-9 cells moves D by ~1e-11, far below any tolerance. */
+    double eps = 1e-9 * m->h;
+    for (int j = 0; j < m->ny; j++)
+        for (int i = 0; i < m->nx; i++) {
+            double *c = m->cells + ((size_t)j * m->nx + i) * PPB_MAP_STRIDE;
+            for (int corner = 0; corner < 4; corner++) {
+                int cx = corner & 1, cy = corner >> 1;
+                double xp = m->xp0 + (i + cx) * m->h + (cx ? -eps : eps);
+                double depth = (j + cy) * m->h + (cy ? -eps : eps);
+                double y = -depth, x = xp - y * m->tan_theta_l;
+                double D, abar;
+                int lit;
+                ppb_light_path_exact(sc, x, y, &D, &abar, &lit);
+                c[PPB_MAP_D * 4 + corner] = D;
+                c[PPB_MAP_ABAR * 4 + corner] = abar;
+                c[PPB_MAP_LIT * 4 + corner] = lit;
+            }
+        }
+    return 0;
+}
+
+void ppb_maps_free(ppb_maps *m)
+{
+    free(m->cells);
+    m->cells = NULL;
+}
+
+void ppb_maps_lookup(const ppb_maps *m, double x, double y, double *D, double *abar, double *lit)
+{
+    ppb_map_lookup(m->cells, m->xp0, m->h, m->nx, m->ny, m->tan_theta_l, x, y, D, abar, lit);
+}
+
+double ppb_maps_depth(const ppb_maps *m, double x, double y)
+{
+    double D, abar, lit;
+    ppb_maps_lookup(m, x, y, &D, &abar, &lit);
+    return lit > 0.0 ? D : INFINITY;
+}
+
+/* Unscattered transmittance of the beam entering S1 at x_e: it leaves through S2, or through S4
+ * when oblique light reaches x = W/2 first. */
+static double beam_transmittance(const ppb_scene *sc, double xe)
+{
+    double th = sc->theta_deg * PPB_PI / 180.0, t = tan(th);
+    double xb = xe + sc->height * t, yb = -sc->height;
+    if (xb > 0.5 * sc->width) {
+        xb = 0.5 * sc->width;
+        yb = -(xb - xe) / t;
+    }
+    return exp(-ppb_segment_optical_depth(sc, xe, 0.0, xb, yb));
+}
+
+double ppb_ballistic_fraction(const ppb_scene *sc)
+{
+    double th = sc->theta_deg * PPB_PI / 180.0;
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return exp(-sc->sigma_t * sc->height / cos(th));
+    double a = -0.5 * sc->width, b = 0.5 * sc->width;
+    if (sc->step == PPB_STEP_SHADOW)
+        b = fmin(b, sc->step_x);
+    if (b <= a)
+        return 0.0;
+    /* The integrand is smooth between the entry points where the path's end switches from S2 to
+     * S4 or where it starts or ends on the step (it may jump there); Gauss-Legendre panels between
+     * those breaks never sample a break and are exact to ~1e-14 for these exponentials. */
+    double t = tan(th), brk[5] = {a, b, 0, 0, 0};
+    int nb = 2;
+    double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
+    for (int k = 0; k < 3; k++)
+        if (cand[k] > a && cand[k] < b)
+            brk[nb++] = cand[k];
+    for (int i = 1; i < nb; i++) /* insertion sort of a handful */
+        for (int k = i; k > 0 && brk[k] < brk[k - 1]; k--) {
+            double s = brk[k];
+            brk[k] = brk[k - 1];
+            brk[k - 1] = s;
+        }
+    static const double gx[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                                 0.9061798459386640};
+    static const double gw[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+                                 0.4786286704993665, 0.2369268850561891};
+    const int panels = 64;
+    double sum = 0.0;
+    for (int p = 0; p + 1 < nb; p++) {
+        double hstep = (brk[p + 1] - brk[p]) / panels;
+        for (int k = 0; hstep > 0.0 && k < panels; k++) {
+            double mid = brk[p] + (k + 0.5) * hstep;
+            for (int q = 0; q < 5; q++)
+                sum += 0.5 * hstep * gw[q] * beam_transmittance(sc, mid + 0.5 * hstep * gx[q]);
+        }
+    }
+    return sum / (b - a);
+}

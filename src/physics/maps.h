@@ -1,0 +1,50 @@
+/* maps.h: the tube's light maps (paper Sec. 3.1 and 3.3; SPEC.md sections 1-3): the optical
+ * depth D along the light path from S1 (infinite where S1's lit part cannot be seen along -w_L)
+ * and the average albedo along that path, on a light-aligned grid over the cross-section, plus
+ * the exact light-path quantities they sample and the exact ballistic exit fraction.
+ *
+ * The grid's columns follow the light (x' = x + y tan theta_L), so D is linear in depth along a
+ * column and every shadow edge is a column edge; each cell keeps its corners as limits from
+ * inside (kernels/march_params.h). Node values are exact for the piecewise-constant media, so
+ * the only map error is bilinear interpolation across a kink or jump that cuts a cell (oblique
+ * light with a density or albedo step), and it vanishes as map_res grows. */
+#ifndef PPB_MAPS_H
+#define PPB_MAPS_H
+
+#include "base/err.h"
+#include "model/scene.h"
+
+typedef struct ppb_maps {
+    int tube;
+    double tan_theta_l;
+    double xp0;    /* x' of the first node column */
+    double h;      /* cell size, mfp */
+    int nx, ny;    /* cells */
+    double *cells; /* [ny][nx][PPB_MAP_STRIDE] */
+} ppb_maps;
+
+/* Builds the maps with map_res cells per mfp (slab mode: one column). */
+int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err);
+void ppb_maps_free(ppb_maps *m);
+
+/* Interpolated map values at (x, y): D (finite, continued into shadow), average albedo and the
+ * lit fraction (0 or 1 except inside a cell that a shadow edge cuts). */
+void ppb_maps_lookup(const ppb_maps *m, double x, double y, double *D, double *abar, double *lit);
+
+/* D from the map as the paper defines it: infinite where fully shadowed. */
+double ppb_maps_depth(const ppb_maps *m, double x, double y);
+
+/* Exact values at (x, y) inside the cross-section (y <= 0): D continued into shadow, the length
+ * average of the albedo along the light path (paper Sec. 3.3), and whether the point is lit
+ * (SPEC.md section 3). In slab mode x is ignored. */
+void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, double *abar,
+                          int *lit);
+
+/* Exact optical depth of the straight segment (x0, y0)-(x1, y1) through the medium. */
+double ppb_segment_optical_depth(const ppb_scene *sc, double x0, double y0, double x1, double y1);
+
+/* Exact fraction of the power entering the lit part of S1 that leaves unscattered, through any
+ * surface (SPEC.md section 4: ballistic). */
+double ppb_ballistic_fraction(const ppb_scene *sc);
+
+#endif

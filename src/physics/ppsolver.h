@@ -1,0 +1,98 @@
+/* ppsolver.h: the plane-parallel solution of a homogeneous slab (paper Sec. 2.2, Eq. 8-12).
+ *
+ * Owns the discretised transfer equation K dI/dtau = (E - alpha P) I - alpha q exp(-tau/mu0)
+ * over the direction cells of directions.h (tau = -y sigma_t grows downward, mu = w.y, SPEC.md
+ * section 10's consistent Eq. 8), its eigen solution (Eq. 9-11), the boundary conditions (Eq.
+ * 12: no diffuse light enters either face), the collimated beam as a particular solution, and
+ * the evaluation API the ray marcher and `ppslab` use.
+ *
+ * Choices, and why:
+ * - Eigenproblem: the up/down mirror gives P = [[A, B], [B, A]], so with u = X+ + X-,
+ *   v = X+ - X- the 2N problem becomes lambda^2 v = C G+ C G- v (C = (|Omega| K+)^-1,
+ *   G+- = |Omega| (E - alpha (A +- B)), both symmetric). With T = C^(1/2), H+- = T G+- T and
+ *   H- = L L^T (Cholesky; H- is positive definite for alpha <= 1), L^T H+ L is symmetric with
+ *   eigenvalues lambda^2 >= 0: one N x N symmetric eigensolve (LAPACKE_dsyevd) gives all 2N
+ *   modes +-lambda, with u = T L y, v = lambda T L^-T y.
+ * - Scaling: a mode with lambda > 0 is written exp(lambda (tau - tau0)), one with lambda < 0
+ *   exp(lambda tau), so every exponential is <= 1 inside the slab; the boundary system splits
+ *   into the two N x N systems of the sums and differences of its unknowns.
+ * - Beam: the single-scattering source alpha q_i exp(-tau/mu0) (q_i = cell average of
+ *   p(w . w_L)) gets the particular solution Z exp(-tau/mu0), solved in the eigenbasis. Where
+ *   1/mu0 meets an eigenvalue (|lambda mu0 - 1| < 1e-7) mu0 is moved by 2e-7 relative, the
+ *   discrete-ordinates treatment; the whole solution (beam included) then uses the moved mu0,
+ *   so it stays an exact, conserving solution of a beam 1e-7 rad away (pp_mu0 tells).
+ * - alpha = 1 (taken for 1 - alpha < 1e-13): the double zero eigenvalue is replaced by its two
+ *   exact solutions, the isotropic constant and the diffusion mode tau 1 + h. The constant
+ *   is an ordinary mode with lambda = 0; the linear part adds pp_source_linear() * tau to J.
+ * - Radiance in any direction: by integrating the source function J exactly along the ray
+ *   (the discrete-ordinates "source-function integration"), not by looking up a cell, so
+ *   angular detail finer than a cell (single scattering, the HG peak) is kept.
+ * - Energy: rows of P conserve exactly (phase.h), so R + T + absorbed + ballistic = 1 holds to
+ *   rounding for the cell field; the totals come from the cell field at the faces. */
+#ifndef PPB_PPSOLVER_H
+#define PPB_PPSOLVER_H
+
+#include "base/err.h"
+
+typedef struct pp_params {
+    double tau0;    /* optical thickness, (0, 1e6] */
+    double albedo;  /* [0, 1] */
+    double g;       /* HG asymmetry, |g| < 1 */
+    double mu0;     /* cos theta_L in (0, 1] */
+    int directions; /* cells per hemisphere */
+} pp_params;
+
+typedef struct pp_solution pp_solution; /* opaque */
+
+/* Seconds spent in each stage of a solve (for the benchmark). */
+typedef struct pp_timing {
+    double phase;    /* phase matrix blocks and the beam's source vector */
+    double eigen;    /* the symmetric reduction and eigendecomposition */
+    double boundary; /* particular solution, boundary systems, totals */
+} pp_timing;
+
+/* Solves one slab; rejects invalid params with a clear message. */
+int pp_solve(const pp_params *p, pp_solution **out, ppb_err *err);
+
+/* The same, reusing the phase matrix of `share` when it has the same g and directions (the
+ * matrix depends on nothing else: the marcher's tables at several albedos need it once), and
+ * reporting stage times when t is not NULL. share and t may be NULL. */
+int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out, pp_timing *t,
+                ppb_err *err);
+void pp_free(pp_solution *s);
+
+/* The parameters solved, with mu0 as used (see the resonance note above). */
+pp_params pp_get_params(const pp_solution *s);
+double pp_mu0(const pp_solution *s);
+
+/* Homogeneous modes (M of them: 2N, or 2N - 1 at alpha = 1), sorted by |lambda| ascending;
+ * e_k(tau) = exp(lambda_k (tau - tau_ref_k)), tau_ref_k = 0 if lambda_k < 0 else tau0. */
+int pp_nmodes(const pp_solution *s);
+void pp_modes(const pp_solution *s, double *lambda, double *tau_ref);
+/* Mode k's cell vector times its boundary coefficient c_k (length 2N, cells as in
+ * directions.h): I(tau) = sum_k pp_mode_vector(k) e_k(tau) + particular + linear. */
+const double *pp_mode_vector(const pp_solution *s, int k);
+
+/* Source function for scattering into the continuous direction w (unit vector, tube frame),
+ * per unit optical depth, E_perp = 1:
+ *   J(tau, w) = alpha integral p(w.w') I_diffuse(tau, w') dw' + alpha p(w.w_L) exp(-tau/mu0).
+ * Diffuse part in modal form: sum_k a_k(w) e_k(tau) + b(w) exp(-tau/mu0) + a_lin tau. */
+void pp_source_coeffs(const pp_solution *s, const double w[3], double *a, double *b);
+double pp_source_linear(const pp_solution *s); /* a_lin: 0 unless alpha = 1 */
+double pp_source_direct(const pp_solution *s, double tau, const double w[3]);
+double pp_source(const pp_solution *s, double tau, const double w[3]);
+
+/* Scattered radiance at depth tau in direction w: J integrated exactly along w back to the face
+ * it comes from. At tau = 0 with w.y > 0 the reflected radiance, at tau0 with w.y < 0 the
+ * transmitted. Horizontal w (w.y = 0) gives J(tau, w), the infinite-slab limit. */
+double pp_radiance(const pp_solution *s, double tau, const double w[3]);
+
+/* Cell averages I_i(tau), i in [0, 2N) (up cells first, then their mirrors). */
+void pp_cell_field(const pp_solution *s, double tau, double *field);
+
+/* Fractions of the incident power cos(theta_L) E_perp: reflected and transmitted scattered
+ * light, and the unscattered beam exp(-tau0/mu0); pp_absorbed the rest, computed. */
+void pp_totals(const pp_solution *s, double *R, double *T, double *ballistic);
+double pp_absorbed(const pp_solution *s);
+
+#endif

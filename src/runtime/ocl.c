@@ -1,0 +1,306 @@
+#include "runtime/ocl.h"
+
+#include <ctype.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef PPB_KERNEL_DIR
+#define PPB_KERNEL_DIR "kernels"
+#endif
+#define MAX_PLATFORMS 16
+#define MAX_DEVICES   64
+
+const char *ppb_cl_errname(cl_int code)
+{
+    switch (code) {
+#define E(c)                                                                                       \
+    case c:                                                                                        \
+        return #c;
+        /* clang-format off */
+        E(CL_SUCCESS)
+        E(CL_DEVICE_NOT_FOUND)
+        E(CL_DEVICE_NOT_AVAILABLE)
+        E(CL_COMPILER_NOT_AVAILABLE)
+        E(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+        E(CL_OUT_OF_RESOURCES)
+        E(CL_OUT_OF_HOST_MEMORY)
+        E(CL_PROFILING_INFO_NOT_AVAILABLE)
+        E(CL_MEM_COPY_OVERLAP)
+        E(CL_IMAGE_FORMAT_MISMATCH)
+        E(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+        E(CL_BUILD_PROGRAM_FAILURE)
+        E(CL_MAP_FAILURE)
+        E(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+        E(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+        E(CL_COMPILE_PROGRAM_FAILURE)
+        E(CL_LINKER_NOT_AVAILABLE)
+        E(CL_LINK_PROGRAM_FAILURE)
+        E(CL_DEVICE_PARTITION_FAILED)
+        E(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+        E(CL_INVALID_VALUE)
+        E(CL_INVALID_DEVICE_TYPE)
+        E(CL_INVALID_PLATFORM)
+        E(CL_INVALID_DEVICE)
+        E(CL_INVALID_CONTEXT)
+        E(CL_INVALID_QUEUE_PROPERTIES)
+        E(CL_INVALID_COMMAND_QUEUE)
+        E(CL_INVALID_HOST_PTR)
+        E(CL_INVALID_MEM_OBJECT)
+        E(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+        E(CL_INVALID_IMAGE_SIZE)
+        E(CL_INVALID_SAMPLER)
+        E(CL_INVALID_BINARY)
+        E(CL_INVALID_BUILD_OPTIONS)
+        E(CL_INVALID_PROGRAM)
+        E(CL_INVALID_PROGRAM_EXECUTABLE)
+        E(CL_INVALID_KERNEL_NAME)
+        E(CL_INVALID_KERNEL_DEFINITION)
+        E(CL_INVALID_KERNEL)
+        E(CL_INVALID_ARG_INDEX)
+        E(CL_INVALID_ARG_VALUE)
+        E(CL_INVALID_ARG_SIZE)
+        E(CL_INVALID_KERNEL_ARGS)
+        E(CL_INVALID_WORK_DIMENSION)
+        E(CL_INVALID_WORK_GROUP_SIZE)
+        E(CL_INVALID_WORK_ITEM_SIZE)
+        E(CL_INVALID_GLOBAL_OFFSET)
+        E(CL_INVALID_EVENT_WAIT_LIST)
+        E(CL_INVALID_EVENT)
+        E(CL_INVALID_OPERATION)
+        E(CL_INVALID_GL_OBJECT)
+        E(CL_INVALID_BUFFER_SIZE)
+        E(CL_INVALID_MIP_LEVEL)
+        E(CL_INVALID_GLOBAL_WORK_SIZE)
+        E(CL_INVALID_PROPERTY)
+        E(CL_INVALID_IMAGE_DESCRIPTOR)
+        E(CL_INVALID_COMPILER_OPTIONS)
+        E(CL_INVALID_LINKER_OPTIONS)
+        E(CL_INVALID_DEVICE_PARTITION_COUNT)
+        /* clang-format on */
+#undef E
+    case -1001:
+        return "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL platform: is pocl-opencl-icd installed?)";
+    default:
+        return "unknown OpenCL error";
+    }
+}
+
+int ppb_cl_check(cl_int code, const char *what, ppb_err *err)
+{
+    if (code == CL_SUCCESS)
+        return 0;
+    return ppb_fail(err, "OpenCL: %s failed: %s (%d)", what, ppb_cl_errname(code), (int)code);
+}
+
+/* Every (platform, device) pair in a fixed order: platforms as the ICD loader lists them,
+ * devices of all types within each. This order is what indices refer to. */
+typedef struct dev_entry {
+    cl_platform_id platform;
+    cl_device_id device;
+    char name[512];
+} dev_entry;
+
+static int enumerate(dev_entry *out, int cap, ppb_err *err)
+{
+    cl_platform_id plats[MAX_PLATFORMS];
+    cl_uint np = 0;
+    cl_int rc = clGetPlatformIDs(MAX_PLATFORMS, plats, &np);
+    if (rc == -1001 || (rc == CL_SUCCESS && np == 0))
+        return ppb_fail(err, "OpenCL: no platform found (install pocl-opencl-icd: make deps)");
+    if (ppb_cl_check(rc, "clGetPlatformIDs", err))
+        return -1;
+    int n = 0;
+    for (cl_uint p = 0; p < np && p < MAX_PLATFORMS; p++) {
+        cl_device_id devs[MAX_DEVICES];
+        cl_uint nd = 0;
+        if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, MAX_DEVICES, devs, &nd) != CL_SUCCESS)
+            continue;
+        char pname[200] = "";
+        clGetPlatformInfo(plats[p], CL_PLATFORM_NAME, sizeof pname, pname, NULL);
+        for (cl_uint d = 0; d < nd && n < cap; d++, n++) {
+            char dname[256] = "";
+            clGetDeviceInfo(devs[d], CL_DEVICE_NAME, sizeof dname, dname, NULL);
+            out[n].platform = plats[p];
+            out[n].device = devs[d];
+            snprintf(out[n].name, sizeof out[n].name, "%s / %s", pname, dname);
+        }
+    }
+    if (n == 0)
+        return ppb_fail(err, "OpenCL: no device found: %s", ppb_cl_errname(CL_DEVICE_NOT_FOUND));
+    return n;
+}
+
+int ppb_ocl_list(FILE *out, ppb_err *err)
+{
+    dev_entry devs[MAX_DEVICES];
+    int n = enumerate(devs, MAX_DEVICES, err);
+    for (int i = 0; i < n; i++) {
+        cl_uint cu = 0;
+        cl_ulong mem = 0;
+        char ver[128] = "";
+        clGetDeviceInfo(devs[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cu, &cu, NULL);
+        clGetDeviceInfo(devs[i].device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, NULL);
+        clGetDeviceInfo(devs[i].device, CL_DEVICE_VERSION, sizeof ver, ver, NULL);
+        fprintf(out, "%d: %s (%u compute units, %.1f GiB, %s)\n", i, devs[i].name, cu,
+                (double)mem / (1024.0 * 1024.0 * 1024.0), ver);
+    }
+    return n;
+}
+
+static int contains_nocase(const char *hay, const char *needle)
+{
+    size_t n = strlen(needle);
+    for (; *hay; hay++) {
+        size_t i = 0;
+        while (i < n && hay[i] &&
+               tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+            i++;
+        if (i == n)
+            return 1;
+    }
+    return 0;
+}
+
+/* Index when the selector is all digits, else the first name containing it. */
+static int choose(const dev_entry *devs, int n, const char *sel, ppb_err *err)
+{
+    if (!sel || !*sel)
+        return 0;
+    char *end;
+    long idx = strtol(sel, &end, 10);
+    if (*end == '\0') {
+        if (idx < 0 || idx >= n)
+            return ppb_fail(
+                err, "--device %s: no such device (there are %d; see `ppbench devices`)", sel, n);
+        return (int)idx;
+    }
+    for (int i = 0; i < n; i++)
+        if (contains_nocase(devs[i].name, sel))
+            return i;
+    return ppb_fail(err, "--device %s: no device name contains it (see `ppbench devices`)", sel);
+}
+
+int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err)
+{
+    memset(ocl, 0, sizeof *ocl);
+    dev_entry devs[MAX_DEVICES];
+    int n = enumerate(devs, MAX_DEVICES, err);
+    if (n < 0)
+        return -1;
+    if (!selector || !*selector)
+        selector = getenv("PPBENCH_DEVICE");
+    int i = choose(devs, n, selector, err);
+    if (i < 0)
+        return -1;
+    ocl->platform = devs[i].platform;
+    ocl->device = devs[i].device;
+    snprintf(ocl->name, sizeof ocl->name, "%s", devs[i].name);
+    clGetDeviceInfo(ocl->device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof ocl->compute_units,
+                    &ocl->compute_units, NULL);
+    clGetDeviceInfo(ocl->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof ocl->max_workgroup,
+                    &ocl->max_workgroup, NULL);
+    clGetDeviceInfo(ocl->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof ocl->global_mem,
+                    &ocl->global_mem, NULL);
+    clGetDeviceInfo(ocl->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof ocl->max_alloc,
+                    &ocl->max_alloc, NULL);
+    cl_int rc;
+    cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)ocl->platform, 0};
+    ocl->context = clCreateContext(props, 1, &ocl->device, NULL, NULL, &rc);
+    if (ppb_cl_check(rc, "clCreateContext", err))
+        return -1;
+    ocl->queue = clCreateCommandQueue(ocl->context, ocl->device, 0, &rc);
+    if (ppb_cl_check(rc, "clCreateCommandQueue", err)) {
+        clReleaseContext(ocl->context);
+        ocl->context = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+void ppb_ocl_close(ppb_ocl *ocl)
+{
+    if (ocl->queue)
+        clReleaseCommandQueue(ocl->queue);
+    if (ocl->context)
+        clReleaseContext(ocl->context);
+    ocl->queue = NULL;
+    ocl->context = NULL;
+}
+
+static const char *kernel_dir(void)
+{
+    const char *d = getenv("PPBENCH_KERNELS");
+    return (d && *d) ? d : PPB_KERNEL_DIR;
+}
+
+static char *read_file(const char *path, ppb_err *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        ppb_fail(err, "%s: cannot open kernel source (set PPBENCH_KERNELS to the kernels/ dir)",
+                 path);
+        return NULL;
+    }
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        fclose(f);
+        ppb_fail(err, "%s: cannot read kernel source", path);
+        return NULL;
+    }
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static int build_failed(ppb_ocl *ocl, cl_program prog, const char *path, cl_int rc, ppb_err *err)
+{
+    size_t n = 0;
+    clGetProgramBuildInfo(prog, ocl->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
+    char *log = malloc(n + 1);
+    if (log) {
+        log[0] = '\0';
+        clGetProgramBuildInfo(prog, ocl->device, CL_PROGRAM_BUILD_LOG, n, log, NULL);
+        log[n] = '\0';
+    }
+    ppb_fail(err, "OpenCL: building %s failed: %s\nbuild log:\n%s", path, ppb_cl_errname(rc),
+             log ? log : "(no log)");
+    free(log);
+    clReleaseProgram(prog);
+    return -1;
+}
+
+int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog, ppb_err *err)
+{
+    char path[2048], opts[4096];
+    const char *dir = kernel_dir();
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    char *src = read_file(path, err);
+    if (!src)
+        return -1;
+    cl_int rc;
+    const char *srcs[1] = {src};
+    *prog = clCreateProgramWithSource(ocl->context, 1, srcs, NULL, &rc);
+    free(src);
+    if (ppb_cl_check(rc, "clCreateProgramWithSource", err))
+        return -1;
+    /* Random123's headers sit under /usr/include; -cl-fp32-correctly-rounded-divide-sqrt is
+     * left out on purpose: kernels that need exact results use double. */
+    snprintf(opts, sizeof opts, "-I %s -I /usr/include %s", dir, extra ? extra : "");
+    rc = clBuildProgram(*prog, 1, &ocl->device, opts, NULL, NULL);
+    if (rc != CL_SUCCESS)
+        return build_failed(ocl, *prog, path, rc, err);
+    return 0;
+}
+
+int ppb_ocl_kernel(cl_program prog, const char *name, cl_kernel *k, ppb_err *err)
+{
+    cl_int rc;
+    *k = clCreateKernel(prog, name, &rc);
+    if (rc != CL_SUCCESS)
+        return ppb_fail(err, "OpenCL: clCreateKernel(%s) failed: %s", name, ppb_cl_errname(rc));
+    return 0;
+}

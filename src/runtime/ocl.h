@@ -1,0 +1,48 @@
+/* ocl.h: the OpenCL runtime: platform and device discovery and choice, program builds from
+ * kernels/ with the shared headers and Random123 on the include path, and error names.
+ *
+ * A ppb_ocl owns its context, queue and device; ppb_ocl_close releases them. Device choice:
+ * an index into the flattened list that `ppbench devices` prints, or a case-insensitive
+ * substring of "platform / device" names; NULL or "" falls back to $PPBENCH_DEVICE, then 0. */
+#ifndef PPB_OCL_H
+#define PPB_OCL_H
+
+#define CL_TARGET_OPENCL_VERSION 120
+#include <CL/cl.h>
+#include <stdio.h>
+
+#include "base/err.h"
+
+typedef struct ppb_ocl {
+    cl_platform_id platform;
+    cl_device_id device;
+    cl_context context;
+    cl_command_queue queue;
+    char name[512]; /* "platform / device" */
+    cl_uint compute_units;
+    size_t max_workgroup;
+    cl_ulong global_mem;
+    cl_ulong max_alloc;
+} ppb_ocl;
+
+const char *ppb_cl_errname(cl_int code);
+
+/* Prints one line per device ("index: platform / device, units, memory"); returns the count. */
+int ppb_ocl_list(FILE *out, ppb_err *err);
+
+int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err);
+void ppb_ocl_close(ppb_ocl *ocl);
+
+/* Builds kernels/<file> (directory from $PPBENCH_KERNELS, else the build-time path) with
+ * options "-I <kernels> -I <Random123> <extra>". On failure err holds the build log. */
+int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog,
+                  ppb_err *err);
+
+/* Creates kernel `name` from prog, naming it in the error. */
+int ppb_ocl_kernel(cl_program prog, const char *name, cl_kernel *k, ppb_err *err);
+
+/* Turns a failing OpenCL call into an error naming the call and the code: returns 0 when
+ * code == CL_SUCCESS. */
+int ppb_cl_check(cl_int code, const char *what, ppb_err *err);
+
+#endif
