@@ -7,17 +7,18 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${REGRESS_OUT:-build/regress}
 photons=${REGRESS_PHOTONS:-3e6}
+ppbench=${PPBENCH:-./ppbench}
 mkdir -p "$out"
 t0=$(date +%s)
 mapfile -t cases < configs/study.list
 for c in "${cases[@]}"; do
   echo "regress: $c ($(( $(date +%s) - t0 ))s)" >&2
-  ./ppbench run --quiet --set mc.photons="$photons" --out "$out/$c" "configs/$c.ini"
+  "$ppbench" run --quiet --set mc.photons="$photons" --out "$out/$c" "configs/$c.ini"
 done
 for f in tests/regress/*.ini; do
   c=$(basename "$f" .ini)
   echo "regress: $c ($(( $(date +%s) - t0 ))s)" >&2
-  ./ppbench run --quiet --out "$out/$c" "$f"
+  "$ppbench" run --quiet --out "$out/$c" "$f"
 done
 
 # value CASE FILE METHOD CELL COLUMN: one number from a case's CSV.
