@@ -264,7 +264,7 @@ static unsigned char *read_png(const fake *f, const char *name, int *w, int *h)
 static void write_images(fake *f)
 {
     ppb_err err;
-    if (ppb_images_write(&f->ex, &err))
+    if (ppb_images_write(f->cfg.out_dir, &f->cfg.scene, f->ex.res, f->ex.n, 0, &err))
         fail_msg("%s", err.msg);
 }
 
@@ -421,7 +421,8 @@ static void test_unwritable_dir_fails(void **state)
     assert_non_null(blocker);
     fclose(blocker);
     ppb_err err = {{0}};
-    assert_int_equal(ppb_images_write(&f->ex, &err), -1);
+    assert_int_equal(ppb_images_write(f->cfg.out_dir, &f->cfg.scene, f->ex.res, f->ex.n, 0, &err),
+                     -1);
     assert_true(strlen(err.msg) > 0);
     fake_free(f);
 }

@@ -62,14 +62,6 @@ void ppb_experiment_free(ppb_experiment *ex)
     ex->n = 0;
 }
 
-const ppb_result *ppb_experiment_find(const ppb_experiment *ex, const char *id)
-{
-    for (int i = 0; i < ex->n; i++)
-        if (strcmp(ex->res[i].method, id) == 0)
-            return &ex->res[i];
-    return NULL;
-}
-
 const ppb_result *ppb_experiment_reference(const ppb_experiment *ex)
 {
     for (int i = 0; i < ex->n; i++) {
@@ -189,5 +181,7 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
         return -1;
     if (write_comparisons(ex, err) || write_timings(ex, err) || write_provenance(ex, err))
         return -1;
-    return ppb_images_write(ex, err);
+    const ppb_result *ref = ppb_experiment_reference(ex);
+    return ppb_images_write(ex->cfg->out_dir, &ex->cfg->scene, ex->res, ex->n,
+                            ref ? (int)(ref - ex->res) : -1, err);
 }

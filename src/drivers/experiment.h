@@ -28,8 +28,6 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err);
 void ppb_experiment_free(ppb_experiment *ex);
 
-const ppb_result *ppb_experiment_find(const ppb_experiment *ex, const char *id);
-
 /* The result every other one is measured against (mc), or NULL. */
 const ppb_result *ppb_experiment_reference(const ppb_experiment *ex);
 

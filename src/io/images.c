@@ -27,7 +27,6 @@
 #include <string.h>
 
 #include "base/atomic_file.h"
-#include "drivers/experiment.h"
 #include "io/image_exr.h"
 #include "io/image_png.h"
 #include "io/render_tube.h"
@@ -51,37 +50,40 @@ static const rgb8 cool = {59, 76, 192}, neutral = {221, 221, 221}, warm = {180, 
 
 /* Everything rendered once and shared by the writers. */
 typedef struct img_ctx {
-    const ppb_experiment *ex;
+    const ppb_scene *scene;
+    const ppb_result *res;
+    int n;
     char dir[1100];
     unsigned char *kind; /* PPB_PIX_* per panel pixel, the same for every method */
-    float *value[PPB_MAX_RESULTS];
-    int ref;      /* index of the reference result, -1 if none */
-    double white; /* radiance shown as white on every PNG */
+    float **value;       /* per result, n of them */
+    int ref;             /* index of the reference result, -1 if none */
+    double white;        /* radiance shown as white on every PNG */
 } img_ctx;
 
 static void free_ctx(img_ctx *c)
 {
     free(c->kind);
-    for (int i = 0; i < PPB_MAX_RESULTS; i++)
+    for (int i = 0; c->value && i < c->n; i++)
         free(c->value[i]);
+    free(c->value);
 }
 
 static int render_panels(img_ctx *c, ppb_err *err)
 {
-    const ppb_experiment *ex = c->ex;
     ppb_tube_view views[2];
-    if (ppb_tube_views_paper(views, &ex->cfg->scene, VIEW_NX, VIEW_NY, err))
+    if (ppb_tube_views_paper(views, c->scene, VIEW_NX, VIEW_NY, err))
         return -1;
     c->kind = malloc(PANEL_PIXELS);
-    if (!c->kind)
+    c->value = calloc((size_t)c->n, sizeof *c->value);
+    if (!c->kind || !c->value)
         return ppb_fail(err, "images: out of memory");
     size_t half = PANEL_PIXELS / 2;
-    for (int i = 0; i < ex->n; i++) {
+    for (int i = 0; i < c->n; i++) {
         c->value[i] = malloc(PANEL_PIXELS * sizeof(float));
         if (!c->value[i])
             return ppb_fail(err, "images: out of memory");
-        ppb_tube_view_render(&views[0], &ex->res[i], c->value[i], c->kind);
-        ppb_tube_view_render(&views[1], &ex->res[i], c->value[i] + half, c->kind + half);
+        ppb_tube_view_render(&views[0], &c->res[i], c->value[i], c->kind);
+        ppb_tube_view_render(&views[1], &c->res[i], c->value[i] + half, c->kind + half);
     }
     return 0;
 }
@@ -152,7 +154,7 @@ static int write_exr(const img_ctx *c, int i, ppb_err *err)
     for (size_t k = 0; k < PANEL_PIXELS; k++)
         rgb[3 * k] = rgb[3 * k + 1] = rgb[3 * k + 2] = c->value[i][k];
     char path[1300];
-    image_path(c, "", c->ex->res[i].method, "exr", path, sizeof path);
+    image_path(c, "", c->res[i].method, "exr", path, sizeof path);
     int rc = ppb_exr_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
     free(rgb);
     return rc;
@@ -165,7 +167,7 @@ static int write_png(const img_ctx *c, int i, ppb_err *err)
         return ppb_fail(err, "images: out of memory");
     tone_map(c, i, rgb, VIEW_NX);
     char path[1300];
-    image_path(c, "", c->ex->res[i].method, "png", path, sizeof path);
+    image_path(c, "", c->res[i].method, "png", path, sizeof path);
     int rc = ppb_png_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
     free(rgb);
     return rc;
@@ -224,7 +226,7 @@ static int write_error(const img_ctx *c, int i, ppb_err *err)
     }
     error_bar(rgb + 3 * PANEL_PIXELS);
     char path[1300];
-    image_path(c, "error_", c->ex->res[i].method, "png", path, sizeof path);
+    image_path(c, "error_", c->res[i].method, "png", path, sizeof path);
     int rc = ppb_png_write_rgb(path, VIEW_NX, (int)ny, rgb, err);
     free(rgb);
     return rc;
@@ -232,7 +234,7 @@ static int write_error(const img_ctx *c, int i, ppb_err *err)
 
 static int write_sheet(const img_ctx *c, ppb_err *err)
 {
-    int n = c->ex->n;
+    int n = c->n;
     size_t nx = (size_t)n * VIEW_NX + (size_t)(n - 1) * SHEET_GAP;
     unsigned char *rgb = malloc(3 * nx * PANEL_NY);
     if (!rgb)
@@ -250,7 +252,7 @@ static int write_sheet(const img_ctx *c, ppb_err *err)
 
 static int write_all(const img_ctx *c, ppb_err *err)
 {
-    for (int i = 0; i < c->ex->n; i++) {
+    for (int i = 0; i < c->n; i++) {
         if (write_exr(c, i, err) || write_png(c, i, err))
             return -1;
         if (c->ref >= 0 && i != c->ref && write_error(c, i, err))
@@ -259,17 +261,15 @@ static int write_all(const img_ctx *c, ppb_err *err)
     return write_sheet(c, err);
 }
 
-int ppb_images_write(const struct ppb_experiment *ex, ppb_err *err)
+int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_result *res, int n,
+                     int ref, ppb_err *err)
 {
-    if (ex->cfg->scene.geometry != PPB_GEOM_TUBE || ex->n <= 0)
+    if (sc->geometry != PPB_GEOM_TUBE || n <= 0)
         return 0;
-    img_ctx c = {.ex = ex, .ref = -1};
-    snprintf(c.dir, sizeof c.dir, "%s/images", ex->cfg->out_dir);
+    img_ctx c = {.scene = sc, .res = res, .n = n, .ref = (ref >= 0 && ref < n) ? ref : -1};
+    snprintf(c.dir, sizeof c.dir, "%s/images", out_dir);
     if (ppb_mkdirs(c.dir, err))
         return -1;
-    const ppb_result *ref = ppb_experiment_reference(ex);
-    if (ref)
-        c.ref = (int)(ref - ex->res);
     int rc = render_panels(&c, err);
     if (rc == 0) {
         c.white = white_level(&c, c.ref >= 0 ? c.ref : 0);

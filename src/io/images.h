@@ -1,14 +1,18 @@
 /* images.h: shaded images of the tube (paper Fig. 6-7) from every method's radiance, written
  * as OpenEXR (linear) and PNG (tone-mapped, one exposure for all methods), plus a false-colour
- * image of each method's error against the Monte Carlo. Called by the experiment writer. */
+ * image of each method's error against the Monte Carlo. Takes results, not an experiment, so the
+ * drivers above it (the experiment writer) call down into it and never the other way. */
 #ifndef PPB_IMAGES_H
 #define PPB_IMAGES_H
 
 #include "base/err.h"
+#include "model/result.h"
+#include "model/scene.h"
 
-struct ppb_experiment;
-
-/* Writes the images of an experiment under its output directory; nothing in slab mode. */
-int ppb_images_write(const struct ppb_experiment *ex, ppb_err *err);
+/* Writes the images of n results of one scene under <out_dir>/images/; nothing in slab mode.
+ * res[ref] is the reference (exposure and error images); ref < 0: none, the exposure follows
+ * res[0] and no error images are written. */
+int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_result *res, int n,
+                     int ref, ppb_err *err);
 
 #endif
