@@ -22,7 +22,7 @@ TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
 BIN   ?= ppbench
 
-.PHONY: all deps test unit asan bench perf format format-check clean
+.PHONY: all deps test layers unit asan bench perf format format-check clean
 all: $(BIN)
 
 # Dependencies first: the pkg-config flags are only asked for once the packages are there.
@@ -61,8 +61,12 @@ unit: $(BIN) $(TESTS)
 	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
 	done; exit $$fail
 
-test: unit
+# The layer check first: it reads includes only and fails in a second.
+test: layers unit
 	@bash tests/regress.sh
+
+layers:
+	@bash scripts/check_layers.sh
 
 asan:
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
