@@ -180,6 +180,39 @@ static int choose(const dev_entry *devs, int n, const char *sel, ppb_err *err)
     return ppb_fail(err, "--device %s: no device name contains it (see `ppbench devices`)", sel);
 }
 
+/* The device limits the launches are sized by; a query that fails, or a work-group limit of
+ * zero (the launch size would divide by it), is an error naming the query. */
+static int device_info(ppb_ocl *ocl, ppb_err *err)
+{
+    const struct {
+        cl_device_info what;
+        const char *name;
+        void *dst;
+        size_t size;
+    } q[] = {
+        {CL_DEVICE_MAX_COMPUTE_UNITS, "CL_DEVICE_MAX_COMPUTE_UNITS", &ocl->compute_units,
+         sizeof ocl->compute_units},
+        {CL_DEVICE_MAX_WORK_GROUP_SIZE, "CL_DEVICE_MAX_WORK_GROUP_SIZE", &ocl->max_workgroup,
+         sizeof ocl->max_workgroup},
+        {CL_DEVICE_GLOBAL_MEM_SIZE, "CL_DEVICE_GLOBAL_MEM_SIZE", &ocl->global_mem,
+         sizeof ocl->global_mem},
+        {CL_DEVICE_MAX_MEM_ALLOC_SIZE, "CL_DEVICE_MAX_MEM_ALLOC_SIZE", &ocl->max_alloc,
+         sizeof ocl->max_alloc},
+    };
+    for (size_t i = 0; i < sizeof q / sizeof q[0]; i++) {
+        char what[96];
+        snprintf(what, sizeof what, "clGetDeviceInfo(%s)", q[i].name);
+        if (ppb_cl_check(clGetDeviceInfo(ocl->device, q[i].what, q[i].size, q[i].dst, NULL), what,
+                         err))
+            return -1;
+    }
+    if (ocl->max_workgroup == 0 || ocl->compute_units == 0)
+        return ppb_fail(err, "OpenCL: %s reports %s 0", ocl->name,
+                        ocl->max_workgroup == 0 ? "CL_DEVICE_MAX_WORK_GROUP_SIZE"
+                                                : "CL_DEVICE_MAX_COMPUTE_UNITS");
+    return 0;
+}
+
 int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err)
 {
     memset(ocl, 0, sizeof *ocl);
@@ -195,14 +228,8 @@ int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err)
     ocl->platform = devs[i].platform;
     ocl->device = devs[i].device;
     snprintf(ocl->name, sizeof ocl->name, "%s", devs[i].name);
-    clGetDeviceInfo(ocl->device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof ocl->compute_units,
-                    &ocl->compute_units, NULL);
-    clGetDeviceInfo(ocl->device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof ocl->max_workgroup,
-                    &ocl->max_workgroup, NULL);
-    clGetDeviceInfo(ocl->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof ocl->global_mem,
-                    &ocl->global_mem, NULL);
-    clGetDeviceInfo(ocl->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof ocl->max_alloc,
-                    &ocl->max_alloc, NULL);
+    if (device_info(ocl, err))
+        return -1;
     cl_int rc;
     cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)ocl->platform, 0};
     ocl->context = clCreateContext(props, 1, &ocl->device, NULL, NULL, &rc);
@@ -256,6 +283,8 @@ static char *read_file(const char *path, ppb_err *err)
     return buf;
 }
 
+/* Reports the build log and releases the program; the caller's handle is cleared by
+ * ppb_ocl_build, so no caller can release it a second time (PoCL aborts on that). */
 static int build_failed(ppb_ocl *ocl, cl_program prog, const char *path, cl_int rc, ppb_err *err)
 {
     size_t n = 0;
@@ -285,14 +314,19 @@ int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program 
     const char *srcs[1] = {src};
     *prog = clCreateProgramWithSource(ocl->context, 1, srcs, NULL, &rc);
     free(src);
-    if (ppb_cl_check(rc, "clCreateProgramWithSource", err))
+    if (ppb_cl_check(rc, "clCreateProgramWithSource", err)) {
+        *prog = NULL;
         return -1;
+    }
     /* Random123's headers sit under /usr/include; -cl-fp32-correctly-rounded-divide-sqrt is
      * left out on purpose: kernels that need exact results use double. */
     snprintf(opts, sizeof opts, "-I %s -I /usr/include %s", dir, extra ? extra : "");
     rc = clBuildProgram(*prog, 1, &ocl->device, opts, NULL, NULL);
-    if (rc != CL_SUCCESS)
-        return build_failed(ocl, *prog, path, rc, err);
+    if (rc != CL_SUCCESS) {
+        cl_program failed = *prog;
+        *prog = NULL;
+        return build_failed(ocl, failed, path, rc, err);
+    }
     return 0;
 }
 
@@ -300,7 +334,9 @@ int ppb_ocl_kernel(cl_program prog, const char *name, cl_kernel *k, ppb_err *err
 {
     cl_int rc;
     *k = clCreateKernel(prog, name, &rc);
-    if (rc != CL_SUCCESS)
+    if (rc != CL_SUCCESS) {
+        *k = NULL;
         return ppb_fail(err, "OpenCL: clCreateKernel(%s) failed: %s", name, ppb_cl_errname(rc));
+    }
     return 0;
 }
