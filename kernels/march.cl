@@ -39,12 +39,12 @@ typedef struct ppb_mcol {
     long tab_off, coef_off;
 } ppb_mcol;
 
-/* Column c of the tables ([ncols][nalb][ndir][ntau[c]], C [ncols][nalb][ndir]). */
+/* Column c of the tables (layout: march_params.h); the offsets are of its albedo node 0. */
 inline ppb_mcol ppb_column(const ppb_march_params *P, int ndir, int c)
 {
-    ppb_mcol m = {P->tau0[c], P->tau_h[c], P->ntau[c], 0, (long)c * P->nalb * ndir};
-    for (int k = 0; k < c; k++)
-        m.tab_off += (long)P->nalb * ndir * P->ntau[k];
+    ppb_mcol m = {P->tau0[c], P->tau_h[c], P->ntau[c],
+                  ppb_march_table_offset(P->ntau, c, 0, P->nalb, ndir),
+                  ppb_march_coef_offset(c, 0, P->nalb, ndir)};
     return m;
 }
 
@@ -263,7 +263,7 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
                                __global const double *tabR, __global const double *tabS,
                                __global const double *coefC, __global double *out)
 {
-    int nbins = P.ntheta * P.nphi;
+    int nbins = ppb_bin_count(P.ntheta, P.nphi);
     int gid = (int)get_global_id(0);
     int row = P.row0 + gid / nbins, bin = gid % nbins;
     int surf = -1;
@@ -272,13 +272,13 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
             surf = s;
     if (surf < 0)
         return;
-    int seg = row - P.offset[surf], nsurf = P.tube ? 4 : 2;
-    int ndir = nsurf * nbins * P.nsamp * P.nsamp;
+    int seg = row - P.offset[surf];
+    int ndir = ppb_march_ndir(ppb_surface_count(P.tube), nbins, P.nsamp);
     double cx = 0.0, cy = surf == PPB_S1 ? 0.0 : -P.height, seglen = 0.0;
     int along_x = surf == PPB_S1 || surf == PPB_S2;
     if (P.tube) {
         ppb_segment_centre(surf, seg, P.nseg[surf], P.width, P.height, &cx, &cy);
-        seglen = (along_x ? P.width : P.height) / P.nseg[surf];
+        seglen = ppb_segment_length(surf, P.nseg[surf], P.width, P.height);
     }
     int npts = P.tube ? P.npts : 1;
     double sum = 0.0;
@@ -293,5 +293,5 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
                 sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, wx, wy);
             }
     }
-    out[(long)row * nbins + bin] = sum / (npts * P.nsamp * P.nsamp);
+    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
 }

@@ -3,8 +3,8 @@
  *
  * Owns: the launch parameters passed by value, the kernel argument indices, the layout of the
  * light maps (paper Sec. 3.1 and 3.3: optical depth D along the light path and average albedo)
- * and their bilinear lookup, the order of the direction samples that index the integral tables
- * (paper Eq. 15-17), and the Henyey-Greenstein phase function (paper Sec. 4.1).
+ * and their bilinear lookup, and the layout of the integral tables (paper Eq. 15-17): the order
+ * and count of their direction samples and where each (column, albedo node) block starts.
  *
  * Plain C that is also OpenCL C, like ppb_conventions.h. */
 #ifndef PPB_MARCH_PARAMS_H
@@ -97,6 +97,37 @@ PPB_FN void ppb_march_dir(int surf, int bin, int a, int b, int n, int ntheta, in
 PPB_FN int ppb_march_dir_index(int surf, int bin, int a, int b, int n, int nbins)
 {
     return ((surf * nbins + bin) * n + a) * n + b;
+}
+
+/* Direction samples in the tables: every sample of every bin of every surface. */
+PPB_FN int ppb_march_ndir(int nsurf, int nbins, int n)
+{
+    return nsurf * nbins * n * n;
+}
+
+/* The inverse of ppb_march_dir_index: surface, bin and sample (a, b) of table column dir. */
+PPB_FN void ppb_march_dir_split(int dir, int n, int nbins, int *surf, int *bin, int *a, int *b)
+{
+    int per_bin = n * n, ab = dir % per_bin;
+    *surf = dir / (nbins * per_bin);
+    *bin = dir / per_bin % nbins;
+    *a = ab / n;
+    *b = ab % n;
+}
+
+/* Table layout: R and S are [column][albedo node][direction][tau node] with ntau[c] tau nodes
+ * in column c, C is [column][albedo node][direction]. First element of block (c, node) in R and
+ * S, and in C. */
+PPB_FN long ppb_march_table_offset(const int *ntau, int c, int node, int nalb, int ndir)
+{
+    long off = 0;
+    for (int k = 0; k < c; k++)
+        off += (long)nalb * ndir * ntau[k];
+    return off + (long)node * ndir * ntau[c];
+}
+PPB_FN long ppb_march_coef_offset(int c, int node, int nalb, int ndir)
+{
+    return ((long)c * nalb + node) * ndir;
 }
 
 /* Bilinear map lookup at (x, y): D, average albedo and lit fraction. x is sheared along the light

@@ -184,7 +184,7 @@ inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_lanes *s, int l,
             int bin =
                 ppb_dir_bin(surf, (double)wx, (double)wy, (double)s->wz[l], p->ntheta, p->nphi);
             size_t cell =
-                ((size_t)p->offset[surf] + (size_t)seg) * (size_t)(p->ntheta * p->nphi) + bin;
+                ppb_cell_index(p->offset[surf], seg, ppb_bin_count(p->ntheta, p->nphi), bin);
             atom_add(base + PPB_MC_TALLY_ALL * p->ncells + cell, q);
             if (s->nscat[l] == 1)
                 atom_add(base + PPB_MC_TALLY_ONCE * p->ncells + cell, q);

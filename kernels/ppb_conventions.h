@@ -1,9 +1,11 @@
 /* ppb_conventions.h: the conventions of SPEC.md sections 2-4 coded once, for host and kernels.
  *
- * Owns: surface ids and their local frames (n, b = +z, t = n x b), the direction bins (equal
- * sin^2(theta) theta bins, phi folded to [0, 180] deg), the (surface, segment, bin) cell index
- * of every radiance array, segment centres, the piecewise-constant medium and the
- * Henyey-Greenstein phase function. Plain C that is
+ * Owns: surface ids, the surface count, and their local frames (n, b = +z, t = n x b), the
+ * direction bins (equal sin^2(theta) theta bins, phi folded to [0, 180] deg) and their count,
+ * the (surface, segment, bin) cell index of every radiance array, segment centres and lengths,
+ * the piecewise-constant medium and the Henyey-Greenstein phase function (and its factored form
+ * for sums over many cosines). Where each surface's rows start (the offsets) is the host's
+ * ppb_scene_layout (src/model/scene.h); kernels receive those offsets. Plain C that is
  * also OpenCL C: the host includes it from src/, kernels with -I kernels. Nothing here
  * allocates or keeps state. */
 #ifndef PPB_CONVENTIONS_H
@@ -14,6 +16,7 @@
 #define PPB_FN inline
 #else
 #include <math.h>
+#include <stddef.h>
 #define PPB_FN static inline
 #endif
 
@@ -21,6 +24,12 @@
 
 /* Surfaces (SPEC.md section 2). In slab mode only S1 and S2 exist. */
 enum { PPB_S1 = 0, PPB_S2 = 1, PPB_S3 = 2, PPB_S4 = 3, PPB_NSURF = 4 };
+
+/* Surfaces that exist: S1..S4 in the tube, S1 and S2 in slab mode. */
+PPB_FN int ppb_surface_count(int tube)
+{
+    return tube ? 4 : 2;
+}
 
 /* Step kinds (SPEC.md section 1 and 3). */
 enum { PPB_STEP_NONE = 0, PPB_STEP_DENSITY = 1, PPB_STEP_ALBEDO = 2, PPB_STEP_SHADOW = 3 };
@@ -69,6 +78,19 @@ PPB_FN int ppb_dir_bin(int surf, double wx, double wy, double wz, int ntheta, in
     return ppb_theta_bin(mu, ntheta) * nphi + ppb_phi_bin(wt, wz, nphi);
 }
 
+/* Direction bins per surface point; bin = theta_bin * nphi + phi_bin. */
+PPB_FN int ppb_bin_count(int ntheta, int nphi)
+{
+    return ntheta * nphi;
+}
+
+/* Flat index of (segment row, bin) in every radiance array and tally: row = the surface's first
+ * row (its layout offset) + segment, rows of nbins bins each. */
+PPB_FN size_t ppb_cell_index(int surf_offset, int seg, int nbins, int bin)
+{
+    return ((size_t)surf_offset + (size_t)seg) * (size_t)nbins + (size_t)bin;
+}
+
 /* Projected solid angle of every bin: (1/2) d(sin^2) x 2 d(phi) = pi / (ntheta nphi); the
  * folded bin counts both phi and -phi. */
 PPB_FN double ppb_bin_proj_solid_angle(int ntheta, int nphi)
@@ -108,6 +130,12 @@ PPB_FN double ppb_segment_centre(int surf, int seg, int nseg, double width, doub
     return s;
 }
 
+/* Length of one segment of a tube surface: W / nseg on S1 and S2, H / nseg on S3 and S4. */
+PPB_FN double ppb_segment_length(int surf, int nseg, double width, double height)
+{
+    return (surf == PPB_S1 || surf == PPB_S2 ? width : height) / nseg;
+}
+
 /* Segment holding coordinate s along a surface of length len starting at s0. */
 PPB_FN int ppb_segment_of(double s, double s0, double len, int nseg)
 {
@@ -127,10 +155,22 @@ PPB_FN double ppb_albedo_at(double x, int step, double step_x, double albedo, do
 }
 
 /* Henyey-Greenstein phase function of the scattering cosine, per steradian, normalised to 1
- * over the sphere (SPEC.md section 1; paper Sec. 4.1). */
+ * over the sphere (SPEC.md section 1; paper Sec. 4.1):
+ *     p(cos) = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2)) = ppb_hg_norm(g) / base^(3/2),
+ * base = ppb_hg_base(g, cos). The factored form is for sums of p over many cosines (the phase
+ * matrix's quadratures, src/physics/phase.c), which take the constant out of the sum; it agrees
+ * with ppb_hg_phase to rounding (a few ulps), not bit for bit. */
+PPB_FN double ppb_hg_base(double g, double cos_angle)
+{
+    return 1.0 + g * g - 2.0 * g * cos_angle;
+}
+PPB_FN double ppb_hg_norm(double g)
+{
+    return (1.0 - g * g) / (4.0 * PPB_PI);
+}
 PPB_FN double ppb_hg_phase(double g, double cos_angle)
 {
-    double den = 1.0 + g * g - 2.0 * g * cos_angle;
+    double den = ppb_hg_base(g, cos_angle);
     return (1.0 - g * g) / (4.0 * PPB_PI * den * sqrt(den));
 }
 

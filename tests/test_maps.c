@@ -222,6 +222,33 @@ static void test_ballistic(void **state)
     assert_close(ppb_ballistic_fraction(&sc), (7.0 * e + (1.0 - e) / r2) / 10.0, 1e-10);
     ppb_scene slab = tu_slab(2.0, 0.9, 0.0, 60.0);
     assert_close(ppb_ballistic_fraction(&slab), exp(-4.0), 1e-12); /* tau0 / mu0 */
+    assert_close(ppb_beam_depth(&slab, 0.0), 4.0, 1e-14);
+}
+
+/* Oblique light across the density step (theta_L = 30 deg, sigma_t 1 -> 0.5 at x = 0), the case
+ * where mp's own copy of the beam depth and its 3-point rule were off by 8e-8. The beam's
+ * path has length L = H / cos = 2 sqrt 3 and crosses x over H tan = sqrt 3 (sin = 1/2). */
+static void test_ballistic_oblique_density(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    sc.step = PPB_STEP_DENSITY;
+    sc.theta_deg = 30;
+    double L = 2.0 * sqrt(3.0), shift = sqrt(3.0), s = 0.5;
+    /* Beam depth by path lengths on each side: entry at -1 runs 1 / sin = 2 left of the step and
+     * L - 2 right of it; entry at 4 leaves through S4 after (5 - 4) / sin = 2, all right. */
+    assert_close(ppb_beam_depth(&sc, -4.0), L, 1e-13);
+    assert_close(ppb_beam_depth(&sc, -1.0), 2.0 + 0.5 * (L - 2.0), 1e-13);
+    assert_close(ppb_beam_depth(&sc, 1.0), 0.5 * L, 1e-13);
+    assert_close(ppb_beam_depth(&sc, 4.0), 0.5 * 2.0, 1e-13);
+    /* Closed form of the average of exp(-depth) over x_e in [-5, 5], piece by piece:
+     *   [-5, -shift]: all left, e^{-L};  [-shift, 0]: depth = L/2 - x_e / (2 s), integral
+     *   2 s e^{-L/2} (1 - e^{-L/2});  [0, 5 - shift]: all right, e^{-L/2};  [5 - shift, 5]: out
+     *   through S4 after (5 - x_e) / s at sigma_t 1/2, integral 2 s (1 - e^{-L/2}). */
+    double eh = exp(-0.5 * L);
+    double sum = (5.0 - shift) * exp(-L) + 2.0 * s * eh * (1.0 - eh) + (5.0 - shift) * eh +
+                 2.0 * s * (1.0 - eh);
+    assert_close(ppb_ballistic_fraction(&sc), sum / 10.0, 1e-13);
 }
 
 int main(void)
@@ -236,6 +263,7 @@ int main(void)
         cmocka_unit_test(test_average_albedo_oblique),
         cmocka_unit_test(test_slab),
         cmocka_unit_test(test_ballistic),
+        cmocka_unit_test(test_ballistic_oblique_density),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

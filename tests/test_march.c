@@ -548,6 +548,69 @@ static void assert_tables_identical(const ppb_march_tables *a, const ppb_march_t
  * answered from the cache, byte-identical to a fresh build; a change that shapes the tables
  * (sigma_t_right, albedo) rebuilds them; one that does not (the step length) does not; pp and ss
  * keep their own tables. */
+/* The layout conventions host and kernel share (kernels/march_params.h, ppb_conventions.h,
+ * model/scene.h), checked by their defining properties rather than restated formulas. */
+static void test_shared_layout(void **state)
+{
+    (void)state;
+    /* Table directions: ppb_march_dir_index is a bijection onto [0, ndir) and
+     * ppb_march_dir_split its inverse. */
+    enum { NSURF = 4, NBINS = 6, N = 3 };
+    int ndir = ppb_march_ndir(NSURF, NBINS, N), seen[NSURF * NBINS * N * N] = {0};
+    assert_int_equal(ndir, NSURF * NBINS * N * N);
+    for (int surf = 0; surf < NSURF; surf++)
+        for (int bin = 0; bin < NBINS; bin++)
+            for (int a = 0; a < N; a++)
+                for (int b = 0; b < N; b++) {
+                    int dir = ppb_march_dir_index(surf, bin, a, b, N, NBINS), s2, bin2, a2, b2;
+                    assert_in_range(dir, 0, ndir - 1);
+                    seen[dir]++;
+                    ppb_march_dir_split(dir, N, NBINS, &s2, &bin2, &a2, &b2);
+                    assert_int_equal(s2, surf);
+                    assert_int_equal(bin2, bin);
+                    assert_int_equal(a2, a);
+                    assert_int_equal(b2, b);
+                }
+    for (int dir = 0; dir < ndir; dir++)
+        assert_int_equal(seen[dir], 1);
+    /* Table blocks, in build order (column, albedo node), tile R/S and C without gap or overlap. */
+    int ntau[PPB_MARCH_MAX_COLS] = {193, 97}, nalb = 3;
+    long end = 0, cend = 0;
+    for (int c = 0; c < PPB_MARCH_MAX_COLS; c++)
+        for (int node = 0; node < nalb; node++) {
+            assert_int_equal(ppb_march_table_offset(ntau, c, node, nalb, ndir), end);
+            assert_int_equal(ppb_march_coef_offset(c, node, nalb, ndir), cend);
+            end += (long)ndir * ntau[c];
+            cend += ndir;
+        }
+    assert_int_equal(end, (long)nalb * ndir * (ntau[0] + ntau[1]));
+    /* Cells: the layout's rows of every surface, then bins, cover [0, ncells) once each. */
+    ppb_scene sc = tu_tube();
+    ppb_layout lo = ppb_scene_layout(&sc);
+    assert_int_equal(lo.nsurf, ppb_surface_count(1));
+    size_t next = 0;
+    for (int surf = 0; surf < lo.nsurf; surf++)
+        for (int seg = 0; seg < lo.nseg[surf]; seg++)
+            for (int bin = 0; bin < lo.nbins; bin++)
+                assert_int_equal(ppb_cell(&lo, surf, seg, bin), next++);
+    assert_int_equal(next, lo.ncells);
+    /* Cell measures (SPEC.md 4): a surface's segments add up to its length, the bins of a point to
+     * pi, so a surface's cells measure length x pi; the power entering is W cos(theta_L). */
+    sc.theta_deg = 60;
+    double len[PPB_NSURF] = {10.0, 10.0, 3.0, 3.0};
+    for (int surf = 0; surf < lo.nsurf; surf++)
+        assert_close(lo.nseg[surf] * lo.nbins * ppb_scene_cell_measure(&sc, surf),
+                     len[surf] * PPB_PI, 1e-14);
+    assert_close(ppb_scene_power_in(&sc), 10.0 * 0.5, 1e-15);
+    /* Henyey-Greenstein's factored form (phase.c's quadratures) is ppb_hg_phase to rounding. */
+    double gs[] = {-0.95, -0.5, 0.0, 0.3, 0.9};
+    for (int i = 0; i < 5; i++)
+        for (int k = 0; k <= 40; k++) {
+            double c = -1.0 + k / 20.0, base = ppb_hg_base(gs[i], c), p = ppb_hg_phase(gs[i], c);
+            assert_close(ppb_hg_norm(gs[i]) / (base * sqrt(base)), p, 1e-14 * p); /* relative */
+        }
+}
+
 static void test_march_cache(void **state)
 {
     (void)state;
@@ -644,6 +707,7 @@ int main(void)
         cmocka_unit_test(test_tube_irregular_pieces),
         cmocka_unit_test(test_pp_density_step_columns),
         cmocka_unit_test(test_pp_uniform_one_column),
+        cmocka_unit_test(test_shared_layout),
         cmocka_unit_test(test_march_cache),
         cmocka_unit_test(test_march_method_cache),
     };

@@ -30,7 +30,7 @@ static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *wha
 static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
                                      const ppb_march_tables *tab, const ppb_march_opts *opts)
 {
-    double th = sc->theta_deg * PPB_PI / 180.0, wl[3];
+    double wl[3];
     ppb_scene_light_dir(sc, wl);
     int tube = sc->geometry == PPB_GEOM_TUBE;
     return (ppb_march_params){
@@ -41,8 +41,8 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
         .albedo = sc->albedo,
         .albedo_right = sc->albedo_right,
         .step_x = sc->step_x,
-        .tan_theta_l = tan(th),
-        .cos_theta_l = cos(th),
+        .tan_theta_l = ppb_scene_tan_theta_l(sc),
+        .cos_theta_l = ppb_scene_cos_theta_l(sc),
         .light_x = wl[0],
         .light_y = wl[1],
         .map_xp0 = maps->xp0,
@@ -222,17 +222,15 @@ int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
 void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
                       ppb_totals *t)
 {
-    int tube = sc->geometry == PPB_GEOM_TUBE;
-    double psa = ppb_bin_proj_solid_angle(sc->ntheta, sc->nphi);
     double flux[PPB_NSURF] = {0};
     for (int s = 0; s < lo->nsurf; s++) {
-        double seglen =
-            !tube ? 1.0 : (s == PPB_S1 || s == PPB_S2 ? sc->width : sc->height) / lo->nseg[s];
+        /* A cell's energy: its average radiance times segment length x projected solid angle. */
+        double measure = ppb_scene_cell_measure(sc, s);
         for (int seg = 0; seg < lo->nseg[s]; seg++)
             for (int b = 0; b < lo->nbins; b++)
-                flux[s] += radiance[ppb_cell(lo, s, seg, b)] * psa * seglen;
+                flux[s] += radiance[ppb_cell(lo, s, seg, b)] * measure;
     }
-    double entering = ppb_scene_lit_width(sc) * cos(sc->theta_deg * PPB_PI / 180.0);
+    double entering = ppb_scene_power_in(sc);
     memset(t, 0, sizeof *t);
     if (entering > 0.0) {
         t->R = flux[PPB_S1] / entering;

@@ -306,21 +306,13 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
 static void cells_to_result(const ppb_mc_tallies *t, const ppb_scene *sc, int once, ppb_result *r)
 {
     const ppb_layout *lo = &r->layout;
-    double lit = ppb_scene_lit_width(sc);
-    double wl[3];
-    ppb_scene_light_dir(sc, wl);
-    double cos_l = -wl[1];
-    double psa = ppb_bin_proj_solid_angle(sc->ntheta, sc->nphi);
+    double power = ppb_scene_power_in(sc);
     size_t tstride = (size_t)PPB_MC_NTALLY * t->ncells;
     const uint64_t *base = t->cells + (size_t)(once ? 1 : 0) * t->ncells;
     for (int s = 0; s < lo->nsurf; s++) {
         /* Each photon carries lit x cos(theta_L) / N of the entering power (SPEC.md 4); a
          * cell's radiance is its energy over segment length x projected solid angle. */
-        double seg_len = 1.0;
-        if (sc->geometry == PPB_GEOM_TUBE)
-            seg_len = (s == PPB_S1 || s == PPB_S2) ? sc->width / sc->segments_top
-                                                   : sc->height / sc->segments_side;
-        double scale = lit * cos_l / (seg_len * psa) / PPB_MC_FIXED_SCALE;
+        double scale = power / ppb_scene_cell_measure(sc, s) / PPB_MC_FIXED_SCALE;
         for (int seg = 0; seg < lo->nseg[s]; seg++)
             for (int k = 0; k < lo->nbins; k++) {
                 size_t c = ppb_cell(lo, s, seg, k);

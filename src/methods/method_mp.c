@@ -8,12 +8,14 @@
  * of S1..S4 takes the diffusive flux through its own surface from the 3-D source-to-point
  * vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged over the
  * segment (its 1/rho^2 part exactly, the smooth rest on samples_seg points); radiance = flux / pi
- * in every direction bin. */
+ * in every direction bin. The ballistic total is the scene's exact one (physics/maps.h), as for
+ * every deterministic method. */
 #include "methods/method_mp.h"
 
 #include <math.h>
 
 #include "methods/method_ss.h"
+#include "physics/maps.h"
 #include "physics/multipole.h"
 
 /* A stretch of the lit strip of S1 with one set of medium coefficients. */
@@ -74,48 +76,6 @@ static void fill_bins(ppb_result *out, int surf, int seg, double radiance)
         out->radiance[ppb_cell(&out->layout, surf, seg, b)] = radiance;
 }
 
-/* Optical depth of the unscattered beam from the entry point x0 on S1 to where it leaves the
- * tube (S2, or a side at oblique incidence); sigma_t steps at step_x for the density step. */
-static double beam_depth(const ppb_scene *sc, double x0)
-{
-    double t = sc->theta_deg * PPB_PI / 180.0, st = sin(t), ct = cos(t);
-    double half = 0.5 * sc->width, x1 = x0 + sc->height * st / ct;
-    x1 = fmax(-half, fmin(half, x1)); /* the side it leaves through, if it gets there first */
-    double len = fabs(st) > 0 ? fabs(x1 - x0) / fabs(st) : sc->height;
-    if (sc->step != PPB_STEP_DENSITY || fabs(st) == 0)
-        return len * ppb_sigma_t_at(x0, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-    double lo = fmin(x0, x1), hi = fmax(x0, x1);
-    double left = (fmax(lo, fmin(hi, sc->step_x)) - lo) / fabs(st); /* path length at x < step */
-    return left * sc->sigma_t + (len - left) * sc->sigma_t_right;
-}
-
-/* Ballistic (unscattered) fraction of the power entering the lit S1: exact geometry, integrated
- * over the entry points by Gauss-Legendre on pieces where the path depth is linear in x0. */
-static double tube_ballistic(const ppb_scene *sc, double xa, double xb)
-{
-    double t = sc->theta_deg * PPB_PI / 180.0, shift = sc->height * tan(t);
-    double cuts[4] = {xa, sc->step_x, (shift > 0 ? 0.5 : -0.5) * sc->width - shift, xb};
-    for (int i = 1; i < 4; i++) /* sort the four cuts (insertion) */
-        for (int j = i; j > 0 && cuts[j] < cuts[j - 1]; j--) {
-            double tmp = cuts[j];
-            cuts[j] = cuts[j - 1];
-            cuts[j - 1] = tmp;
-        }
-    static const double node[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
-    static const double weight[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-    double sum = 0;
-    for (int i = 0; i < 3; i++) {
-        double a = fmax(xa, cuts[i]), b = fmin(xb, cuts[i + 1]);
-        int panels = (int)ceil((b - a) * 8.0);
-        for (int p = 0; p < panels; p++) {
-            double h = (b - a) / panels, mid = a + (p + 0.5) * h;
-            for (int j = 0; j < 3; j++)
-                sum += 0.5 * h * weight[j] * exp(-beam_depth(sc, mid + 0.5 * h * node[j]));
-        }
-    }
-    return xb > xa ? sum / (xb - xa) : 0.0;
-}
-
 static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
@@ -123,12 +83,12 @@ static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
     int npiece;
     if (mp_pieces(cfg, piece, &npiece, err))
         return -1;
-    double cos_l = cos(sc->theta_deg * PPB_PI / 180.0);
-    double power = ppb_scene_lit_width(sc) * cos_l; /* entering the lit S1 per unit z */
+    double cos_l = ppb_scene_cos_theta_l(sc);
+    double power = ppb_scene_power_in(sc); /* entering the lit S1 per unit z */
     double surface_power[PPB_NSURF] = {0};
     for (int surf = 0; surf < PPB_NSURF; surf++) {
         int nseg = out->layout.nseg[surf];
-        double len = (surf <= PPB_S2 ? sc->width : sc->height) / nseg;
+        double len = ppb_scene_segment_length(sc, surf);
         for (int seg = 0; seg < nseg; seg++) {
             double flux = cos_l * mp_segment_flux(cfg, piece, npiece, surf, seg, len);
             fill_bins(out, surf, seg, flux / PPB_PI);
@@ -139,7 +99,7 @@ static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
     out->totals.R = surface_power[PPB_S1] * scale;
     out->totals.T = surface_power[PPB_S2] * scale;
     out->totals.sides = (surface_power[PPB_S3] + surface_power[PPB_S4]) * scale;
-    out->totals.ballistic = npiece ? tube_ballistic(sc, piece[0].xa, piece[npiece - 1].xb) : 0;
+    out->totals.ballistic = ppb_ballistic_fraction(sc); /* over the lit strip */
     return 0;
 }
 
@@ -149,11 +109,11 @@ static int mp_slab(const ppb_config *cfg, ppb_result *out, ppb_err *err)
     ppb_multipole mp;
     if (ppb_multipole_init(&mp, sc->sigma_t, sc->albedo, sc->g, sc->height, cfg->mp.pairs, err))
         return -1;
-    double cos_l = cos(sc->theta_deg * PPB_PI / 180.0);
+    double cos_l = ppb_scene_cos_theta_l(sc);
     out->totals.R = ppb_multipole_total_R(&mp);
     out->totals.T = ppb_multipole_total_T(&mp);
     out->totals.sides = 0;
-    out->totals.ballistic = exp(-sc->sigma_t * sc->height / cos_l);
+    out->totals.ballistic = ppb_ballistic_fraction(sc);
     fill_bins(out, PPB_S1, 0, cos_l * out->totals.R / PPB_PI);
     fill_bins(out, PPB_S2, 0, cos_l * out->totals.T / PPB_PI);
     return 0;

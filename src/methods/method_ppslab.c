@@ -30,8 +30,7 @@ int ppb_method_ppslab(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     if (sc->geometry != PPB_GEOM_SLAB)
         return ppb_fail(err, "ppslab: needs geometry = slab (it is the slab's own solution)");
     double tau0 = sc->height * sc->sigma_t;
-    pp_params p = {tau0, sc->albedo, sc->g, cos(sc->theta_deg * PPB_PI / 180.0),
-                   cfg->pp.directions};
+    pp_params p = {tau0, sc->albedo, sc->g, ppb_scene_cos_theta_l(sc), cfg->pp.directions};
     pp_solution *s = NULL;
     if (pp_solve(&p, &s, err) != 0)
         return -1;

@@ -6,7 +6,7 @@ ppb_layout ppb_scene_layout(const ppb_scene *sc)
 {
     ppb_layout lo = {0};
     int tube = sc->geometry == PPB_GEOM_TUBE;
-    lo.nsurf = tube ? 4 : 2;
+    lo.nsurf = ppb_surface_count(tube);
     lo.nseg[PPB_S1] = lo.nseg[PPB_S2] = tube ? sc->segments_top : 1;
     lo.nseg[PPB_S3] = lo.nseg[PPB_S4] = tube ? sc->segments_side : 0;
     int rows = 0;
@@ -14,9 +14,15 @@ ppb_layout ppb_scene_layout(const ppb_scene *sc)
         lo.offset[s] = rows;
         rows += lo.nseg[s];
     }
-    lo.nbins = sc->ntheta * sc->nphi;
+    lo.nbins = ppb_bin_count(sc->ntheta, sc->nphi);
     lo.ncells = (size_t)rows * (size_t)lo.nbins;
     return lo;
+}
+
+/* Segments of a tube surface (SPEC.md section 2: segments_top on S1/S2, segments_side on S3/S4). */
+static int tube_segments(const ppb_scene *sc, int surf)
+{
+    return (surf == PPB_S1 || surf == PPB_S2) ? sc->segments_top : sc->segments_side;
 }
 
 double ppb_scene_sample_point(const ppb_scene *sc, int surf, int seg, double *x, double *y)
@@ -26,15 +32,34 @@ double ppb_scene_sample_point(const ppb_scene *sc, int surf, int seg, double *x,
         *y = surf == PPB_S1 ? 0.0 : -sc->height;
         return 0.0;
     }
-    int nseg = (surf == PPB_S1 || surf == PPB_S2) ? sc->segments_top : sc->segments_side;
-    return ppb_segment_centre(surf, seg, nseg, sc->width, sc->height, x, y);
+    return ppb_segment_centre(surf, seg, tube_segments(sc, surf), sc->width, sc->height, x, y);
+}
+
+/* theta_L in radians: the one conversion from [light] theta_deg. */
+static double theta_l(const ppb_scene *sc)
+{
+    return sc->theta_deg * PPB_PI / 180.0;
+}
+
+double ppb_scene_cos_theta_l(const ppb_scene *sc)
+{
+    return cos(theta_l(sc));
+}
+
+double ppb_scene_sin_theta_l(const ppb_scene *sc)
+{
+    return sin(theta_l(sc));
+}
+
+double ppb_scene_tan_theta_l(const ppb_scene *sc)
+{
+    return tan(theta_l(sc));
 }
 
 void ppb_scene_light_dir(const ppb_scene *sc, double w[3])
 {
-    double t = sc->theta_deg * PPB_PI / 180.0;
-    w[0] = sin(t);
-    w[1] = -cos(t);
+    w[0] = ppb_scene_sin_theta_l(sc);
+    w[1] = -ppb_scene_cos_theta_l(sc);
     w[2] = 0.0;
 }
 
@@ -47,6 +72,23 @@ double ppb_scene_lit_width(const ppb_scene *sc)
         return lit < 0 ? 0 : (lit > sc->width ? sc->width : lit);
     }
     return sc->width;
+}
+
+double ppb_scene_power_in(const ppb_scene *sc)
+{
+    return ppb_scene_lit_width(sc) * ppb_scene_cos_theta_l(sc);
+}
+
+double ppb_scene_segment_length(const ppb_scene *sc, int surf)
+{
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return 1.0;
+    return ppb_segment_length(surf, tube_segments(sc, surf), sc->width, sc->height);
+}
+
+double ppb_scene_cell_measure(const ppb_scene *sc, int surf)
+{
+    return ppb_scene_segment_length(sc, surf) * ppb_bin_proj_solid_angle(sc->ntheta, sc->nphi);
 }
 
 const char *ppb_surface_name(int surf)

@@ -1,5 +1,8 @@
 /* scene.h: what is being simulated (SPEC.md sections 1-4): geometry, medium, light, bins, and
- * the layout of every radiance array over (surface, segment, bin).
+ * the layout of every radiance array over (surface, segment, bin); the light's angle in the
+ * forms the methods use (theta_L is converted from degrees here only), the power entering the
+ * lit S1 and the segment length x projected solid angle that turn cell energies into average
+ * radiances (SPEC.md section 4).
  *
  * Conventions themselves (frames, bin edges, segment centres, the medium step) live in
  * kernels/ppb_conventions.h so host and kernels share them; this header adds the host-side
@@ -35,21 +38,36 @@ typedef struct ppb_layout {
 
 ppb_layout ppb_scene_layout(const ppb_scene *sc);
 
-/* Flat index of (surface, segment, bin); bin = theta_bin * nphi + phi_bin. */
+/* Flat index of (surface, segment, bin); bin = theta_bin * nphi + phi_bin (ppb_cell_index). */
 static inline size_t ppb_cell(const ppb_layout *lo, int surf, int seg, int bin)
 {
-    return ((size_t)lo->offset[surf] + (size_t)seg) * (size_t)lo->nbins + (size_t)bin;
+    return ppb_cell_index(lo->offset[surf], seg, lo->nbins, bin);
 }
 
 /* Segment centre and coordinate s along the surface (s = 0 in slab mode). */
 double ppb_scene_sample_point(const ppb_scene *sc, int surf, int seg, double *x, double *y);
 
-/* The light direction w_L = (sin theta_L, -cos theta_L, 0). */
+/* The light direction w_L = (sin theta_L, -cos theta_L, 0), and cos, sin and tan of theta_L
+ * (the incidence angle from the S1 normal, [light] theta_deg in degrees). */
 void ppb_scene_light_dir(const ppb_scene *sc, double w[3]);
+double ppb_scene_cos_theta_l(const ppb_scene *sc);
+double ppb_scene_sin_theta_l(const ppb_scene *sc);
+double ppb_scene_tan_theta_l(const ppb_scene *sc);
 
 /* Width of the lit part of S1 (tube) -- the shadow step lights x < step_x only; 1 in slab mode
  * (per unit area). Used to normalise totals (SPEC.md section 4). */
 double ppb_scene_lit_width(const ppb_scene *sc);
+
+/* Power entering the lit part of S1 per unit E_perp: lit width x cos(theta_L) per unit length
+ * in z (tube), cos(theta_L) per unit area (slab). Totals are fractions of it (SPEC.md 4). */
+double ppb_scene_power_in(const ppb_scene *sc);
+
+/* Length of one segment of surface surf (ppb_segment_length); 1 in slab mode (per unit area). */
+double ppb_scene_segment_length(const ppb_scene *sc, int surf);
+
+/* Segment length x projected solid angle of one bin (SPEC.md section 4): a cell's energy per
+ * unit length in z (per unit area in slab mode) divided by this is its average radiance. */
+double ppb_scene_cell_measure(const ppb_scene *sc, int surf);
 
 const char *ppb_surface_name(int surf);
 

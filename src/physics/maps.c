@@ -30,16 +30,15 @@ double ppb_segment_optical_depth(const ppb_scene *sc, double x0, double y0, doub
 void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, double *abar,
                           int *lit)
 {
-    double th = sc->theta_deg * PPB_PI / 180.0;
     double depth = y < 0.0 ? -y : 0.0;
     if (sc->geometry == PPB_GEOM_SLAB) {
-        *D = sc->sigma_t * depth / cos(th);
+        *D = sc->sigma_t * depth / ppb_scene_cos_theta_l(sc);
         *abar = sc->albedo;
         *lit = 1;
         return;
     }
     /* The path runs from (x, y) along -w_L to S1 at x' = x + y tan(theta_L). */
-    double xp = x - depth * tan(th);
+    double xp = x - depth * ppb_scene_tan_theta_l(sc);
     *D = ppb_segment_optical_depth(sc, x, -depth, xp, 0.0);
     *abar = sc->albedo;
     if (sc->step == PPB_STEP_ALBEDO) {
@@ -57,9 +56,8 @@ int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err)
 {
     if (map_res < 1)
         return ppb_fail(err, "maps: map_res must be at least 1 (got %d)", map_res);
-    double th = sc->theta_deg * PPB_PI / 180.0;
     m->tube = sc->geometry == PPB_GEOM_TUBE;
-    m->tan_theta_l = tan(th);
+    m->tan_theta_l = ppb_scene_tan_theta_l(sc);
     m->h = 1.0 / map_res;
     m->ny = (int)ceil(sc->height * map_res - 1e-9);
     if (m->ny < 1)
@@ -117,24 +115,24 @@ double ppb_maps_depth(const ppb_maps *m, double x, double y)
     return lit > 0.0 ? D : INFINITY;
 }
 
-/* Unscattered transmittance of the beam entering S1 at x_e: it leaves through S2, or through S4
- * when oblique light reaches x = W/2 first. */
-static double beam_transmittance(const ppb_scene *sc, double xe)
+double ppb_beam_depth(const ppb_scene *sc, double xe)
 {
-    double th = sc->theta_deg * PPB_PI / 180.0, t = tan(th);
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return sc->sigma_t * sc->height / ppb_scene_cos_theta_l(sc);
+    /* It leaves through S2, or through S4 when oblique light reaches x = W/2 first. */
+    double t = ppb_scene_tan_theta_l(sc);
     double xb = xe + sc->height * t, yb = -sc->height;
     if (xb > 0.5 * sc->width) {
         xb = 0.5 * sc->width;
         yb = -(xb - xe) / t;
     }
-    return exp(-ppb_segment_optical_depth(sc, xe, 0.0, xb, yb));
+    return ppb_segment_optical_depth(sc, xe, 0.0, xb, yb);
 }
 
 double ppb_ballistic_fraction(const ppb_scene *sc)
 {
-    double th = sc->theta_deg * PPB_PI / 180.0;
     if (sc->geometry == PPB_GEOM_SLAB)
-        return exp(-sc->sigma_t * sc->height / cos(th));
+        return exp(-ppb_beam_depth(sc, 0.0)); /* Beer-Lambert: exp(-tau0 / mu0) */
     double a = -0.5 * sc->width, b = 0.5 * sc->width;
     if (sc->step == PPB_STEP_SHADOW)
         b = fmin(b, sc->step_x);
@@ -143,7 +141,7 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
     /* The integrand is smooth between the entry points where the path's end switches from S2 to
      * S4 or where it starts or ends on the step (it may jump there); Gauss-Legendre panels between
      * those breaks never sample a break and are exact to ~1e-14 for these exponentials. */
-    double t = tan(th), brk[5] = {a, b, 0, 0, 0};
+    double t = ppb_scene_tan_theta_l(sc), brk[5] = {a, b, 0, 0, 0};
     int nb = 2;
     double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
     for (int k = 0; k < 3; k++)
@@ -166,7 +164,7 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
         for (int k = 0; hstep > 0.0 && k < panels; k++) {
             double mid = brk[p] + (k + 0.5) * hstep;
             for (int q = 0; q < 5; q++)
-                sum += 0.5 * hstep * gw[q] * beam_transmittance(sc, mid + 0.5 * hstep * gx[q]);
+                sum += 0.5 * hstep * gw[q] * exp(-ppb_beam_depth(sc, mid + 0.5 * hstep * gx[q]));
         }
     }
     return sum / (b - a);

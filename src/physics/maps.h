@@ -43,8 +43,16 @@ void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, do
 /* Exact optical depth of the straight segment (x0, y0)-(x1, y1) through the medium. */
 double ppb_segment_optical_depth(const ppb_scene *sc, double x0, double y0, double x1, double y1);
 
-/* Exact fraction of the power entering the lit part of S1 that leaves unscattered, through any
- * surface (SPEC.md section 4: ballistic). */
+/* Exact optical depth of the unscattered beam from its entry point x_e on S1 to where it leaves
+ * the tube: through S2, or through S4 when oblique light reaches x = W/2 first (theta_L >= 0),
+ * across the density step if it meets it. Slab mode: sigma_t H / cos(theta_L), x_e ignored. */
+double ppb_beam_depth(const ppb_scene *sc, double xe);
+
+/* Fraction of the power entering the lit part of S1 that leaves unscattered, through any
+ * surface (SPEC.md section 4: ballistic): exp(-ppb_beam_depth) averaged over the lit entry
+ * points, by Gauss-Legendre panels between the entry points where the path's end switches from
+ * S2 to S4 or the path starts or ends on the step (~1e-14); exp(-tau0 / mu0) in slab mode. The
+ * one ballistic fraction of every deterministic method. */
 double ppb_ballistic_fraction(const ppb_scene *sc);
 
 #endif

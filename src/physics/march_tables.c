@@ -11,18 +11,12 @@
 
 #include "kernels/march_params.h"
 
-static int nsurfaces(const ppb_scene *sc)
-{
-    return sc->geometry == PPB_GEOM_TUBE ? 4 : 2;
-}
-
 /* Direction sample `dir` in the table order of ppb_march_dir_index. */
 static void table_dir(const ppb_scene *sc, int nsamp, int dir, double w[3])
 {
-    int nbins = sc->ntheta * sc->nphi, per_bin = nsamp * nsamp;
-    int surf = dir / (nbins * per_bin), bin = dir / per_bin % nbins, ab = dir % per_bin;
-    ppb_march_dir(surf, bin, ab / nsamp, ab % nsamp, nsamp, sc->ntheta, sc->nphi, &w[0], &w[1],
-                  &w[2]);
+    int surf, bin, a, b;
+    ppb_march_dir_split(dir, nsamp, ppb_bin_count(sc->ntheta, sc->nphi), &surf, &bin, &a, &b);
+    ppb_march_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
 }
 
 static double beam_phase(const ppb_scene *sc, const double w[3])
@@ -101,7 +95,8 @@ static int alloc_common(const ppb_scene *sc, const table_key *k, ppb_march_table
 {
     memset(t, 0, sizeof *t);
     t->nsamp = k->nsamp;
-    t->ndir = nsurfaces(sc) * sc->ntheta * sc->nphi * k->nsamp * k->nsamp;
+    t->ndir = ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                             ppb_bin_count(sc->ntheta, sc->nphi), k->nsamp);
     t->nalb = k->nalb;
     t->alb0 = k->alb0;
     t->alb_h = k->alb_h;
@@ -327,18 +322,22 @@ static int solve_block(pp_build *b, double tau0, double alb, pp_solution **sol, 
     pp_params prm = {.tau0 = tau0,
                      .albedo = alb,
                      .g = sc->g,
-                     .mu0 = cos(sc->theta_deg * PPB_PI / 180.0),
+                     .mu0 = ppb_scene_cos_theta_l(sc),
                      .directions = b->pp->directions};
     return pp_solve_ex(&prm, b->first, sol, NULL, err);
 }
 
-/* The (column c, albedo node) block: C, and the R and S rows at offset off. */
-static int build_block(pp_build *b, int c, int node, size_t off, ppb_err *err)
+/* The (column c, albedo node) block: C, and the R and S rows (layout: march_params.h). */
+static int build_block(pp_build *b, int c, int node, ppb_err *err)
 {
     ppb_march_tables *t = b->t;
     const ppb_march_col *col = &t->col[c];
     double alb = t->alb0 + node * t->alb_h;
-    double *C = t->C + ((size_t)c * t->nalb + node) * t->ndir;
+    double *C = t->C + ppb_march_coef_offset(c, node, t->nalb, t->ndir);
+    int ntau[PPB_MARCH_MAX_COLS];
+    for (int k = 0; k < t->ncols; k++)
+        ntau[k] = t->col[k].ntau;
+    size_t off = (size_t)ppb_march_table_offset(ntau, c, node, t->nalb, t->ndir);
     if (alb <= 0.0) {
         /* No scattering: no diffuse field; sigma_s = 0 zeroes the source anyway. */
         for (int dir = 0; dir < t->ndir; dir++)
@@ -380,12 +379,9 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
     if (build_begin(&b, &key, err))
         return -1;
     int rc = 0;
-    size_t off = 0; /* of the current (column, albedo node) block in R and S */
     for (int c = 0; c < t->ncols && rc == 0; c++)
-        for (int node = 0; node < t->nalb && rc == 0; node++) {
-            rc = build_block(&b, c, node, off, err);
-            off += (size_t)t->ndir * t->col[c].ntau;
-        }
+        for (int node = 0; node < t->nalb && rc == 0; node++)
+            rc = build_block(&b, c, node, err);
     return build_end(&b, rc);
 }
 

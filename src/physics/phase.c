@@ -25,7 +25,7 @@ static double gauss_order_wanted(double g, double cos_theta_min, double h)
     double ag = fabs(g);
     if (ag < 1e-14)
         return 1; /* isotropic: p is constant */
-    double den = 1.0 + ag * ag - 2.0 * ag * cos_theta_min;
+    double den = ppb_hg_base(ag, cos_theta_min);
     double ratio = sqrt(den / ag) / h;
     double rho = ratio + sqrt(ratio * ratio + 1.0);
     return ceil(log(1.0 / PHASE_TOL) / (2.0 * log(rho)));
@@ -50,14 +50,19 @@ static double peak_angle(double g, const double *a, const double *b)
     return acos(c > 1.0 ? 1.0 : (c < -1.0 ? -1.0 : c));
 }
 
-/* Sum over node pairs of w_a w_b p(x_a . x_b). The inner cell's nodes are copied into
- * columns scaled by 2g (padded to an even count with a zero-weight node) so that the inner loop
- * runs two nodes at a time with SSE2; a scalar loop does the same elsewhere. */
+/* Sum over node pairs of w_a w_b p(x_a . x_b), p in the shared factored form (ppb_conventions.h:
+ * p = ppb_hg_norm(g) / base^(3/2), base = ppb_hg_base(g, cos) = (1 + g^2) - 2g cos), with the
+ * normalisation taken out of the sum and base's two terms split so that the 2g scaling of the
+ * inner cell's nodes leaves the inner loop: the nodes are copied into columns scaled by 2g
+ * (padded to an even count with a zero-weight node) and the loop runs two nodes at a time with
+ * SSE2; a scalar loop does the same elsewhere. It is the hot loop of the phase matrix, which is
+ * why it does not call ppb_hg_phase per pair. */
 static double pair_sum(double g, const double *na, const double *nb, int nq)
 {
     enum { CAP = PP_QMAX * PP_QMAX + 2 };
     double y0[CAP], y1[CAP], y2[CAP], yw[CAP];
-    double c1 = (1.0 - g * g) / (4.0 * PPB_PI), g2 = 1.0 + g * g, tg = 2.0 * g, sum = 0.0;
+    /* g2 = base at cos = 0, i.e. 1 + g^2, exactly */
+    double c1 = ppb_hg_norm(g), g2 = ppb_hg_base(g, 0.0), tg = 2.0 * g, sum = 0.0;
     int np = nq + (nq & 1);
     for (int b = 0; b < np; b++) {
         const double *y = nb + 4 * (b < nq ? b : 0);
@@ -385,10 +390,11 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
         const double *nj = pp_dirs_nodes(d, j, q, err);
         if (!nj)
             return -1;
-        /* point-to-cell: one outer node of weight 1, q x q inner nodes */
-        double c1 = (1.0 - g * g) / (4.0 * PPB_PI), sum = 0.0;
+        /* point-to-cell: one outer node of weight 1, q x q inner nodes; p factored as in
+         * pair_sum */
+        double c1 = ppb_hg_norm(g), sum = 0.0;
         for (int b = 0; b < q * q; b++) {
-            double den = 1.0 + g * g - 2.0 * g * dot3(point, nj + 4 * b);
+            double den = ppb_hg_base(g, dot3(point, nj + 4 * b));
             sum += nj[4 * b + 3] / (den * sqrt(den));
         }
         F[j] = c1 * sum;
