@@ -68,6 +68,39 @@ static void test_config_errors(void **state)
     expect(args, 2, "--set medium.gg: unknown key");
 }
 
+/* The method ids are checked by the registry on every path that loads a config (run, sweep,
+ * mc-shard, mc-merge), before any work, with exit code 2; the expected text is the config's
+ * own line and ids. */
+static void test_method_errors(void **state)
+{
+    (void)state;
+    const char *cmds[] = {"run", "sweep", "mc-shard --out /nonexistent-dir/x",
+                          "mc-merge --out /nonexistent-dir/x"};
+    char args[1400], want[1400], path[1200];
+    for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++) {
+        snprintf(path, sizeof path, "%s",
+                 config("cli-unknown", "[experiment]\nmethods = mc, xx\n"));
+        snprintf(args, sizeof args, "%s %s%s", cmds[i], path, i == 3 ? " /nonexistent-dir/p" : "");
+        snprintf(want, sizeof want,
+                 "ppbench: %s:2: [experiment] methods: unknown method 'xx' (see ppbench --help)\n",
+                 path);
+        expect(args, 2, want);
+        snprintf(path, sizeof path, "%s",
+                 config("cli-slabonly", "[experiment]\nname = a\n\nmethods = ppslab\n"));
+        snprintf(args, sizeof args, "%s %s%s", cmds[i], path, i == 3 ? " /nonexistent-dir/p" : "");
+        snprintf(want, sizeof want,
+                 "ppbench: %s:4: [experiment] methods: method 'ppslab' runs in slab mode only\n",
+                 path);
+        expect(args, 2, want);
+    }
+    snprintf(path, sizeof path, "%s", config("cli-tube", "[tube]\nwidth = 5\n"));
+    snprintf(args, sizeof args, "run --set experiment.methods=mc,zz %s", path);
+    expect(args, 2,
+           "ppbench: --set experiment.methods: unknown method 'zz' (see ppbench --help)\n");
+    snprintf(args, sizeof args, "run --set experiment.methods=ppslab %s", path);
+    expect(args, 2, "ppbench: --set experiment.methods: method 'ppslab' runs in slab mode only\n");
+}
+
 static void test_devices_and_keys(void **state)
 {
     (void)state;
@@ -92,6 +125,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_help_and_usage),
         cmocka_unit_test(test_config_errors),
+        cmocka_unit_test(test_method_errors),
         cmocka_unit_test(test_devices_and_keys),
     };
     return cmocka_run_group_tests_name("cli", tests, NULL, NULL);

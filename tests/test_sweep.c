@@ -127,6 +127,9 @@ static void test_bad_sweeps(void **state)
         {"[medium]\ng = 0:x:0.1\n", "is not a number"},
         {"[medium]\ng = 0\n", "nothing to sweep"},
         {"[medium]\ng = -0.9:0.9:0.01\nalbedo = 0:1:0.01\n", "over the limit"},
+        /* The registry's check of the method ids (methods/registry.c) runs before any work. */
+        {"[experiment]\nmethods = mc, xx\n[medium]\ng = 0, 0.5\n",
+         ":2: .experiment. methods: unknown method .xx. (see ppbench --help)"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         snprintf(cfg, sizeof cfg, "%s/bad%zu.ini", d, i);

@@ -7,6 +7,7 @@
 #include "base/atomic_file.h"
 #include "io/csv.h"
 #include "io/images.h"
+#include "methods/registry.h"
 #include "base/progress.h"
 
 #ifndef PPB_VERSION
@@ -154,9 +155,6 @@ static int write_comparisons(const ppb_experiment *ex, ppb_err *err)
             return -1;
         out_path(ex, "summary.csv", path, sizeof path);
         if (ppb_write_summary_csv(path, ex->res, ex->n, ref, skip_for(ref), err))
-            return -1;
-        out_path(ex, "regions.csv", path, sizeof path);
-        if (ppb_write_regions_csv(path, sc, ex->res, ex->n, ref, skip_for(ref), err))
             return -1;
     }
     for (int i = 0; i < ex->n; i++) {

@@ -64,7 +64,7 @@ static int load_sum(const ppb_config *cfg, const char *const *dirs, int ndirs, p
 
 int ppb_mc_shard_merge(const ppb_config *cfg, const char *const *dirs, int ndirs, ppb_err *err)
 {
-    static ppb_experiment ex;
+    ppb_experiment ex = {0};
     ppb_mc_tallies sum = {0};
     int rc = load_sum(cfg, dirs, ndirs, &sum, err);
     ppb_layout lo = ppb_scene_layout(&cfg->scene);

@@ -91,7 +91,7 @@ static int write_tables(const char *dir, const char *const *cases, int ncases, p
     fprintf(csv.f, "case,cell,method,rms_rel,noise_rel,rms_excess,paper_rms_rel\n");
     fputs("| case | cell | method | RMS % | noise floor % | excess % | paper % |\n", md.f);
     fprintf(md.f, "|---|---|---|---|---|---|---|\n");
-    static summary_row rows[512];
+    summary_row rows[512]; /* 36 KB */
     for (int c = 0; c < ncases; c++) {
         int n = read_summary(dir, cases[c], rows, 512, err);
         if (n < 0) {

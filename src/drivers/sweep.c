@@ -46,12 +46,12 @@ static int exists(const char *path)
     return stat(path, &st) == 0;
 }
 
-static void write_header(const ppb_config *cfg, FILE *f)
+static void write_header(const ppb_grid *grid, FILE *f)
 {
     fprintf(f, "point");
-    for (int a = 0; a < cfg->naxes; a++) {
+    for (int a = 0; a < grid->naxes; a++) {
         char name[64];
-        ppb_config_key_name(cfg->axes[a].key, name, sizeof name);
+        ppb_config_key_name(grid->axes[a].key, name, sizeof name);
         fprintf(f, ",%s", name);
     }
     fprintf(f, ",method");
@@ -62,7 +62,7 @@ static void write_header(const ppb_config *cfg, FILE *f)
 
 /* One row per method of a point: its parameters, the RMS per summary cell against the Monte
  * Carlo (empty without one), the noise floor at x = 0 and the totals. */
-static void write_rows(const ppb_config *cfg, const ppb_config *pt, long long i,
+static void write_rows(const ppb_grid *grid, const ppb_config *pt, long long i,
                        const ppb_experiment *ex, FILE *f)
 {
     const ppb_result *ref = ppb_experiment_reference(ex);
@@ -71,8 +71,8 @@ static void write_rows(const ppb_config *cfg, const ppb_config *pt, long long i,
     ppb_point *pts = malloc(sizeof *pts * (size_t)(cap > 2 ? cap : 2));
     for (int m = 0; m < ex->n; m++) {
         fprintf(f, "%lld", i);
-        for (int a = 0; a < cfg->naxes; a++)
-            fprintf(f, ",%.10g", ppb_config_key_value(pt, cfg->axes[a].key));
+        for (int a = 0; a < grid->naxes; a++)
+            fprintf(f, ",%.10g", ppb_config_key_value(pt, grid->axes[a].key));
         fprintf(f, ",%s", ex->res[m].method);
         ppb_rms x0[2] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
         for (int c = 0; c < PPB_NCELLS; c++) {
@@ -92,10 +92,10 @@ static void write_rows(const ppb_config *cfg, const ppb_config *pt, long long i,
     free(pts);
 }
 
-static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i, ppb_run_ctx *ctx,
-                     ppb_err *err)
+static int run_point(const ppb_config *cfg, const ppb_grid *grid, const ppb_config *pt, long long i,
+                     ppb_run_ctx *ctx, ppb_err *err)
 {
-    static ppb_experiment ex;
+    ppb_experiment ex = {0};
     double t0 = ppb_now();
     int rc = ppb_experiment_compute(&ex, pt, ctx, err);
     if (rc == 0 && !ex.partial) {
@@ -109,7 +109,7 @@ static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i, p
         }
         point_file(cfg->out_dir, h, "csv", path, sizeof path);
         if (rc == 0 && (rc = ppb_afile_open(&af, path, err)) == 0) {
-            write_rows(cfg, pt, i, &ex, af.f);
+            write_rows(grid, pt, i, &ex, af.f);
             rc = ppb_afile_commit(&af, err);
         }
     }
@@ -118,34 +118,35 @@ static int run_point(const ppb_config *cfg, const ppb_config *pt, long long i, p
 }
 
 /* Every point is resolved and checked before any work starts. */
-static int check_grid(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
+static int check_grid(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o,
+                      ppb_err *err)
 {
-    long long n = ppb_config_npoints(cfg);
-    if (cfg->naxes == 0)
+    long long n = ppb_grid_npoints(grid);
+    if (grid->naxes == 0)
         return ppb_fail(err, "%s: no key holds a list: nothing to sweep (use ppbench run)",
                         cfg->path);
     if (n > PPB_SWEEP_MAX_POINTS && !o->yes)
         return ppb_fail(err, "%s: the grid has %lld points, over the limit of %d: add --yes",
                         cfg->path, n, PPB_SWEEP_MAX_POINTS);
-    static ppb_config pt;
+    ppb_config pt;
     for (long long i = 0; i < n; i++)
-        if (ppb_config_point(cfg, i, &pt, err))
+        if (ppb_config_point(cfg, grid, i, &pt, err))
             return -1;
     return 0;
 }
 
 /* grid.txt: the header of sweep.csv, then each point's hash in grid order; merge reads it. */
-static int write_grid(const ppb_config *cfg, ppb_err *err)
+static int write_grid(const ppb_config *cfg, const ppb_grid *grid, ppb_err *err)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/grid.txt", cfg->out_dir);
     ppb_afile af;
     if (ppb_afile_open(&af, path, err))
         return -1;
-    write_header(cfg, af.f);
-    static ppb_config pt;
-    for (long long i = 0; i < ppb_config_npoints(cfg); i++) {
-        ppb_config_point(cfg, i, &pt, NULL);
+    write_header(grid, af.f);
+    ppb_config pt;
+    for (long long i = 0; i < ppb_grid_npoints(grid); i++) {
+        ppb_config_point(cfg, grid, i, &pt, NULL);
         fprintf(af.f, "%016llx\n", (unsigned long long)point_hash(&pt));
     }
     return ppb_afile_commit(&af, err);
@@ -221,11 +222,11 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
 }
 
 /* The points with index % parts == part, one device context for all of them. */
-static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, int parts, int quiet,
-                     ppb_err *err)
+static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o, int part,
+                     int parts, int quiet, ppb_err *err)
 {
-    long long n = ppb_config_npoints(cfg);
-    static ppb_config pt;
+    long long n = ppb_grid_npoints(grid);
+    ppb_config pt;
     ppb_progress pr;
     ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
     /* Points that share a medium share the marcher's tables: built once per process. */
@@ -235,11 +236,11 @@ static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, i
     int rc = 0;
     for (long long i = part; i < n && rc == 0 && !ppb_interrupted(); i += parts) {
         char path[1300];
-        if ((rc = ppb_config_point(cfg, i, &pt, err)) != 0)
+        if ((rc = ppb_config_point(cfg, grid, i, &pt, err)) != 0)
             break;
         point_file(cfg->out_dir, point_hash(&pt), "csv", path, sizeof path);
         if (!exists(path))
-            rc = run_point(cfg, &pt, i, &ctx, err);
+            rc = run_point(cfg, grid, &pt, i, &ctx, err);
         ppb_progress_update(&pr, (double)++done * parts);
     }
     ppb_ctx_close(&ctx);
@@ -250,11 +251,12 @@ static int run_shard(const ppb_config *cfg, const ppb_sweep_opts *o, int part, i
 
 /* --jobs J: J processes, each its own device context, taking every J-th point of this shard;
  * the first one shows progress. A failing child's message is on its stderr. */
-static int run_jobs(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
+static int run_jobs(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o,
+                    ppb_err *err)
 {
     int jobs = o->jobs > 1 ? o->jobs : 1, parts = o->shard_n * jobs;
     if (jobs == 1)
-        return run_shard(cfg, o, o->shard_i - 1, o->shard_n, o->quiet, err);
+        return run_shard(cfg, grid, o, o->shard_i - 1, o->shard_n, o->quiet, err);
     fflush(NULL);
     pid_t pids[64];
     for (int j = 0; j < jobs; j++) {
@@ -263,7 +265,8 @@ static int run_jobs(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err
             return ppb_fail(err, "--jobs: fork failed");
         if (pids[j] == 0) {
             ppb_err e = {{0}};
-            int rc = run_shard(cfg, o, o->shard_i - 1 + o->shard_n * j, parts, o->quiet || j, &e);
+            int rc =
+                run_shard(cfg, grid, o, o->shard_i - 1 + o->shard_n * j, parts, o->quiet || j, &e);
             if (rc)
                 fprintf(stderr, "ppbench sweep (job %d): %s\n", j + 1, e.msg);
             _exit(rc ? 1 : 0);
@@ -278,15 +281,16 @@ static int run_jobs(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err
     return failed ? ppb_fail(err, "%d of %d jobs failed", failed, jobs) : 0;
 }
 
-int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
+int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o,
+                  ppb_err *err)
 {
-    if (check_grid(cfg, o, err))
+    if (check_grid(cfg, grid, o, err))
         return PPB_SWEEP_BAD_CONFIG;
     char dir[1200];
     snprintf(dir, sizeof dir, "%s/points", cfg->out_dir);
-    if (ppb_mkdirs(dir, err) || write_grid(cfg, err))
+    if (ppb_mkdirs(dir, err) || write_grid(cfg, grid, err))
         return -1;
-    if (run_jobs(cfg, o, err))
+    if (run_jobs(cfg, grid, o, err))
         return -1;
     if (ppb_interrupted())
         return 0;
@@ -294,7 +298,7 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err)
     long long missing = assemble(dirs, 1, cfg->out_dir, err);
     if (missing < 0)
         return -1;
-    if (missing == 0 && ppb_sweep_heatmaps(cfg, cfg->out_dir, err))
+    if (missing == 0 && ppb_sweep_heatmaps(cfg, grid, cfg->out_dir, err))
         return -1;
     if (!o->quiet && missing)
         fprintf(stderr, "%s: %lld points left to other shards; merge when done\n", cfg->name,

@@ -11,8 +11,9 @@
 #ifndef PPB_SWEEP_H
 #define PPB_SWEEP_H
 
-#include "model/config.h"
 #include "base/err.h"
+#include "model/config.h"
+#include "model/grid.h"
 
 #define PPB_SWEEP_BAD_CONFIG 2
 #define PPB_SWEEP_MAX_POINTS 10000 /* larger grids need --yes */
@@ -24,9 +25,11 @@ typedef struct ppb_sweep_opts {
     int jobs;             /* processes on this machine (each opens the device), 1 = serial */
 } ppb_sweep_opts;
 
-/* Returns 0, -1 on a run failure, PPB_SWEEP_BAD_CONFIG when the grid is refused before any
- * work starts. */
-int ppb_sweep_run(const ppb_config *cfg, const ppb_sweep_opts *o, ppb_err *err);
+/* Runs the grid points of cfg (its keys holding lists, loaded into grid by
+ * ppb_config_load_grid). Returns 0, -1 on a run failure, PPB_SWEEP_BAD_CONFIG when the grid
+ * is refused before any work starts. */
+int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o,
+                  ppb_err *err);
 int ppb_sweep_merge(const char *const *dirs, int n, const char *out_dir, ppb_err *err);
 
 #endif

@@ -4,9 +4,10 @@
 #ifndef PPB_SWEEP_PLOT_H
 #define PPB_SWEEP_PLOT_H
 
-#include "model/config.h"
 #include "base/err.h"
+#include "model/config.h"
+#include "model/grid.h"
 
-int ppb_sweep_heatmaps(const ppb_config *cfg, const char *dir, ppb_err *err);
+int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir, ppb_err *err);
 
 #endif

@@ -1,43 +1,5 @@
 #include "methods/method.h"
 
-#include <string.h>
-
-#include "methods/method_mc.h"
-#include "methods/method_mp.h"
-#include "methods/method_pp.h"
-#include "methods/method_ppslab.h"
-#include "methods/method_ss.h"
-
-/* The registry: the order here is the order of outputs. */
-static const ppb_method methods[] = {
-    {"mc", "mc1", 0, 1, "photon Monte Carlo reference (mc1: its once-scattered part)",
-     ppb_method_mc},
-    {"pp", NULL, 0, 0, "plane-parallel ray marching, the paper's method", ppb_method_pp},
-    {"ss", NULL, 0, 0, "single scattering by ray marching", ppb_method_ss},
-    {"mp", NULL, 0, 0, "multipole diffusion", ppb_method_mp},
-    {"mp+ss", NULL, 0, 0, "multipole diffusion plus single scattering", ppb_method_mp_ss},
-    {"ppslab", NULL, 1, 2, "plane-parallel solution at the slab faces (slab mode only)",
-     ppb_method_ppslab},
-};
-
-int ppb_method_count(void)
-{
-    return (int)(sizeof methods / sizeof methods[0]);
-}
-
-const ppb_method *ppb_method_at(int i)
-{
-    return (i >= 0 && i < ppb_method_count()) ? &methods[i] : NULL;
-}
-
-const ppb_method *ppb_method_find(const char *id)
-{
-    for (int i = 0; i < ppb_method_count(); i++)
-        if (strcmp(methods[i].id, id) == 0)
-            return &methods[i];
-    return NULL;
-}
-
 int ppb_ctx_ocl(ppb_run_ctx *ctx, ppb_ocl **ocl, ppb_err *err)
 {
     if (!ctx->ocl_open) {

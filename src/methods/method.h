@@ -1,4 +1,6 @@
-/* method.h: the one interface every method implements, and the registry of method ids.
+/* method.h: the one interface every method implements: what a method receives (ppb_run_ctx,
+ * with the OpenCL device opened on first use) and what describes it (ppb_method). The table of
+ * methods and the lookup by id are the registry's (methods/registry.h).
  *
  * A method, given the experiment (scene and settings), fills radiance per (surface, segment,
  * bin) and its totals. A method may also produce a second result in the same run (mc writes
@@ -40,9 +42,5 @@ typedef struct ppb_method {
     const char *summary;
     ppb_method_fn run;
 } ppb_method;
-
-const ppb_method *ppb_method_find(const char *id);
-int ppb_method_count(void);
-const ppb_method *ppb_method_at(int i);
 
 #endif

@@ -4,14 +4,46 @@
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
-#include "methods/method.h"
+#include "kernels/march_params.h"
 
 typedef enum { K_INT, K_LLONG, K_REAL, K_ENUM, K_NAME, K_PATH, K_METHODS } key_type;
+
+/* What `ppbench keys` calls each type. */
+static const char *const type_names[] = {
+    [K_INT] = "integer",
+    [K_LLONG] = "integer",
+    [K_REAL] = "real",
+    [K_ENUM] = "one of",
+    [K_NAME] = "name",
+    [K_PATH] = "path",
+    [K_METHODS] = "list of method ids",
+};
+
+/* The names of an enum key's values, each paired with its C enum value, so that parsing,
+ * printing and `ppbench keys` never depend on the order of the enum. Ends at name NULL; the
+ * order here is the order `ppbench keys` lists them. */
+typedef struct enum_name {
+    int value;
+    const char *name;
+} enum_name;
+
+static const enum_name geometry_names[] = {
+    {PPB_GEOM_TUBE, "tube"}, {PPB_GEOM_SLAB, "slab"}, {0, NULL}};
+static const enum_name step_names[] = {{PPB_STEP_NONE, "none"},
+                                       {PPB_STEP_DENSITY, "density"},
+                                       {PPB_STEP_ALBEDO, "albedo"},
+                                       {PPB_STEP_SHADOW, "shadow"},
+                                       {0, NULL}};
+static const enum_name table_names[] = {{PPB_TABLE_R, "R"}, {PPB_TABLE_S, "S"}, {0, NULL}};
+
+/* An enum key is stored as an int (ppb_scene.geometry is a ppb_geometry). */
+_Static_assert(sizeof(ppb_geometry) == sizeof(int), "enum keys are stored as int");
 
 typedef struct key_def {
     const char *section, *key;
@@ -19,7 +51,7 @@ typedef struct key_def {
     size_t offset;
     double min, max;
     const char *def;
-    const char *enums; /* "a|b|c" for K_ENUM: stored as the index */
+    const enum_name *enums; /* K_ENUM: the value names */
     const char *help;
 } key_def;
 
@@ -28,7 +60,7 @@ typedef struct key_def {
 static const key_def keys[] = {
     {"experiment", "name", K_NAME, F(name), 0, 0, "", NULL,
      "experiment name; default: the config file's base name"},
-    {"experiment", "geometry", K_ENUM, F(scene.geometry), 0, 0, "tube", "tube|slab",
+    {"experiment", "geometry", K_ENUM, F(scene.geometry), 0, 0, "tube", geometry_names,
      "the tube of SPEC.md 2, or the infinite slab of thickness `height`"},
     {"experiment", "methods", K_METHODS, F(methods), 0, 0, "mc, pp, ss, mp, mp+ss", NULL,
      "method ids, comma-separated (`ppbench --help` lists them)"},
@@ -44,7 +76,7 @@ static const key_def keys[] = {
     {"medium", "albedo", K_REAL, F(scene.albedo), 0, 1, "0.95", NULL,
      "single-scattering albedo (left of the step)"},
     {"medium", "g", K_REAL, F(scene.g), -0.95, 0.95, "0", NULL, "Henyey-Greenstein asymmetry"},
-    {"medium", "step", K_ENUM, F(scene.step), 0, 0, "none", "none|density|albedo|shadow",
+    {"medium", "step", K_ENUM, F(scene.step), 0, 0, "none", step_names,
      "what changes at x = step_x (tube only)"},
     {"medium", "step_x", K_REAL, F(scene.step_x), -500, 500, "0", NULL,
      "position of the step, mfp; inside the tube"},
@@ -77,7 +109,7 @@ static const key_def keys[] = {
      "direction cells per hemisphere (M = 2 x directions)"},
     {"pp", "modes", K_INT, F(pp.modes), 0, 8000, "0", NULL,
      "n_e: modes kept by the march, 0 = all"},
-    {"pp", "table", K_ENUM, F(pp.table), 0, 0, "S", "R|S",
+    {"pp", "table", K_ENUM, F(pp.table), 0, 0, "S", table_names,
      "integral table of the march: R (Eq. 15) or S (Eq. 16-17)"},
     {"pp", "step", K_REAL, F(pp.step), 1e-4, 1, "0.05", NULL, "ray-march step, mfp"},
     {"pp", "albedos", K_INT, F(pp.albedos), 2, 64, "9", NULL,
@@ -207,21 +239,38 @@ static void store_number(ppb_config *cfg, const key_def *k, double v)
         *(double *)p = v;
 }
 
+/* "a|b|c": the names of an enum key, as errors and `ppbench keys` show them. */
+static void enum_list(const enum_name *e, char *buf, size_t cap)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    for (int j = 0; e[j].name && len < cap; j++)
+        len += (size_t)snprintf(buf + len, cap - len, "%s%s", j ? "|" : "", e[j].name);
+}
+
+static const char *enum_value_name(const enum_name *e, int value)
+{
+    for (int j = 0; e[j].name; j++)
+        if (e[j].value == value)
+            return e[j].name;
+    return "?";
+}
+
 static int parse_enum(const key_def *k, const char *text, int *out, char *why, size_t n)
 {
-    const char *p = k->enums;
-    for (int i = 0; *p; i++) {
-        size_t len = strcspn(p, "|");
-        if (strlen(text) == len && strncasecmp(p, text, len) == 0) {
-            *out = i;
+    for (int j = 0; k->enums[j].name; j++)
+        if (strcasecmp(k->enums[j].name, text) == 0) {
+            *out = k->enums[j].value;
             return 0;
         }
-        p += len + (p[len] == '|');
-    }
-    snprintf(why, n, "'%s' is not one of %s", text, k->enums);
+    char names[256];
+    enum_list(k->enums, names, sizeof names);
+    snprintf(why, n, "'%s' is not one of %s", text, names);
     return -1;
 }
 
+/* Method ids as a list of strings: whether each names a method is the method registry's
+ * business (ppb_methods_check), checked once the config is loaded. */
 static int parse_methods(ppb_config *cfg, const char *text, char *why, size_t n)
 {
     char buf[1024];
@@ -230,8 +279,9 @@ static int parse_methods(ppb_config *cfg, const char *text, char *why, size_t n)
     for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
          tok = strtok_r(NULL, ",", &save)) {
         tok = trim(tok);
-        if (!ppb_method_find(tok)) {
-            snprintf(why, n, "unknown method '%s' (see ppbench --help)", tok);
+        if (strlen(tok) >= sizeof cfg->methods[0]) {
+            snprintf(why, n, "method id '%s' is longer than %zu characters", tok,
+                     sizeof cfg->methods[0] - 1);
             return -1;
         }
         for (int i = 0; i < cfg->nmethods; i++)
@@ -268,8 +318,8 @@ static int parse_string(const key_def *k, char *dst, size_t cap, const char *tex
     return 0;
 }
 
-/* Sets key i from text; a list on a numeric key becomes a sweep axis. */
-static int set_key(ppb_config *cfg, int i, const char *text, int line, char *why, size_t n)
+/* Sets key i from text; a list on a numeric key becomes an axis of grid (NULL: refused). */
+static int set_key(ppb_config *cfg, ppb_grid *grid, int i, const char *text, char *why, size_t n)
 {
     const key_def *k = &keys[i];
     char *p = (char *)cfg + k->offset;
@@ -292,21 +342,43 @@ static int set_key(ppb_config *cfg, int i, const char *text, int line, char *why
     store_number(cfg, k, vals[0]);
     if (count == 1)
         return 0;
-    if (cfg->naxes == PPB_MAX_AXES) {
+    if (!grid) {
+        snprintf(why, n, "a list (a sweep) is not accepted here");
+        return -1;
+    }
+    if (grid->naxes == PPB_MAX_AXES) {
         snprintf(why, n, "more than %d swept keys", PPB_MAX_AXES);
         return -1;
     }
-    ppb_axis *ax = &cfg->axes[cfg->naxes++];
-    ax->key = i;
-    ax->line = line;
-    ax->n = count;
-    memcpy(ax->values, vals, (size_t)count * sizeof vals[0]);
+    if (ppb_grid_add(grid, i, vals, count)) {
+        snprintf(why, n, "out of memory");
+        return -1;
+    }
     return 0;
+}
+
+/* inih reports the line of the first error but passes no line to the handler (the system
+ * library is built without INI_HANDLER_LINENO); reading through this counter gives the line
+ * inih is on, which inih itself counts once per read. */
+typedef struct line_reader {
+    FILE *f;
+    int line;
+} line_reader;
+
+static char *read_line(char *str, int num, void *stream)
+{
+    line_reader *r = stream;
+    char *s = fgets(str, num, r->f);
+    r->line += s != NULL;
+    return s;
 }
 
 typedef struct parse_state {
     ppb_config *cfg;
+    ppb_grid *grid;
+    line_reader *in;
     char seen[PPB_MAX_KEYS];
+    int err_line; /* line of the first key error, 0 = none */
     char why[1200];
     char what[128];
 } parse_state;
@@ -314,8 +386,11 @@ typedef struct parse_state {
 static int on_key(void *user, const char *section, const char *name, const char *value)
 {
     parse_state *st = user;
+    if (st->err_line)
+        return 1; /* inih reads on after an error; the first one is reported */
     int i = find_key(section, name);
     snprintf(st->what, sizeof st->what, "[%s] %s", section, name);
+    st->err_line = st->in->line;
     if (i < 0) {
         snprintf(st->why, sizeof st->why, "%s",
                  section_known(section) ? "unknown key" : "unknown section");
@@ -326,42 +401,25 @@ static int on_key(void *user, const char *section, const char *name, const char 
         return 0;
     }
     st->seen[i] = 1;
-    return set_key(st->cfg, i, value, 0, st->why, sizeof st->why) == 0;
-}
-
-/* inih reports the line of the first failing key, but not the line of every key; the checks
- * that span keys run after parsing and find a key's line by reading the file again. */
-static int line_of(const char *path, const char *section, const char *key)
-{
-    FILE *f = fopen(path, "r");
-    if (!f)
+    st->cfg->origin[i].line = st->in->line;
+    if (set_key(st->cfg, st->grid, i, value, st->why, sizeof st->why))
         return 0;
-    char buf[4096], cur[128] = "";
-    int line = 0, found = 0;
-    while (!found && fgets(buf, sizeof buf, f)) {
-        line++;
-        char *s = trim(buf);
-        if (*s == '[') {
-            char *e = strchr(s, ']');
-            if (e)
-                *e = '\0';
-            snprintf(cur, sizeof cur, "%s", trim(s + 1));
-            continue;
-        }
-        char *eq = strpbrk(s, "=:");
-        if (!eq || strcmp(cur, section) != 0)
-            continue;
-        *eq = '\0';
-        found = strcmp(trim(s), key) == 0;
-    }
-    fclose(f);
-    return found ? line : 0;
+    st->err_line = 0;
+    return 1;
 }
 
-static int key_error(const ppb_config *cfg, const char *section, const char *key, ppb_err *err,
-                     const char *why)
+int ppb_config_key_fail(const ppb_config *cfg, const char *section, const char *key, ppb_err *err,
+                        const char *fmt, ...)
 {
-    int line = line_of(cfg->path, section, key);
+    char why[1200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, sizeof why, fmt, ap);
+    va_end(ap);
+    int i = find_key(section, key);
+    if (i >= 0 && cfg->origin[i].from_set)
+        return ppb_fail(err, "--set %s.%s: %s", section, key, why);
+    int line = i >= 0 ? cfg->origin[i].line : 0;
     return ppb_fail(err, "%s:%d: [%s] %s: %s", cfg->path, line, section, key, why);
 }
 
@@ -371,17 +429,11 @@ static int validate(const ppb_config *cfg, ppb_err *err)
     const ppb_scene *sc = &cfg->scene;
     int slab = sc->geometry == PPB_GEOM_SLAB;
     if (slab && sc->step != PPB_STEP_NONE)
-        return key_error(cfg, "medium", "step", err, "steps are refused in slab mode (SPEC.md 2)");
+        return ppb_config_key_fail(cfg, "medium", "step", err,
+                                   "steps are refused in slab mode (SPEC.md 2)");
     if (!slab && sc->step != PPB_STEP_NONE && fabs(sc->step_x) >= 0.5 * sc->width)
-        return key_error(cfg, "medium", "step_x", err, "the step must lie inside the tube");
-    for (int i = 0; i < cfg->nmethods; i++) {
-        const ppb_method *m = ppb_method_find(cfg->methods[i]);
-        if (m->slab_only && !slab) {
-            char why[128];
-            snprintf(why, sizeof why, "method '%s' runs in slab mode only", m->id);
-            return key_error(cfg, "experiment", "methods", err, why);
-        }
-    }
+        return ppb_config_key_fail(cfg, "medium", "step_x", err,
+                                   "the step must lie inside the tube");
     return 0;
 }
 
@@ -397,10 +449,9 @@ static int apply_defaults(ppb_config *cfg, ppb_err *err)
 {
     char why[512];
     for (int i = 0; i < NKEYS; i++)
-        if (set_key(cfg, i, keys[i].def, 0, why, sizeof why))
+        if (set_key(cfg, NULL, i, keys[i].def, why, sizeof why))
             return ppb_fail(err, "internal: default of [%s] %s: %s", keys[i].section, keys[i].key,
                             why);
-    cfg->naxes = 0;
     return 0;
 }
 
@@ -412,28 +463,27 @@ int ppb_config_defaults(ppb_config *cfg, ppb_err *err)
     return apply_defaults(cfg, err);
 }
 
-int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)
+int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err *err)
 {
     memset(cfg, 0, sizeof *cfg);
+    if (grid)
+        ppb_grid_clear(grid);
     snprintf(cfg->path, sizeof cfg->path, "%s", path);
     if (apply_defaults(cfg, err))
         return -1;
     FILE *f = fopen(path, "r");
     if (!f)
         return ppb_fail(err, "%s: cannot open config: %s", path, strerror(errno));
-    parse_state st = {.cfg = cfg};
-    int rc = ini_parse_file(f, on_key, &st);
+    line_reader in = {.f = f};
+    parse_state st = {.cfg = cfg, .grid = grid, .in = &in};
+    int rc = ini_parse_stream(read_line, &in, on_key, &st);
     fclose(f);
-    if (rc > 0 && st.why[0])
+    if (rc > 0 && rc == st.err_line)
         return ppb_fail(err, "%s:%d: %s: %s", path, rc, st.what, st.why);
     if (rc > 0)
         return ppb_fail(err, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
     if (rc < 0)
         return ppb_fail(err, "%s: cannot read config", path);
-    for (int a = 0; a < cfg->naxes; a++) {
-        const key_def *k = &keys[cfg->axes[a].key];
-        cfg->axes[a].line = line_of(path, k->section, k->key);
-    }
     if (!cfg->name[0])
         base_name(path, cfg->name, sizeof cfg->name);
     if (!cfg->out_dir[0])
@@ -441,8 +491,13 @@ int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)
     return validate(cfg, err);
 }
 
-int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const char *value,
-                   ppb_err *err)
+int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)
+{
+    return ppb_config_load_grid(cfg, NULL, path, err);
+}
+
+int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, const char *key,
+                        const char *value, ppb_err *err)
 {
     int i = find_key(section, key);
     if (i < 0)
@@ -450,39 +505,29 @@ int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const 
                         section_known(section) ? "unknown key" : "unknown section");
     char why[1200];
     /* A key set again replaces an earlier list on it. */
-    for (int a = 0; a < cfg->naxes; a++)
-        if (cfg->axes[a].key == i) {
-            memmove(&cfg->axes[a], &cfg->axes[a + 1],
-                    (size_t)(cfg->naxes - a - 1) * sizeof cfg->axes[0]);
-            cfg->naxes--;
-            break;
-        }
-    if (set_key(cfg, i, value, 0, why, sizeof why))
+    if (grid)
+        ppb_grid_remove(grid, i);
+    if (set_key(cfg, grid, i, value, why, sizeof why))
         return ppb_fail(err, "--set %s.%s: %s", section, key, why);
+    cfg->origin[i].from_set = 1;
     return validate(cfg, err);
 }
 
-long long ppb_config_npoints(const ppb_config *cfg)
+int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const char *value,
+                   ppb_err *err)
 {
-    long long n = 1;
-    for (int a = 0; a < cfg->naxes; a++)
-        n *= cfg->axes[a].n;
-    return n;
+    return ppb_config_set_grid(cfg, NULL, section, key, value, err);
 }
 
-int ppb_config_point(const ppb_config *cfg, long long i, ppb_config *out, ppb_err *err)
+int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, ppb_config *out,
+                     ppb_err *err)
 {
-    long long n = ppb_config_npoints(cfg);
+    long long n = ppb_grid_npoints(grid);
     if (i < 0 || i >= n)
         return ppb_fail(err, "grid point %lld out of range [0, %lld)", i, n);
     *out = *cfg;
-    out->naxes = 0;
-    /* Row-major: the last axis varies fastest. */
-    for (int a = cfg->naxes - 1; a >= 0; a--) {
-        const ppb_axis *ax = &cfg->axes[a];
-        store_number(out, &keys[ax->key], ax->values[i % ax->n]);
-        i /= ax->n;
-    }
+    for (int a = 0; grid && a < grid->naxes; a++)
+        store_number(out, &keys[grid->axes[a].key], ppb_grid_value(grid, a, i));
     return validate(out, err);
 }
 
@@ -499,14 +544,9 @@ static void write_value(const ppb_config *cfg, const key_def *k, FILE *out)
     case K_REAL:
         fprintf(out, "%.17g", *(const double *)p);
         break;
-    case K_ENUM: {
-        int v = *(const int *)p;
-        const char *e = k->enums;
-        for (int j = 0; j < v; j++)
-            e += strcspn(e, "|") + 1;
-        fprintf(out, "%.*s", (int)strcspn(e, "|"), e);
+    case K_ENUM:
+        fprintf(out, "%s", enum_value_name(k->enums, *(const int *)p));
         break;
-    }
     case K_METHODS:
         for (int j = 0; j < cfg->nmethods; j++)
             fprintf(out, "%s%s", j ? ", " : "", cfg->methods[j]);
@@ -527,18 +567,16 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out)
 
 void ppb_config_write_keys(FILE *out)
 {
-    static const char *types[] = {"integer", "integer",           "real", "one of", "name",
-                                  "path",    "list of method ids"};
     fprintf(out, "| section | key | type | default | range | meaning |\n");
     fprintf(out, "|---|---|---|---|---|---|\n");
     for (int i = 0; i < NKEYS; i++) {
         const key_def *k = &keys[i];
-        char range[128] = "";
+        char range[256] = "";
         if (k->type == K_ENUM)
-            snprintf(range, sizeof range, "%s", k->enums);
-        else if (k->type <= K_REAL)
+            enum_list(k->enums, range, sizeof range);
+        else if (k->type == K_INT || k->type == K_LLONG || k->type == K_REAL)
             snprintf(range, sizeof range, "[%g, %g]", k->min, k->max);
-        fprintf(out, "| %s | %s | %s | %s | %s | %s |\n", k->section, k->key, types[k->type],
+        fprintf(out, "| %s | %s | %s | %s | %s | %s |\n", k->section, k->key, type_names[k->type],
                 k->def[0] ? k->def : "(see meaning)", range, k->help);
     }
 }

@@ -1,21 +1,25 @@
 /* config.h: an experiment's settings, read from an INI file (SPEC.md section 9 plus the
  * method settings documented in configs/README.md).
  *
- * Owns the key table (section, key, type, default, range): parsing, validation, defaults and
- * the documentation all come from that one table in config.c. A numeric key may hold a list
- * ("0, 0.5, 0.9" or "0:1:0.25"), which makes the config a sweep; ppb_config_point() resolves
- * one grid point to plain values. Errors read "file:line: key: reason". */
+ * Owns the key table (section, key, type, default, range) and the name table of every enum
+ * key: parsing, validation, defaults and the documentation all come from those tables in
+ * config.c. A numeric key may hold a list ("0, 0.5, 0.9" or "0:1:0.25"), which makes the config
+ * a sweep: the lists go into a grid the caller owns (model/grid.h) and ppb_config_point()
+ * resolves one grid point to plain values. Errors read "file:line: [section] key: reason".
+ *
+ * The config knows no methods: `methods` is a list of id strings, checked against the method
+ * registry by the methods layer (ppb_methods_check in methods/registry.h). For such later
+ * checks the config records where each key was set (ppb_config_key_fail). */
 #ifndef PPB_CONFIG_H
 #define PPB_CONFIG_H
 
 #include <stdio.h>
 
 #include "base/err.h"
+#include "model/grid.h"
 #include "model/scene.h"
 
 #define PPB_MAX_METHODS 16
-#define PPB_MAX_AXES    8
-#define PPB_MAX_LIST    1024
 #define PPB_MAX_KEYS    64
 
 typedef struct ppb_mc_settings {
@@ -42,19 +46,17 @@ typedef struct ppb_mp_settings {
     int samples; /* quadrature nodes per mfp over the lit strip */
 } ppb_mp_settings;
 
-/* One swept key: its table index and values. */
-typedef struct ppb_axis {
-    int key;
-    int line;
-    int n;
-    double values[PPB_MAX_LIST];
-} ppb_axis;
+/* Where a key's value came from, so that checks made after loading name the right place. */
+typedef struct ppb_key_origin {
+    int line;     /* line of the key in the config file, 0 = not in the file */
+    int from_set; /* 1: last set by ppb_config_set (--set on the command line) */
+} ppb_key_origin;
 
 typedef struct ppb_config {
     char path[1024];
     char name[128];
     int nmethods;
-    char methods[PPB_MAX_METHODS][32];
+    char methods[PPB_MAX_METHODS][32]; /* ids as written; methods/registry.h checks them */
     ppb_scene scene;
     int samples_dir; /* directions per bin axis for deterministic methods (n x n per bin) */
     int samples_seg; /* points per segment for deterministic methods */
@@ -62,25 +64,33 @@ typedef struct ppb_config {
     ppb_pp_settings pp;
     ppb_mp_settings mp;
     char out_dir[1024];
-    int key_line[PPB_MAX_KEYS]; /* line of each key in the file, 0 = default */
-    int naxes;                  /* keys holding lists: a sweep */
-    ppb_axis axes[PPB_MAX_AXES];
+    ppb_key_origin origin[PPB_MAX_KEYS]; /* per key of the table */
 } ppb_config;
 
 /* Every key at its default (the study's settings); no file involved. */
 int ppb_config_defaults(ppb_config *cfg, ppb_err *err);
 
-/* Loads and validates a config; on error nothing in *cfg is meaningful. */
-int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err);
+/* Loads and validates a config; on error nothing in *cfg is meaningful. A key holding a list
+ * becomes an axis of grid (emptied first; a key keeps its list's first value in *cfg); with grid
+ * NULL a list is an error. */
+int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err *err);
+int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err); /* grid NULL */
 
-/* Sets one key from a string as if it stood in the file (used by tests and --set). */
+/* Sets one key from a string as if it stood in the file (used by tests and --set); a list
+ * replaces the key's axis in grid (NULL: lists refused), a plain value removes it. */
+int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, const char *key,
+                        const char *value, ppb_err *err);
 int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const char *value,
-                   ppb_err *err);
+                   ppb_err *err); /* grid NULL */
 
-/* Number of grid points (1 when nothing is swept), and the config of point i (row-major over
- * the axes in file order). */
-long long ppb_config_npoints(const ppb_config *cfg);
-int ppb_config_point(const ppb_config *cfg, long long i, ppb_config *out, ppb_err *err);
+/* The config of grid point i (model/grid.h), validated; grid NULL has the one point 0. */
+int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, ppb_config *out,
+                     ppb_err *err);
+
+/* Fails with why (printf format) about a key, named where it was set: "file:line: [section]
+ * key: why" (line 0 when the key kept its default), or "--set section.key: why". Returns -1. */
+int ppb_config_key_fail(const ppb_config *cfg, const char *section, const char *key, ppb_err *err,
+                        const char *fmt, ...) __attribute__((format(printf, 5, 6)));
 
 /* Writes every resolved key as "section.key = value" lines: the canonical form hashed for
  * resume and recorded in provenance. */
@@ -89,7 +99,7 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out);
 /* The key table as a Markdown table (configs/README.md is generated from it). */
 void ppb_config_write_keys(FILE *out);
 
-/* Name of swept key k ("medium.g") into buf, and its value in cfg. */
+/* Name of key k of the table ("medium.g", as in ppb_axis.key) into buf, and its value in cfg. */
 void ppb_config_key_name(int key, char *buf, size_t cap);
 double ppb_config_key_value(const ppb_config *cfg, int key);
 

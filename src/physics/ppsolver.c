@@ -531,10 +531,6 @@ int pp_solve(const pp_params *p, pp_solution **out, ppb_err *err)
     return pp_solve_ex(p, NULL, out, NULL, err);
 }
 
-pp_params pp_get_params(const pp_solution *s)
-{
-    return s->p;
-}
 double pp_mu0(const pp_solution *s)
 {
     return s->p.mu0;
@@ -548,11 +544,6 @@ void pp_modes(const pp_solution *s, double *lambda, double *tau_ref)
 {
     memcpy(lambda, s->lambda, (size_t)s->nmodes * sizeof(double));
     memcpy(tau_ref, s->tau_ref, (size_t)s->nmodes * sizeof(double));
-}
-
-const double *pp_mode_vector(const pp_solution *s, int k)
-{
-    return s->V + (size_t)k * s->m;
 }
 
 void pp_totals(const pp_solution *s, double *R, double *T, double *ballistic)

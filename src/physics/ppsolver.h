@@ -61,17 +61,13 @@ int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out,
                 ppb_err *err);
 void pp_free(pp_solution *s);
 
-/* The parameters solved, with mu0 as used (see the resonance note above). */
-pp_params pp_get_params(const pp_solution *s);
+/* mu0 as used (see the resonance note above). */
 double pp_mu0(const pp_solution *s);
 
 /* Homogeneous modes (M of them: 2N, or 2N - 1 at alpha = 1), sorted by |lambda| ascending;
  * e_k(tau) = exp(lambda_k (tau - tau_ref_k)), tau_ref_k = 0 if lambda_k < 0 else tau0. */
 int pp_nmodes(const pp_solution *s);
 void pp_modes(const pp_solution *s, double *lambda, double *tau_ref);
-/* Mode k's cell vector times its boundary coefficient c_k (length 2N, cells as in
- * directions.h): I(tau) = sum_k pp_mode_vector(k) e_k(tau) + particular + linear. */
-const double *pp_mode_vector(const pp_solution *s, int k);
 
 /* Source function for scattering into the continuous direction w (unit vector, tube frame),
  * per unit optical depth, E_perp = 1:
