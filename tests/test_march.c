@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "methods/march.h"
+#include "methods/method_pp.h"
 #include "physics/ppsolver.h"
 
 static ppb_ocl g_ocl;
@@ -681,7 +682,7 @@ static void test_march_method_cache(void **state)
         if (ppb_result_init(&r[i], "pp", &lo, &err))
             fail_msg("%s", err.msg);
         ctx.march_cache = i == 0 ? NULL : (i == 1 ? ppb_march_cache_new() : ctx.march_cache);
-        if (ppb_march_method(&ctx, &r[i], 1, &err))
+        if (ppb_method_pp(&ctx, &r[i], &err))
             fail_msg("%s", err.msg);
     }
     long hits, builds;

@@ -51,7 +51,4 @@ void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *r
  * S march reads its table only at piece ends, the R march at every step). */
 #define PPB_MARCH_TAU_PER_MFP 64
 
-/* Both methods' shared run: maps, tables (pp when with_modes, else ss), march, totals. */
-int ppb_march_method(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err);
-
 #endif

@@ -1,9 +1,56 @@
-/* method_pp.c: the paper's method, plane-parallel ray marching (method_pp.h). */
+/* method_pp.c: the paper's method, plane-parallel ray marching (method_pp.h): the pipeline of
+ * the paper's Fig. 3, from the light maps through the slab tables to the march. */
 #include "methods/method_pp.h"
+
+#include <string.h>
 
 #include "methods/march.h"
 
+int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err)
+{
+    const ppb_config *cfg = ctx->cfg;
+    const ppb_scene *sc = &cfg->scene;
+    ppb_ocl *ocl;
+    if (ppb_ctx_ocl(ctx, &ocl, err))
+        return -1;
+    /* 1. The light maps over the cross-section: optical depth D along the light path and its
+     *    average albedo (Sec. 3.3). */
+    ppb_maps maps = {0};
+    ppb_march_tables own = {0};
+    const ppb_march_tables *tab = &own;
+    if (ppb_maps_build(sc, cfg->pp.map_res, &maps, err))
+        return -1;
+    /* 2. The integral tables R or S from the plane-parallel solution of each column's slab
+     *    (Sec. 3.2, Eq. 15-17); `ss` keeps the direct beam's term only. */
+    int rc;
+    if (ctx->march_cache)
+        /* A sweep's earlier grid point may have built these very tables (byte-identical). */
+        rc = ppb_march_cache_tables(ctx->march_cache, sc, &cfg->pp, cfg->samples_dir,
+                                    PPB_MARCH_TAU_PER_MFP, with_modes, &tab, err);
+    else
+        rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
+                                              &own, err)
+                        : ppb_march_tables_ss(sc, cfg->samples_dir, &own, err);
+    if (rc) {
+        ppb_maps_free(&maps);
+        return -1;
+    }
+    /* 3. The march along every viewing ray of every (segment, bin) cell (Sec. 3.4, Fig. 3),
+     *    then the totals of SPEC.md section 4. */
+    ppb_march_opts opts = {
+        .table = cfg->pp.table, .step = cfg->pp.step, .telescope = 1, .npts = cfg->samples_seg};
+    rc = ppb_march_all(ocl, sc, &maps, tab, &opts, out->method, ctx->quiet, out->radiance,
+                       &out->partial, err);
+    if (!rc) {
+        memset(out->se, 0, out->layout.ncells * sizeof *out->se);
+        ppb_march_totals(sc, &out->layout, out->radiance, &out->totals);
+    }
+    ppb_march_tables_free(&own);
+    ppb_maps_free(&maps);
+    return rc;
+}
+
 int ppb_method_pp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
-    return ppb_march_method(ctx, out, 1, err);
+    return ppb_pp_pipeline(ctx, out, 1, err);
 }

@@ -9,4 +9,8 @@
 /* Fills out[0] with the bin-averaged exit radiance and the totals of SPEC.md section 4. */
 int ppb_method_pp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
+/* The pipeline itself: maps, tables, march, totals. with_modes = 0 keeps only the attenuated
+ * direct beam's single scattering in the tables: that is `ss` (method_ss.h). */
+int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err);
+
 #endif

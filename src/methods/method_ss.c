@@ -1,9 +1,9 @@
 /* method_ss.c: single scattering by ray marching (method_ss.h). */
 #include "methods/method_ss.h"
 
-#include "methods/march.h"
+#include "methods/method_pp.h"
 
 int ppb_method_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
-    return ppb_march_method(ctx, out, 0, err);
+    return ppb_pp_pipeline(ctx, out, 0, err);
 }
