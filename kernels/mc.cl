@@ -49,6 +49,9 @@ typedef PPB_VEC(uint) vuint;
 #define CONVERT_VINT   PPB_CAT(convert_int, PPB_MC_LANES)
 #define LANES          PPB_MC_LANES
 
+/* Uniforms and the scattering samplers (tests/test_mc.c runs them alone). */
+#include "ppb_sampling.h"
+
 /* Philox4x32-10 of PPB_MC_LANES counters (Random123's round and key schedule). */
 typedef struct ppb_mc_vctr {
     vuint v0, v1, v2, v3;
@@ -69,17 +72,6 @@ inline ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
     return c;
 }
 
-/* Philox output word to a uniform in (0, 1): 23 bits plus half a step, exact in float, never 0
- * (log) nor 1. */
-inline vfloat ppb_mc_uniform(vuint r)
-{
-    return (CONVERT_VFLOAT(r >> 9) + 0.5f) * 0x1p-23f;
-}
-inline float ppb_mc_uniform1(uint r)
-{
-    return ((float)(r >> 9) + 0.5f) * 0x1p-23f;
-}
-
 /* Natural log of x in (0, 1], by the fdlibm/musl logf reduction (x = 2^k (1 + f),
  * log(1 + f) = 2 atanh(f / (2 + f)) by a minimax polynomial in s^2); relative error below
  * 1e-7 over the uniforms drawn here. */
@@ -93,34 +85,6 @@ inline vfloat ppb_mc_log(vfloat x)
     vfloat t2 = z * (0.66666662693f + w * 0.28498786688f);
     vfloat hfsq = 0.5f * f * f;
     return s * (hfsq + t1 + t2) + k * 9.0580006145e-06f - hfsq + f + k * 6.9313812256e-01f;
-}
-
-/* sin and cos of 2 pi u for u in (0, 1): reduction to the nearest quadrant (exact in float),
- * then Taylor polynomials on [-pi/4, pi/4] (truncation below 3e-8). */
-inline vfloat ppb_mc_sincos2pi(vfloat u, vfloat *c)
-{
-    vfloat t = 4.0f * u;
-    vfloat q = floor(t + 0.5f);
-    vfloat r = (t - q) * 1.57079632679f;
-    vfloat r2 = r * r;
-    vfloat sr =
-        r *
-        (1.0f + r2 * (-1.0f / 6 + r2 * (1.0f / 120 + r2 * (-1.0f / 5040 + r2 * (1.0f / 362880)))));
-    vfloat cr = 1.0f + r2 * (-0.5f + r2 * (1.0f / 24 + r2 * (-1.0f / 720 + r2 * (1.0f / 40320))));
-    vint quadrant = CONVERT_VINT(q) & 3;
-    vint q1 = quadrant == 1, q2 = quadrant == 2, q3 = quadrant == 3;
-    vfloat s = select(select(select(sr, cr, q1), -sr, q2), -cr, q3);
-    *c = select(select(select(cr, -sr, q1), -cr, q2), sr, q3);
-    return s;
-}
-
-/* Henyey-Greenstein cosine by inversion (e.g. Wang, Jacques & Zheng 1995, MCML Eq. 3.28). */
-inline vfloat ppb_mc_hg_cos(float g, float inv_2g, vfloat u)
-{
-    if (fabs(g) < 1e-4f)
-        return 2.0f * u - 1.0f;
-    vfloat s = (1.0f - g * g) / (1.0f - g + 2.0f * g * u);
-    return clamp((1.0f + g * g - s * s) * inv_2g, -1.0f, 1.0f);
 }
 
 /* Segment of an exit point on surface surf (slab: always 0). */

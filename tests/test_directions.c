@@ -1,6 +1,6 @@
-/* test_directions.c: the equal-area direction cells (src/physics/directions.h): exact solid angles
- * and mean cosines, the two mirror symmetries, closure under w -> -w, cell lookup, and the
- * quadrature nodes. */
+/* test_directions.c: the equal-area direction cells (src/physics/directions.h): ring and cell
+ * areas, solid angles and mean cosines against a Monte Carlo over the sphere, the two mirror
+ * symmetries, closure under w -> -w, cell lookup, and the quadrature nodes. */
 #include "testutil.h"
 
 #include <math.h>
@@ -11,10 +11,10 @@
 
 static const int sizes[] = {2, 7, 64, 334, 1000};
 
-/* Both partitions (default and antipodal): every cell 2 pi / N, so the 2N cells cover 4 pi exactly;
- * each ring's mu span times 2 pi is its cells' total (dOmega = dmu dphi: the exact area of a (mu,
- * phi) rectangle). */
-static void test_solid_angles_exact(void **state)
+/* Both partitions (default and antipodal): each ring's mu span times 2 pi is its cells' total
+ * (dOmega = dmu dphi: the exact area of a (mu, phi) rectangle), the rings tile [0, 1] in mu, and
+ * every cell's own (mu, phi) rectangle has the area |Omega| = 2 pi / N. */
+static void test_ring_areas(void **state)
 {
     (void)state;
     for (size_t t = 0; t < 2 * sizeof sizes / sizeof *sizes; t++) {
@@ -24,15 +24,83 @@ static void test_solid_angles_exact(void **state)
         assert_int_equal(t < sizeof sizes / sizeof *sizes ? pp_dirs_make(n, &d, &err)
                                                           : pp_dirs_make_antipodal(n, &d, &err),
                          0);
-        assert_true(fabs(2 * d.n * d.solid - 4 * PI) < 1e-12);
         double mu_sum = 0.0;
         for (int r = 0; r < d.nrings; r++) {
             int count = d.ring_first[r + 1] - d.ring_first[r];
             double area = (d.mu_edge[r] - d.mu_edge[r + 1]) * 2 * PI;
-            assert_true(fabs(area - count * d.solid) < 1e-13);
+            assert_close(area, count * d.solid, 1e-13);
             mu_sum += d.mu_edge[r] - d.mu_edge[r + 1];
         }
-        assert_true(fabs(mu_sum - 1.0) < 1e-15 && d.mu_edge[d.nrings] == 0.0);
+        assert_close(mu_sum, 1.0, 1e-15);
+        assert_close(d.mu_edge[d.nrings], 0.0, 0.0);
+        for (int i = 0; i < 2 * d.n; i++) {
+            double mu_lo, mu_hi, phi_lo, phi_hi;
+            pp_dirs_bounds(&d, i, &mu_lo, &mu_hi, &phi_lo, &phi_hi);
+            assert_close((mu_hi - mu_lo) * (phi_hi - phi_lo), d.solid, 1e-13);
+        }
+        pp_dirs_free(&d);
+    }
+}
+
+/* splitmix64 (Steele, Lea & Flood 2014): the test's own uniform stream, to (0, 1). */
+static double uniform01(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return ((double)((z ^ (z >> 31)) >> 11) + 0.5) * 0x1p-53;
+}
+
+/* Monte Carlo over the sphere, independent of how the cells were built: directions uniform on
+ * the sphere as normalised Gaussian vectors (Box-Muller; Marsaglia 1972), 500 per cell, looked up
+ * with pp_dirs_cell_of. (1) The counts: each cell should get the fraction |Omega_i| / (4 pi) =
+ * 1 / (2N); Pearson's chi-square over the 2N cells (2N - 1 degrees of freedom) must have
+ * p > 1e-4. (2) The mean of mu over the directions that land in cell i estimates k_i (SPEC.md
+ * section 10: k_i = |Omega_i|^-1 integral of mu over the cell); the z-scores against k_i, with
+ * the sample standard deviation, summed in squares over the cells, are again chi-square with 2N
+ * degrees of freedom. This replaces the check that the 2N cells of 2 pi / N cover 4 pi, which
+ * holds by the definition of |Omega|. */
+static void test_cells_by_monte_carlo(void **state)
+{
+    (void)state;
+    assert_rel(tu_chi2_pvalue(20, 2), exp(-10), 1e-13); /* two degrees of freedom: exp(-x/2) */
+    uint64_t rng = 12345;
+    for (size_t t = 0; t < 2 * sizeof sizes / sizeof *sizes; t++) {
+        pp_dirs d;
+        ppb_err err;
+        int n = sizes[t % (sizeof sizes / sizeof *sizes)], m = 2 * n;
+        assert_int_equal(t < sizeof sizes / sizeof *sizes ? pp_dirs_make(n, &d, &err)
+                                                          : pp_dirs_make_antipodal(n, &d, &err),
+                         0);
+        long total = 500L * m, *count = calloc((size_t)m, sizeof *count);
+        double *sum = calloc((size_t)m, sizeof *sum), *sum2 = calloc((size_t)m, sizeof *sum2);
+        assert_true(count && sum && sum2);
+        for (long k = 0; k < total; k++) {
+            double w[3], norm = 0;
+            for (int c = 0; c < 3; c++) {
+                w[c] = sqrt(-2 * log(uniform01(&rng))) * cos(2 * PI * uniform01(&rng));
+                norm += w[c] * w[c];
+            }
+            for (int c = 0; c < 3; c++)
+                w[c] /= sqrt(norm);
+            int i = pp_dirs_cell_of(&d, w);
+            assert_in_range(i, 0, m - 1);
+            count[i]++, sum[i] += w[1], sum2[i] += w[1] * w[1];
+        }
+        double e = (double)total / m, chi2 = 0, z2 = 0;
+        for (int i = 0; i < m; i++) {
+            chi2 += (count[i] - e) * (count[i] - e) / e;
+            double mean = sum[i] / count[i];
+            double var = (sum2[i] - count[i] * mean * mean) / (count[i] - 1);
+            z2 += (mean - d.k[i]) * (mean - d.k[i]) / (var / count[i]);
+        }
+        double p_count = tu_chi2_pvalue(chi2, m - 1), p_k = tu_chi2_pvalue(z2, m);
+        if (!(p_count > 1e-4 && p_k > 1e-4))
+            fail_msg("N = %d%s: cell counts chi^2 = %.1f (p = %.3g), mean cosines chi^2 = %.1f (p "
+                     "= %.3g) over %d cells",
+                     n, t < sizeof sizes / sizeof *sizes ? "" : " antipodal", chi2, p_count, z2,
+                     p_k, m);
+        free(count), free(sum), free(sum2);
         pp_dirs_free(&d);
     }
 }
@@ -51,8 +119,8 @@ static void test_mean_cosines_exact(void **state)
         double mu = 0.0, wsum = 0.0;
         for (int a = 0; a < 64; a++)
             mu += nodes[4 * a + 1] * nodes[4 * a + 3], wsum += nodes[4 * a + 3];
-        assert_true(fabs(wsum - d.solid) < 1e-15);
-        assert_true(fabs(mu / d.solid - d.k[i]) < 1e-12);
+        assert_close(wsum, d.solid, 1e-15);
+        assert_close(mu / d.solid, d.k[i], 1e-12);
     }
     pp_dirs_free(&d);
 }
@@ -76,7 +144,7 @@ static void test_mirror_symmetries(void **state)
             int m = pp_dirs_zmirror(&d, i);
             assert_int_equal(pp_dirs_cell_of(&d, zm), m);
             assert_int_equal(d.ring[m], d.ring[i]);
-            assert_true(d.k[d.n + i] == -d.k[i]);
+            assert_close(d.k[d.n + i], -d.k[i], 0.0);
         }
         pp_dirs_free(&d);
     }
@@ -104,11 +172,13 @@ static void test_partition_is_antipodal(void **state)
         pp_dirs_free(&plain);
         for (int r = 0; r < d.nrings; r++) {
             int count = d.ring_first[r + 1] - d.ring_first[r];
-            assert_true(count == 1 || count % 2 == 0);
+            if (!(count == 1 || count % 2 == 0))
+                fail_msg("N = %d: ring %d has %d cells, neither one nor even", sizes[t], r, count);
         }
         for (int i = 0; i < 2 * d.n; i++) {
             int a = pp_dirs_antipode(&d, i);
-            assert_true(a >= 0 && a < 2 * d.n && (a < d.n) != (i < d.n));
+            assert_in_range(a, 0, 2 * d.n - 1);
+            assert_int_not_equal(a < d.n, i < d.n);
             assert_int_equal(pp_dirs_antipode(&d, a), i);
             const double *c = d.centre + 3 * i;
             double minus[3] = {-c[0], -c[1], -c[2]};
@@ -144,7 +214,8 @@ static void test_nodes_lie_in_their_cell(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_solid_angles_exact),
+        cmocka_unit_test(test_ring_areas),
+        cmocka_unit_test(test_cells_by_monte_carlo),
         cmocka_unit_test(test_mean_cosines_exact),
         cmocka_unit_test(test_mirror_symmetries),
         cmocka_unit_test(test_partition_is_antipodal),

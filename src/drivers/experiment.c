@@ -156,6 +156,9 @@ static int write_comparisons(const ppb_experiment *ex, ppb_err *err)
         out_path(ex, "summary.csv", path, sizeof path);
         if (ppb_write_summary_csv(path, ex->res, ex->n, ref, skip_for(ref), err))
             return -1;
+        out_path(ex, "regions.csv", path, sizeof path);
+        if (ppb_write_regions_csv(path, sc, ex->res, ex->n, ref, skip_for(ref), err))
+            return -1;
     }
     for (int i = 0; i < ex->n; i++) {
         if (!is_secondary(ex->res[i].method))

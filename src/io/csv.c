@@ -83,6 +83,31 @@ int ppb_write_summary_csv(const char *path, const ppb_result *rs, int n, const p
     return ppb_afile_commit(&af, err);
 }
 
+int ppb_write_regions_csv(const char *path, const ppb_scene *sc, const ppb_result *rs, int n,
+                          const ppb_result *ref, const char *skip, ppb_err *err)
+{
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    fprintf(af.f, "method,region,rms_rel,noise_rel,rms_excess\n");
+    const ppb_layout *lo = &ref->layout;
+    int cap = lo->nseg[PPB_S1] > 1 ? lo->nseg[PPB_S1] : 1;
+    ppb_point pts[cap];
+    for (int m = 0; m < n; m++) {
+        if (!measured(&rs[m], ref, skip))
+            continue;
+        for (int region = 0; region < PPB_NREGIONS; region++) {
+            int np = ppb_region_points(sc, lo, region, pts, cap);
+            if (np == 0)
+                continue; /* slab mode, or a region no segment centre falls in */
+            ppb_rms e = ppb_rms_points(&rs[m], ref, pts, np);
+            fprintf(af.f, "%s,%s,%.6g,%.6g,%.6g\n", rs[m].method, ppb_region_name(region),
+                    e.rms_rel, e.noise_rel, e.rms_excess);
+        }
+    }
+    return ppb_afile_commit(&af, err);
+}
+
 int ppb_write_totals_csv(const char *path, const ppb_result *rs, int n, ppb_err *err)
 {
     ppb_afile af;

@@ -4,13 +4,19 @@
 
 ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_point *pts, int n)
 {
+    return ppb_rms_points_w(m, ref, pts, n, NULL);
+}
+
+ppb_rms ppb_rms_points_w(const ppb_result *m, const ppb_result *ref, const ppb_point *pts, int n,
+                         const double *w)
+{
     const ppb_layout *lo = &ref->layout;
-    /* Every bin has the same projected solid angle (SPEC.md 4), so w_k is a common factor;
-     * it is kept so that unequal bins would only need this line changed. */
-    double wk = 1.0;
     double num = 0, den = 0, noise = 0;
     for (int p = 0; p < n; p++)
         for (int k = 0; k < lo->nbins; k++) {
+            /* Equal bins (SPEC.md 4): w_k is a common factor of both sums and cancels; 1.0
+             * keeps the sums exactly those of the unweighted formula. */
+            double wk = w ? w[k] : 1.0;
             size_t c = ppb_cell(lo, pts[p].surf, pts[p].seg, k);
             double d = m->radiance[c] - ref->radiance[c];
             num += wk * d * d;
@@ -65,4 +71,51 @@ int ppb_cell_points(const ppb_layout *lo, int cell, ppb_point *pts, int cap)
     for (int i = 0; i < n; i++)
         pts[i] = (ppb_point){surf, i};
     return n;
+}
+
+const char *ppb_region_name(int region)
+{
+    static const char *names[PPB_NREGIONS] = {
+        "S1:x<x0-2", "S1:x>x0+2", "S1:|x-x0|<=2", "S1:x<-W/2+3", "S1:x>W/2-3",
+        "S2:x<x0-2", "S2:x>x0+2", "S2:|x-x0|<=2", "S2:x<-W/2+3", "S2:x>W/2-3"};
+    return (region >= 0 && region < PPB_NREGIONS) ? names[region] : "?";
+}
+
+/* Whether a segment centre s lies in a region (of the PPB_REGION_* kinds). The bounds are
+ * strict for the one-sided regions and inclusive for the middle one, so that left, right and
+ * the step region partition the surface. */
+static int in_region(const ppb_scene *sc, int kind, double s)
+{
+    double x0 = sc->step != PPB_STEP_NONE ? sc->step_x : 0.0;
+    double half = 0.5 * sc->width;
+    switch (kind) {
+    case PPB_REGION_LEFT:
+        return s < x0 - 2;
+    case PPB_REGION_RIGHT:
+        return s > x0 + 2;
+    case PPB_REGION_STEP:
+        return fabs(s - x0) <= 2;
+    case PPB_REGION_WALL_LEFT:
+        return s < -half + 3;
+    case PPB_REGION_WALL_RIGHT:
+        return s > half - 3;
+    default:
+        return 0;
+    }
+}
+
+int ppb_region_points(const ppb_scene *sc, const ppb_layout *lo, int region, ppb_point *pts,
+                      int cap)
+{
+    if (sc->geometry != PPB_GEOM_TUBE || region < 0 || region >= PPB_NREGIONS)
+        return 0;
+    int surf = region < PPB_NREGIONS_PER_SURF ? PPB_S1 : PPB_S2;
+    int kind = region % PPB_NREGIONS_PER_SURF;
+    int count = 0;
+    for (int seg = 0; seg < lo->nseg[surf] && count < cap; seg++) {
+        double x, y;
+        if (in_region(sc, kind, ppb_scene_sample_point(sc, surf, seg, &x, &y)))
+            pts[count++] = (ppb_point){surf, seg};
+    }
+    return count;
 }
