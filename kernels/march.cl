@@ -32,6 +32,20 @@ inline double ppb_phi1(double z)
     return fabs(z) < 1e-300 ? 1.0 : expm1(z) / z;
 }
 
+/* The direct beam's factor exp(e_a) phi1(z) over a step whose exponent runs from e_a to
+ * e_b = e_a + z <= 0, times C sigma_t h (in the association the march always used). As written,
+ * exp(e_a) phi1(z) is 0 x inf once e_a underflows while z overflows (a grazing beam in a thick
+ * medium marched towards the light: e_a ~ -D, z ~ +D; issue 15's NaN); the scaled form exp(e_b) (1
+ * - e^{-z}) / z is the same number without either. It is taken only below e_a = -700, where
+ * exp(e_a) leaves the normal range: since e_b <= 0 bounds z by -e_a, neither factor can overflow
+ * above that threshold, and the direct form keeps its bits there. */
+inline double ppb_beam_step(double C, double sigma_t, double h, double e_a, double z)
+{
+    if (e_a < -700.0 && z > 0.0)
+        return C * sigma_t * h * (exp(e_a + z) * (-expm1(-z) / z));
+    return C * exp(e_a) * sigma_t * h * ppb_phi1(z);
+}
+
 /* One column slab's tables: its tau grid and where its blocks start in the R, S and C arrays. */
 typedef struct ppb_mcol {
     double tau0, tau_h;
@@ -57,8 +71,8 @@ inline ppb_msample ppb_sample(const ppb_march_params *P, __global const double *
                               double px, double py, double mx, double my, double l)
 {
     ppb_msample s;
-    ppb_map_lookup(map, P->map_xp0, P->map_h, P->map_nx, P->map_ny, P->tan_theta_l, px + l * mx,
-                   py + l * my, &s.D, &s.abar, &s.lit);
+    ppb_map_lookup(map, P->map_xp0, P->map_h, P->map_i0, P->map_nx, P->map_ny, P->tan_theta_l,
+                   px + l * mx, py + l * my, &s.D, &s.abar, &s.lit);
     s.tau = clamp(s.D * P->cos_theta_l, 0.0, tau0);
     return s;
 }
@@ -135,7 +149,8 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
         ppb_anodes an = ppb_albedo_nodes(P, a.abar);
         double C = ppb_coef(coefC, ndir, dir, an);
         /* The direct beam's steps summed: one exponential over the piece. */
-        sum = C * exp(-(d0 + a.D)) * sigma_t * len * ppb_phi1(-(sigma_t * len + b.D - a.D));
+        double e_a = -(d0 + a.D), z = -(sigma_t * len + b.D - a.D);
+        sum = ppb_beam_step(C, sigma_t, len, e_a, z);
         if (P->with_modes && P->table == PPB_TABLE_S &&
             ppb_slope_ok(a.tau, b.tau, r0, sigma_t, len - 2.0 * eps)) {
             sum += exp(-*d) * ppb_table(tabS, col, ndir, dir, an, b.tau) -
@@ -164,7 +179,8 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
         if (sm.lit > 0.0) {
             ppb_anodes an = ppb_albedo_nodes(P, sm.abar);
             double C = ppb_coef(coefC, ndir, dir, an);
-            double v = C * exp(-(d1 + s1.D)) * sigma_t * h * ppb_phi1(-(sigma_t * h + s2.D - s1.D));
+            double e_a = -(d1 + s1.D), z = -(sigma_t * h + s2.D - s1.D);
+            double v = ppb_beam_step(C, sigma_t, h, e_a, z);
             if (P->with_modes) {
                 double hs = (i == 0 ? h - eps : h) - (i + 1 == n ? eps : 0.0);
                 if (P->table == PPB_TABLE_S && ppb_slope_ok(s1.tau, s2.tau, r0, sigma_t, hs))

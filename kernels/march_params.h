@@ -70,7 +70,9 @@ typedef struct ppb_march_params {
     double d_cap; /* optical distance from the exit point beyond which the march stops */
     int tube;     /* 1 tube, 0 slab */
     int step_kind;
-    int map_nx, map_ny;
+    int map_nx, map_ny; /* cells stored */
+    int map_i0;         /* grid column of the first stored cell column (maps.h) */
+    int map_pad;        /* unused: keeps the count of ints even */
     int ntau[PPB_MARCH_MAX_COLS], nalb;
     int ncols;      /* column slabs in the tables, 1 or 2 */
     int with_modes; /* 0: single scattering (ss), no tables */
@@ -132,20 +134,21 @@ PPB_FN long ppb_march_coef_offset(int c, int node, int nalb, int ndir)
 
 /* Bilinear map lookup at (x, y): D, average albedo and lit fraction. x is sheared along the light
  * (x' = x + y tan theta_L) so that every light path is a grid column: D is linear along it and
- * shadow edges are column edges. Points off the grid take the nearest cell's extrapolation
- * clamped to it. */
-PPB_FN void ppb_map_lookup(const PPB_GMEM double *cells, double xp0, double h, int nx, int ny,
-                           double tan_theta_l, double x, double y, double *D, double *abar,
+ * shadow edges are column edges. The grid's columns are numbered from xp0; only nx of them, from
+ * column i0 on, are stored (the ones further left lie wholly in shadow, maps.h). Points off the
+ * stored cells take the nearest cell's extrapolation clamped to it. */
+PPB_FN void ppb_map_lookup(const PPB_GMEM double *cells, double xp0, double h, int i0, int nx,
+                           int ny, double tan_theta_l, double x, double y, double *D, double *abar,
                            double *lit)
 {
     double fx = (x + y * tan_theta_l - xp0) / h, fy = -y / h;
     int i = (int)floor(fx), j = (int)floor(fy);
-    i = i < 0 ? 0 : (i >= nx ? nx - 1 : i);
+    i = i < i0 ? i0 : (i >= i0 + nx ? i0 + nx - 1 : i);
     j = j < 0 ? 0 : (j >= ny ? ny - 1 : j);
     double tx = fx - i, ty = fy - j;
     tx = tx < 0.0 ? 0.0 : (tx > 1.0 ? 1.0 : tx);
     ty = ty < 0.0 ? 0.0 : (ty > 1.0 ? 1.0 : ty);
-    const PPB_GMEM double *c = cells + ((long)j * nx + i) * PPB_MAP_STRIDE;
+    const PPB_GMEM double *c = cells + ((long)j * nx + (i - i0)) * PPB_MAP_STRIDE;
     double w00 = (1.0 - tx) * (1.0 - ty), w10 = tx * (1.0 - ty), w01 = (1.0 - tx) * ty,
            w11 = tx * ty;
     *D = w00 * c[0] + w10 * c[1] + w01 * c[2] + w11 * c[3];

@@ -7,7 +7,7 @@
 
 #include "base/progress.h"
 
-_Static_assert(sizeof(ppb_march_params) == 21 * sizeof(double) + 24 * sizeof(int),
+_Static_assert(sizeof(ppb_march_params) == 21 * sizeof(double) + 26 * sizeof(int),
                "ppb_march_params: doubles first, an even number of ints, no padding");
 
 static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
@@ -54,6 +54,7 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
         .tube = tube,
         .step_kind = tube ? sc->step : PPB_STEP_NONE,
         .map_nx = maps->nx,
+        .map_i0 = maps->i0,
         .map_ny = maps->ny,
         .nalb = tab->nalb,
         .ncols = tab->ncols,

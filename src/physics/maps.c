@@ -52,29 +52,47 @@ void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, do
            !(sc->step == PPB_STEP_SHADOW && xp >= sc->step_x);
 }
 
-int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err)
+/* The grid of the maps without its cells (ppb_maps_build, ppb_maps_bytes). */
+static void maps_grid(const ppb_scene *sc, int map_res, ppb_maps *m)
 {
-    if (map_res < 1)
-        return ppb_fail(err, "maps: map_res must be at least 1 (got %d)", map_res);
     m->tube = sc->geometry == PPB_GEOM_TUBE;
     m->tan_theta_l = ppb_scene_tan_theta_l(sc);
     m->h = 1.0 / map_res;
-    m->ny = (int)ceil(sc->height * map_res - 1e-9);
-    if (m->ny < 1)
-        m->ny = 1;
+    double ny = ceil(sc->height * map_res - 1e-9);
+    m->ny = ny < 1 ? 1 : (int)ny;
+    m->i0 = 0;
     if (m->tube) {
         /* Columns start at x' = -W/2 (a shadow edge for oblique light) and reach left far enough
-         * for the paths of S3's lower end; step_x = 0 then lies on a column edge too. */
+         * for the paths of S3's lower end; step_x = 0 then lies on a column edge too. Of the
+         * `left` columns beyond -W/2, all in shadow, only the nearest is stored (maps.h). */
         int left = (int)ceil(sc->height * m->tan_theta_l * map_res - 1e-9);
         m->xp0 = -0.5 * sc->width - left * m->h;
-        m->nx = left + (int)ceil(sc->width * map_res - 1e-9);
+        m->i0 = left > 0 ? left - 1 : 0;
+        m->nx = left - m->i0 + (int)ceil(sc->width * map_res - 1e-9);
     } else {
         m->xp0 = -0.5 * m->h;
         m->nx = 1;
     }
+}
+
+double ppb_maps_bytes(const ppb_scene *sc, int map_res)
+{
+    if (map_res < 1)
+        return 0.0;
+    ppb_maps m;
+    maps_grid(sc, map_res, &m);
+    return (double)m.nx * m.ny * PPB_MAP_STRIDE * sizeof *m.cells;
+}
+
+int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err)
+{
+    if (map_res < 1)
+        return ppb_fail(err, "maps: map_res must be at least 1 (got %d)", map_res);
+    maps_grid(sc, map_res, m);
     m->cells = malloc((size_t)m->nx * (size_t)m->ny * PPB_MAP_STRIDE * sizeof *m->cells);
     if (!m->cells)
-        return ppb_fail(err, "maps: out of memory for %d x %d cells", m->nx, m->ny);
+        return ppb_fail(err, "maps: out of memory for %d x %d cells (%.3g GB)", m->nx, m->ny,
+                        ppb_maps_bytes(sc, map_res) / 1e9);
     /* Corners are evaluated a hair inside their cell: the limit from inside, which keeps a jump
      * on the cell edge sharp; 1e-9 cells moves D by ~1e-11, far below any tolerance. */
     double eps = 1e-9 * m->h;
@@ -83,7 +101,7 @@ int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err)
             double *c = m->cells + ((size_t)j * m->nx + i) * PPB_MAP_STRIDE;
             for (int corner = 0; corner < 4; corner++) {
                 int cx = corner & 1, cy = corner >> 1;
-                double xp = m->xp0 + (i + cx) * m->h + (cx ? -eps : eps);
+                double xp = m->xp0 + (m->i0 + i + cx) * m->h + (cx ? -eps : eps);
                 double depth = (j + cy) * m->h + (cy ? -eps : eps);
                 double y = -depth, x = xp - y * m->tan_theta_l;
                 double D, abar;
@@ -105,7 +123,7 @@ void ppb_maps_free(ppb_maps *m)
 
 void ppb_maps_lookup(const ppb_maps *m, double x, double y, double *D, double *abar, double *lit)
 {
-    ppb_map_lookup(m->cells, m->xp0, m->h, m->nx, m->ny, m->tan_theta_l, x, y, D, abar, lit);
+    ppb_map_lookup(m->cells, m->xp0, m->h, m->i0, m->nx, m->ny, m->tan_theta_l, x, y, D, abar, lit);
 }
 
 double ppb_maps_depth(const ppb_maps *m, double x, double y)

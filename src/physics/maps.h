@@ -17,14 +17,23 @@
 typedef struct ppb_maps {
     int tube;
     double tan_theta_l;
-    double xp0;    /* x' of the first node column */
+    double xp0;    /* x' of the grid's node column 0 */
     double h;      /* cell size, mfp */
-    int nx, ny;    /* cells */
+    int i0;        /* grid column of the first stored cell column */
+    int nx, ny;    /* cells stored: columns i0 .. i0 + nx - 1, rows 0 .. ny - 1 */
     double *cells; /* [ny][nx][PPB_MAP_STRIDE] */
 } ppb_maps;
 
-/* Builds the maps with map_res cells per mfp (slab mode: one column). */
+/* Builds the maps with map_res cells per mfp (slab mode: one column). The grid's columns reach
+ * left of x' = -W/2 far enough for the paths of S3's lower end, but those columns lie wholly in
+ * shadow (SPEC.md section 3: a path meeting S1's plane left of -W/2 is unlit), so only the
+ * nearest of them is stored: the lookup clamps the others to it, where lit = 0 exactly and the
+ * march adds nothing. At oblique light that is the difference between W and W + H tan(theta_L)
+ * columns (22 GB at H = 100, theta_L = 80: issue 15). */
 int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err);
+
+/* Bytes ppb_maps_build will allocate (estimated before any allocation). */
+double ppb_maps_bytes(const ppb_scene *sc, int map_res);
 void ppb_maps_free(ppb_maps *m);
 
 /* Interpolated map values at (x, y): D (finite, continued into shadow), average albedo and the
