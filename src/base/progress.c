@@ -2,7 +2,6 @@
 
 #include <signal.h>
 #include <stdio.h>
-#include <time.h>
 
 static volatile sig_atomic_t interrupted;
 
@@ -28,13 +27,6 @@ int ppb_interrupted(void)
 void ppb_interrupt_reset(void)
 {
     interrupted = 0;
-}
-
-double ppb_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 void ppb_progress_begin(ppb_progress *p, const char *label, const char *unit, double total,

@@ -7,6 +7,8 @@
 #ifndef PPB_PROGRESS_H
 #define PPB_PROGRESS_H
 
+#include "base/clock.h" /* ppb_now: its users time what they report progress on */
+
 typedef struct ppb_progress {
     const char *label;
     const char *unit;
@@ -23,8 +25,5 @@ void ppb_progress_begin(ppb_progress *p, const char *label, const char *unit, do
                         int quiet);
 void ppb_progress_update(ppb_progress *p, double done);
 void ppb_progress_end(ppb_progress *p, double done);
-
-/* Monotonic seconds. */
-double ppb_now(void);
 
 #endif

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/csv_read.h"
 #include "methods/method_mc.h"
 
 /* Photons per timed case: enough for a few seconds on a 2-core CPU (the launches then dominate
@@ -50,15 +51,19 @@ static int perf_trace(ppb_run_ctx *ctx, const ppb_config *cfg, long long count, 
  * n = 1 inside and out (no reflection), a pencil beam at normal incidence. It runs in a Python
  * child; pmcxcl builds its kernel on PoCL only with libstdc++ preloaded, and reports its
  * statistics only with the fluence output on, so both are set. Its own device choice is the
- * first OpenCL device (gpuid 1), which it names. Returns photons/s, or 0 when pmcxcl is not
- * installed or fails (then why goes into note). */
+ * first OpenCL device (gpuid 1), which it names. The child answers in CSV (Python's csv module,
+ * which quotes a device name holding a comma) on its original stdout, read by column name;
+ * everything pmcxcl itself prints goes to the discarded stderr. Returns photons/s, or 0 when
+ * pmcxcl is not installed or fails (then why goes into note). */
 static double mcx_photons_per_s(double g, long long photons, char *device, size_t cap, char *note,
                                 size_t note_cap)
 {
     char cmd[2048];
     snprintf(cmd, sizeof cmd,
              "LD_PRELOAD=/usr/lib/x86_64-linux-gnu/libstdc++.so.6 python3 -c '"
-             "import numpy as np, pmcxcl\n"
+             "import csv, os, numpy as np, pmcxcl\n"
+             "out = os.fdopen(os.dup(1), \"w\")\n"
+             "os.dup2(2, 1)\n"
              "cfg = {\"nphoton\": %lld, \"vol\": np.ones((100, 100, 3), dtype=\"uint8\"),"
              " \"tstart\": 0, \"tend\": 1e-8, \"tstep\": 1e-8,"
              " \"srcpos\": [50, 50, 0], \"srcdir\": [0, 0, 1],"
@@ -66,8 +71,11 @@ static double mcx_photons_per_s(double g, long long photons, char *device, size_
              " \"gpuid\": 1, \"autopilot\": 1, \"issave2pt\": 1}\n"
              "pmcxcl.run(dict(cfg, nphoton=10000))\n"
              "r = pmcxcl.run(cfg)\n"
-             "print(\"PPB_MCX\", r[\"stat\"][\"nphoton\"], r[\"stat\"][\"runtime\"],"
-             " pmcxcl.gpuinfo()[0][\"name\"])\n"
+             "w = csv.writer(out, lineterminator=\"\\n\")\n"
+             "w.writerow([\"nphoton\", \"runtime_ms\", \"device\"])\n"
+             "w.writerow([r[\"stat\"][\"nphoton\"], r[\"stat\"][\"runtime\"],"
+             " pmcxcl.gpuinfo()[0][\"name\"]])\n"
+             "out.flush()\n"
              "' 2>/dev/null",
              photons, g);
     FILE *p = popen(cmd, "r");
@@ -75,18 +83,20 @@ static double mcx_photons_per_s(double g, long long photons, char *device, size_
         snprintf(note, note_cap, "cannot start python3");
         return 0;
     }
-    char line[1024];
     double rate = 0;
     snprintf(note, note_cap, "pmcxcl not installed or failed");
-    while (fgets(line, sizeof line, p)) {
-        long long n;
-        double ms;
-        int at = 0;
-        if (sscanf(line, "PPB_MCX %lld %lf %n", &n, &ms, &at) == 2 && ms > 0) {
-            rate = (double)n / (ms * 1e-3);
-            snprintf(device, cap, "%s", line + at);
-            device[strcspn(device, "\n")] = 0;
+    ppb_csv c;
+    ppb_err err;
+    if (ppb_csv_open_stream(&c, p, "pmcxcl", &err) == 0) {
+        int cn = ppb_csv_col(&c, "nphoton"), cms = ppb_csv_col(&c, "runtime_ms");
+        int cdev = ppb_csv_col(&c, "device");
+        double n, ms;
+        if (cn >= 0 && cms >= 0 && ppb_csv_next(&c, &err) == 1 && ppb_csv_double(&c, cn, &n) &&
+            ppb_csv_double(&c, cms, &ms) && ms > 0) {
+            rate = n / (ms * 1e-3);
+            snprintf(device, cap, "%s", ppb_csv_get(&c, cdev));
         }
+        ppb_csv_close(&c);
     }
     pclose(p);
     return rate;

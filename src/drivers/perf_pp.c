@@ -5,29 +5,16 @@
 
 #include <cblas.h>
 #include <math.h>
-#include <stdlib.h>
-#include <time.h>
 
+#include "base/clock.h"
+#include "base/sort.h"
 #include "physics/ppsolver.h"
 
 #define PERF_RUNS 7
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double median(double *v, int n)
 {
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    ppb_sort_doubles(v, (size_t)n);
     return v[n / 2];
 }
 
@@ -45,12 +32,12 @@ static int bench_one(FILE *out, int directions, ppb_err *err)
             return -1;
         phase[r] = t.phase, eigen[r] = t.eigen, bound[r] = t.boundary;
         total[r] = t.phase + t.eigen + t.boundary;
-        double w[3] = {0.3, 0.9, 0.1}, norm = sqrt(0.91), t0 = now_s(), sink = 0.0;
+        double w[3] = {0.3, 0.9, 0.1}, norm = sqrt(0.91), t0 = ppb_now(), sink = 0.0;
         for (int k = 0; k < 3; k++)
             w[k] /= norm;
         for (int k = 0; k < 20; k++)
             sink += pp_radiance(s, 0.0, w);
-        eval[r] = (now_s() - t0) / 20 + 0.0 * sink;
+        eval[r] = (ppb_now() - t0) / 20 + 0.0 * sink;
         pp_free(s);
     }
     fprintf(out,

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "base/atomic_file.h"
+#include "base/csv_read.h"
 
 /* Shinya et al. 2009, Table 2: RMS error against MC in percent, per case and cell, for the
  * proposed method (pp), MP (mp), MP+S (mp+ss) and S (ss). */
@@ -48,27 +49,34 @@ typedef struct summary_row {
     double rms, noise, excess;
 } summary_row;
 
-/* Reads <dir>/<case>/summary.csv; returns the row count or -1. */
+/* Reads <dir>/<case>/summary.csv (columns by name); returns the row count or -1. Rows whose
+ * method or cell is empty or whose numbers do not parse are skipped. */
 static int read_summary(const char *dir, const char *name, summary_row *rows, int cap, ppb_err *err)
 {
-    char path[1200], line[512];
+    char path[1200];
     snprintf(path, sizeof path, "%s/%s/summary.csv", dir, name);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return ppb_fail(err, "%s: cannot open (did the case run with mc?)", path);
-    int n = 0;
-    if (!fgets(line, sizeof line, f)) {
-        fclose(f);
-        return ppb_fail(err, "%s: empty", path);
-    }
-    while (n < cap && fgets(line, sizeof line, f)) {
+    ppb_csv c;
+    ppb_err open_err;
+    if (ppb_csv_open(&c, path, &open_err))
+        return ppb_fail(err, "%s (did the case run with mc?)", open_err.msg);
+    static const char *const names[5] = {"method", "cell", "rms_rel", "noise_rel", "rms_excess"};
+    int col[5];
+    for (int k = 0; k < 5; k++)
+        if ((col[k] = ppb_csv_need(&c, names[k], err)) < 0) {
+            ppb_csv_close(&c);
+            return -1;
+        }
+    int n = 0, rc = 0;
+    while (n < cap && (rc = ppb_csv_next(&c, err)) == 1) {
         summary_row *r = &rows[n];
-        if (sscanf(line, "%31[^,],%15[^,],%lf,%lf,%lf", r->method, r->cell, &r->rms, &r->noise,
-                   &r->excess) == 5)
+        snprintf(r->method, sizeof r->method, "%s", ppb_csv_get(&c, col[0]));
+        snprintf(r->cell, sizeof r->cell, "%s", ppb_csv_get(&c, col[1]));
+        if (r->method[0] && r->cell[0] && ppb_csv_double(&c, col[2], &r->rms) &&
+            ppb_csv_double(&c, col[3], &r->noise) && ppb_csv_double(&c, col[4], &r->excess))
             n++;
     }
-    fclose(f);
-    return n;
+    ppb_csv_close(&c);
+    return rc < 0 ? -1 : n;
 }
 
 static void md_cell(FILE *f, double v)

@@ -10,14 +10,16 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/csv_read.h"
+#include "base/hash.h"
 #include "drivers/experiment.h"
 #include "physics/march_tables.h"
 #include "model/metrics.h"
 #include "base/progress.h"
 #include "drivers/sweep_plot.h"
 
-/* FNV-1a over the resolved settings that shape results (output.dir and the name excluded),
- * so a renamed or moved sweep still finds its finished points. */
+/* A hash (base/hash.h) of the resolved settings that shape results (output.dir and the name
+ * excluded), so a renamed or moved sweep still finds its finished points. */
 static uint64_t point_hash(const ppb_config *pt)
 {
     ppb_config c = *pt;
@@ -28,9 +30,7 @@ static uint64_t point_hash(const ppb_config *pt)
     FILE *f = open_memstream(&text, &len);
     ppb_config_write_resolved(&c, f);
     fclose(f);
-    uint64_t h = 1469598103934665603ULL;
-    for (size_t i = 0; i < len; i++)
-        h = (h ^ (unsigned char)text[i]) * 1099511628211ULL;
+    uint64_t h = ppb_hash64(text, len);
     free(text);
     return h;
 }
@@ -178,43 +178,49 @@ static int find_point(const char *const *dirs, int ndirs, const char *hash, cons
 }
 
 /* Writes out/sweep.csv and out/timings.csv from the points found in dirs, in grid order.
+ * grid.txt is read as CSV (base/csv_read.h): its header is sweep.csv's (names never need
+ * quotes: write_header), its records one field each, a point's hash.
  * Returns the number of points still missing (then nothing is written), or -1. */
 static long long assemble(const char *const *dirs, int ndirs, const char *out, ppb_err *err)
 {
-    char gpath[1200], path[1300], line[8192];
+    char gpath[1200], path[1300];
     snprintf(gpath, sizeof gpath, "%s/grid.txt", dirs[0]);
-    FILE *g = fopen(gpath, "r");
-    if (!g)
-        return ppb_fail(err, "%s: cannot open (not a sweep directory?)", gpath);
+    ppb_csv g;
+    ppb_err gerr;
+    if (ppb_csv_open(&g, gpath, &gerr))
+        return ppb_fail(err, "%s (not a sweep directory?)", gerr.msg);
     ppb_afile csv, tim;
     snprintf(path, sizeof path, "%s/sweep.csv", out);
-    if (!fgets(line, sizeof line, g) || ppb_afile_open(&csv, path, err)) {
-        fclose(g);
-        return ppb_fail(err, "%s: empty grid", gpath);
+    if (ppb_afile_open(&csv, path, err)) {
+        ppb_csv_close(&g);
+        return -1;
     }
     snprintf(path, sizeof path, "%s/timings.csv", out);
     if (ppb_afile_open(&tim, path, err)) {
         ppb_afile_abort(&csv);
-        fclose(g);
+        ppb_csv_close(&g);
         return -1;
     }
-    fputs(line, csv.f);
+    for (int c = 0; c < g.ncol; c++)
+        fprintf(csv.f, "%s%s", c ? "," : "", g.col[c]);
+    fputc('\n', csv.f);
     fprintf(tim.f, "point,seconds\n");
     long long missing = 0;
-    while (fgets(line, sizeof line, g)) {
-        line[strcspn(line, "\n")] = '\0';
-        if (find_point(dirs, ndirs, line, "csv", path, sizeof path) == 0)
+    int rc;
+    while ((rc = ppb_csv_next(&g, err)) == 1) {
+        const char *hash = ppb_csv_get(&g, 0);
+        if (find_point(dirs, ndirs, hash, "csv", path, sizeof path) == 0)
             copy_into(csv.f, path);
         else
             missing++;
-        if (find_point(dirs, ndirs, line, "time", path, sizeof path) == 0)
+        if (find_point(dirs, ndirs, hash, "time", path, sizeof path) == 0)
             copy_into(tim.f, path);
     }
-    fclose(g);
-    if (missing) {
+    ppb_csv_close(&g);
+    if (missing || rc < 0) {
         ppb_afile_abort(&csv);
         ppb_afile_abort(&tim);
-        return missing;
+        return rc < 0 ? -1 : missing;
     }
     if (ppb_afile_commit(&csv, err) || ppb_afile_commit(&tim, err))
         return -1;

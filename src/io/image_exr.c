@@ -5,9 +5,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <OpenEXR/openexr.h>
+
+#include "base/atomic_file.h"
 
 enum { RGB = 3 };
 
@@ -103,13 +104,14 @@ int ppb_exr_write_rgb(const char *path, int width, int height, const float *rgb,
 {
     if (width <= 0 || height <= 0)
         return ppb_fail(err, "%s: empty image %dx%d", path, width, height);
-    /* OpenEXR takes a filename, so the atomic write is done here: temporary name, rename. */
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s.tmp.%d", path, (int)getpid());
+    /* OpenEXR opens the file by name: it writes the temporary, committed once complete. */
+    ppb_apath ap;
+    if (ppb_apath_begin(&ap, path, err))
+        return -1;
     exr_context_initializer_t init = quiet_init();
     exr_context_t ctxt = NULL;
     const char *stage = "cannot start writing";
-    exr_result_t rv = exr_start_write(&ctxt, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
+    exr_result_t rv = exr_start_write(&ctxt, ap.tmp, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv == EXR_ERR_SUCCESS) {
         stage = "cannot define the image";
         rv = define_part(ctxt, width, height);
@@ -128,14 +130,10 @@ int ppb_exr_write_rgb(const char *path, int width, int height, const float *rgb,
         rv = fin;
     }
     if (rv != EXR_ERR_SUCCESS) {
-        remove(tmp);
+        ppb_apath_abort(&ap);
         return exr_fail(err, path, stage, rv);
     }
-    if (rename(tmp, path) != 0) {
-        remove(tmp);
-        return ppb_fail(err, "%s: cannot rename into place", path);
-    }
-    return 0;
+    return ppb_apath_commit(&ap, err);
 }
 
 /* Decoding mirrors write_chunks; channels other than R, G, B are skipped (NULL pointer). */

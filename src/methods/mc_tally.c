@@ -6,10 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char magic[8] = {'P', 'P', 'B', 'M', 'C', 'T', '0', '1'};
+#include "base/atomic_file.h"
+#include "base/hash.h"
 
-/* FNV-1a over the canonical text of every setting that changes a photon's path or its cell,
- * so tallies from different scenes (or bin layouts) can never be merged by mistake. */
+/* Version 02: the fingerprint became base/hash.h's XXH3 (01 held FNV-1a), so a version 01 file
+ * is refused as such instead of failing every merge with "different scenes". */
+static const char magic[8] = {'P', 'P', 'B', 'M', 'C', 'T', '0', '2'};
+
+/* A hash (base/hash.h) of the canonical text of every setting that changes a photon's path or
+ * its cell, so tallies from different scenes (or bin layouts) can never be merged by mistake. */
 uint64_t ppb_mc_scene_fingerprint(const ppb_scene *sc)
 {
     char buf[512];
@@ -20,12 +25,7 @@ uint64_t ppb_mc_scene_fingerprint(const ppb_scene *sc)
                      sc->segments_top, sc->segments_side, sc->sigma_t, sc->albedo, sc->g, sc->step,
                      sc->step_x, sc->sigma_t_right, sc->albedo_right, sc->theta_deg, sc->ntheta,
                      sc->nphi);
-    uint64_t h = 1469598103934665603ull;
-    for (int i = 0; i < n && i < (int)sizeof buf; i++) {
-        h ^= (unsigned char)buf[i];
-        h *= 1099511628211ull;
-    }
-    return h;
+    return ppb_hash64(buf, n < (int)sizeof buf ? (size_t)n : sizeof buf - 1);
 }
 
 static int alloc_arrays(ppb_mc_tallies *t, ppb_err *err)
@@ -139,26 +139,20 @@ static int get_u64s(FILE *f, uint64_t *v, size_t n)
 
 int ppb_mc_tallies_save(const ppb_mc_tallies *t, const char *path, ppb_err *err)
 {
-    char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp)
-        return ppb_fail(err, "%s: path too long", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
-        return ppb_fail(err, "%s: cannot write: %s", tmp, strerror(errno));
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    FILE *f = af.f;
     uint64_t head[4] = {t->fingerprint, t->seed, (uint64_t)t->batches, (uint64_t)t->ncells};
     size_t nb = (size_t)t->batches;
     int bad = fwrite(magic, 1, sizeof magic, f) != sizeof magic || put_u64s(f, head, 4) ||
               put_u64s(f, t->photons, nb) || put_u64s(f, t->totals, nb * PPB_MC_NTOT) ||
               put_u64s(f, t->cells, nb * PPB_MC_NTALLY * t->ncells);
-    if (fclose(f) != 0)
-        bad = 1;
     if (bad) {
-        remove(tmp);
-        return ppb_fail(err, "%s: write failed: %s", tmp, strerror(errno));
+        ppb_afile_abort(&af);
+        return ppb_fail(err, "%s: write failed: %s", path, strerror(errno));
     }
-    if (rename(tmp, path) != 0)
-        return ppb_fail(err, "%s: cannot rename into place: %s", path, strerror(errno));
-    return 0;
+    return ppb_afile_commit(&af, err);
 }
 
 int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
@@ -169,10 +163,15 @@ int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
         return ppb_fail(err, "%s: cannot read: %s", path, strerror(errno));
     char m[8];
     uint64_t head[4];
-    if (fread(m, 1, sizeof m, f) != sizeof m || memcmp(m, magic, sizeof m) != 0 ||
-        get_u64s(f, head, 4)) {
+    if (fread(m, 1, sizeof m, f) != sizeof m || memcmp(m, magic, 6) != 0 || get_u64s(f, head, 4)) {
         fclose(f);
         return ppb_fail(err, "%s: not a ppbench Monte Carlo tally file", path);
+    }
+    if (memcmp(m, magic, sizeof m) != 0) {
+        fclose(f);
+        return ppb_fail(err,
+                        "%s: tally file version %.2s, this ppbench reads %.2s: run the shard again",
+                        path, m + 6, magic + 6);
     }
     if (head[2] < 1 || head[2] > (1u << 20) || head[3] > ((uint64_t)1 << 32)) {
         fclose(f);

@@ -43,8 +43,8 @@ void ppb_mc_tallies_count_range(ppb_mc_tallies *t, uint64_t first, uint64_t coun
 /* dst += src, refusing tallies of another scene, seed or batch count, and overflow. */
 int ppb_mc_tallies_add(ppb_mc_tallies *dst, const ppb_mc_tallies *src, ppb_err *err);
 
-/* Binary file: magic "PPBMCT01", then the header fields and the arrays as little-endian
- * uint64. Written to path.tmp and renamed, so a kill never leaves half a file. */
+/* Binary file: magic "PPBMCT02", then the header fields and the arrays as little-endian
+ * uint64. Written atomically (base/atomic_file.h), so a kill never leaves half a file. */
 int ppb_mc_tallies_save(const ppb_mc_tallies *t, const char *path, ppb_err *err);
 /* Loads into an uninitialised t (allocates). */
 int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err);

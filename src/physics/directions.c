@@ -3,33 +3,11 @@
 
 #include "kernels/ppb_conventions.h"
 
+#include "base/quadrature.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Gauss-Legendre nodes and weights on [-1, 1] by Newton on P_q (Golub-Welsch not needed for
- * q <= 16; the iteration converges to machine precision from the Chebyshev guesses). */
-void pp_gauss_legendre(int q, double *x, double *w)
-{
-    for (int i = 0; i < q; i++) {
-        double z = cos(PPB_PI * (i + 0.75) / (q + 0.5)), dp = 1.0;
-        for (int it = 0; it < 100; it++) {
-            double p0 = 1.0, p1 = z;
-            for (int l = 2; l <= q; l++) {
-                double p2 = ((2 * l - 1) * z * p1 - (l - 1) * p0) / l;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = q * (z * p1 - p0) / (z * z - 1.0);
-            double dz = p1 / dp;
-            z -= dz;
-            if (fabs(dz) < 1e-16)
-                break;
-        }
-        x[i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-    }
-}
 
 /* Cells per ring below a polar ring of `pole` cells (one cap, or four quarter-cap wedges for
  * the antipodal partition of even N). Every cumulative count below the polar ring has the parity
@@ -260,7 +238,7 @@ static int build_nodes(pp_dirs *d, int q)
         return -1;
     double x[PP_QMAX], w[PP_QMAX];
     double ct[PP_QMAX], st[PP_QMAX], wt[PP_QMAX], cp[PP_QMAX], sp[PP_QMAX], wp[PP_QMAX];
-    pp_gauss_legendre(q, x, w);
+    ppb_gauss_legendre(q, x, w);
     for (int i = 0; i < n; i++) {
         int r = d->ring[i];
         double t0 = acos(d->mu_edge[r]), t1 = acos(d->mu_edge[r + 1]);

@@ -72,9 +72,6 @@ int pp_dirs_antipode(const pp_dirs *d, int cell);
 void pp_dirs_bounds(const pp_dirs *d, int cell, double *mu_lo, double *mu_hi, double *phi_lo,
                     double *phi_hi);
 
-/* Gauss-Legendre nodes x and weights w on [-1, 1], 1 <= q <= PP_QMAX. */
-void pp_gauss_legendre(int q, double *x, double *w);
-
 /* q x q product Gauss nodes of a cell, q in [1, PP_QMAX]: rows of (x, y, z, weight), weights
  * summing to |Omega| exactly up to rounding. Built on first use for that q (for all cells). */
 const double *pp_dirs_nodes(pp_dirs *d, int cell, int q, ppb_err *err);

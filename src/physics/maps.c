@@ -6,6 +6,9 @@
 
 #include "kernels/march_params.h"
 
+#include "base/quadrature.h"
+#include "base/sort.h"
+
 /* Fraction of a straight path whose x runs from x0 to x1 that lies right of the step
  * (x >= step_x); a vertical path is wholly on one side. */
 static double right_fraction(double x0, double x1, double step_x)
@@ -165,23 +168,16 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
     for (int k = 0; k < 3; k++)
         if (cand[k] > a && cand[k] < b)
             brk[nb++] = cand[k];
-    for (int i = 1; i < nb; i++) /* insertion sort of a handful */
-        for (int k = i; k > 0 && brk[k] < brk[k - 1]; k--) {
-            double s = brk[k];
-            brk[k] = brk[k - 1];
-            brk[k - 1] = s;
-        }
-    static const double gx[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                                 0.9061798459386640};
-    static const double gw[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                                 0.4786286704993665, 0.2369268850561891};
+    ppb_sort_doubles(brk, (size_t)nb);
+    double gx[5], gw[5]; /* 5-point Gauss-Legendre, summed in ascending x */
+    ppb_gauss_legendre(5, gx, gw);
     const int panels = 64;
     double sum = 0.0;
     for (int p = 0; p + 1 < nb; p++) {
         double hstep = (brk[p + 1] - brk[p]) / panels;
         for (int k = 0; hstep > 0.0 && k < panels; k++) {
             double mid = brk[p] + (k + 0.5) * hstep;
-            for (int q = 0; q < 5; q++)
+            for (int q = 4; q >= 0; q--)
                 sum += 0.5 * hstep * gw[q] * exp(-ppb_beam_depth(sc, mid + 0.5 * hstep * gx[q]));
         }
     }

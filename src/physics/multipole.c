@@ -6,6 +6,8 @@
 
 #include "kernels/ppb_conventions.h"
 
+#include "base/quadrature.h"
+
 /* Mirror index of pair k in the order 0, +1, -1, +2, -2, ... */
 static int pair_index(int k)
 {
@@ -152,16 +154,11 @@ static double inverse_square_strip(double ua, double ub, double v, double nx, do
     return log_part + atan_part;
 }
 
-/* 4-point Gauss-Legendre nodes and weights on [-1, 1]. */
-static const double gl_node[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
-                                  0.8611363115940526};
-static const double gl_weight[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
-                                    0.3478548451374538};
-
 /* int_{ua}^{ub} (-u nx + v ny) (x K1(x) - 1) / rho^2 du, rho^2 = u^2 + v^2, x = sigma_tr rho:
- * the smooth remainder after the 1/rho^2 part, by composite Gauss-Legendre. */
+ * the smooth remainder after the 1/rho^2 part, by composite 4-point Gauss-Legendre (gl_node,
+ * gl_weight: ppb_gauss_legendre(4), summed in ascending x). */
 static double remainder_strip(double sigma_tr, double ua, double ub, double v, double nx, double ny,
-                              int nodes_per_mfp)
+                              int nodes_per_mfp, const double gl_node[4], const double gl_weight[4])
 {
     if (sigma_tr == 0)
         return 0.0;
@@ -170,7 +167,7 @@ static double remainder_strip(double sigma_tr, double ua, double ub, double v, d
     double half = 0.5 * (ub - ua) / panels, sum = 0;
     for (int p = 0; p < panels; p++) {
         double mid = ua + (2 * p + 1) * half;
-        for (int j = 0; j < 4; j++) {
+        for (int j = 3; j >= 0; j--) {
             double u = mid + half * gl_node[j];
             double rho2 = u * u + v * v;
             if (rho2 == 0)
@@ -189,11 +186,13 @@ double ppb_multipole_strip_flux(const ppb_multipole *mp, double xp, double yp, d
     /* A source line at (x_e, -z) along z: (p - s) . n = -u nx + v ny with u = x_e - xp and
      * v = yp + z; its z-integrated flux is alpha' q (-u nx + v ny) 2 s K1(s rho) / (4 pi rho),
      * i.e. alpha' q / (2 pi) x (-u nx + v ny) (1 + (x K1(x) - 1)) / rho^2. */
-    double ua = xa - xp, ub = xb - xp, sum = 0;
+    double ua = xa - xp, ub = xb - xp, sum = 0, gl_node[4], gl_weight[4];
+    ppb_gauss_legendre(4, gl_node, gl_weight);
     for (int k = 0; k < ppb_multipole_nsources(mp); k++) {
         double v = yp + mp->depth[k];
-        double line = inverse_square_strip(ua, ub, v, nx, ny) +
-                      remainder_strip(mp->sigma_tr, ua, ub, v, nx, ny, nodes_per_mfp);
+        double line =
+            inverse_square_strip(ua, ub, v, nx, ny) +
+            remainder_strip(mp->sigma_tr, ua, ub, v, nx, ny, nodes_per_mfp, gl_node, gl_weight);
         sum += mp->charge[k] * line;
     }
     return mp->albedo_reduced * sum / (2.0 * PPB_PI);
@@ -240,13 +239,15 @@ double ppb_multipole_segment_flux(const ppb_multipole *mp, double x0, double y0,
     if (!(xb > xa))
         return 0.0;
     points = points < 1 ? 1 : points;
-    double sum = 0;
+    double sum = 0, gl_node[4], gl_weight[4];
+    ppb_gauss_legendre(4, gl_node, gl_weight);
     for (int k = 0; k < ppb_multipole_nsources(mp); k++) {
         double z = mp->depth[k], rem = 0;
         for (int j = 0; j < points; j++) {
             double f = (j + 0.5) / points;
             double xp = x0 + f * (x1 - x0), yp = y0 + f * (y1 - y0);
-            rem += remainder_strip(mp->sigma_tr, xa - xp, xb - xp, yp + z, nx, ny, nodes_per_mfp);
+            rem += remainder_strip(mp->sigma_tr, xa - xp, xb - xp, yp + z, nx, ny, nodes_per_mfp,
+                                   gl_node, gl_weight);
         }
         double line = inverse_square_segment(x0, y0, x1, y1, nx, ny, xa, xb, z) + rem / points;
         sum += mp->charge[k] * line;

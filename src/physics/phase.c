@@ -3,6 +3,8 @@
 
 #include "kernels/ppb_conventions.h"
 
+#include "base/quadrature.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -352,7 +354,7 @@ static double point_rect(double g, const double w[3], double t0, double t1, doub
                point_rect(g, w, tm, t1, pm, p1, ysign, depth + 1);
     int q = want < 2 ? 2 : (want > PP_QMAX ? PP_QMAX : (int)want);
     double x[PP_QMAX], wt[PP_QMAX], sum = 0.0;
-    pp_gauss_legendre(q, x, wt);
+    ppb_gauss_legendre(q, x, wt);
     for (int a = 0; a < q; a++) {
         double th = tm + 0.5 * (t1 - t0) * x[a], inner = 0.0;
         for (int b = 0; b < q; b++) {

@@ -7,8 +7,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "base/clock.h"
 #include "physics/directions.h"
 #include "physics/phase.h"
 
@@ -40,13 +40,6 @@ typedef struct pp_work {
     double *F;       /* [m]: cell integrals of p(w . w_L) */
     double *h;       /* [n]: alpha = 1 diffusion mode's h+ */
 } pp_work;
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 static double *dalloc(size_t count)
 {
@@ -469,22 +462,22 @@ static int phase_stage(pp_solution *s, const pp_solution *share, ppb_err *err)
 static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp_timing *t,
                         ppb_err *err)
 {
-    double t0 = now_s();
+    double t0 = ppb_now();
     if (phase_stage(s, share, err) != 0)
         return -1;
-    double t1 = now_s();
+    double t1 = ppb_now();
     build_h(s, w);
     if (eigen_modes(s, w, err) != 0)
         return -1;
     avoid_resonance(s, w);
-    double t2 = now_s();
+    double t2 = ppb_now();
     if (pp_phase_row(&s->dirs, s->p.g, s->wL, w->F, err) != 0)
         return -1;
     particular(s, w);
     if (boundary(s, w, err) != 0)
         return -1;
     compute_totals(s);
-    double t3 = now_s();
+    double t3 = ppb_now();
     if (t)
         t->phase = t1 - t0, t->eigen = t2 - t1, t->boundary = t3 - t2;
     return 0;
