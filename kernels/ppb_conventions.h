@@ -98,6 +98,17 @@ PPB_FN double ppb_bin_proj_solid_angle(int ntheta, int nphi)
     return PPB_PI / (ntheta * nphi);
 }
 
+/* A bin's centre in (sin^2(theta), phi), the middle of its projected solid angle: theta in
+ * radians from the normal, phi in radians from t in [0, pi] (the folded half). */
+PPB_FN double ppb_theta_bin_centre(int itheta, int ntheta)
+{
+    return asin(sqrt((itheta + 0.5) / ntheta));
+}
+PPB_FN double ppb_phi_bin_centre(int iphi, int nphi)
+{
+    return (iphi + 0.5) * PPB_PI / nphi;
+}
+
 /* A direction inside bin (itheta, iphi) at fractional position (u, v) in [0,1)^2, uniform in
  * sin^2(theta) and phi, i.e. uniform in projected solid angle; written in world coordinates
  * for surface surf. The folded bin's phi > 0 half is used (b = +z component >= 0). */

@@ -47,19 +47,19 @@ unset multiplot
 GP
 mv "$dir/plots/rms_vs_x.png.tmp" "$dir/plots/rms_vs_x.png"
 
-# In-plane cut at x = 0: the two middle segments, phi bins 0 and nphi-1.
-read -r nt np nseg <<<"$(awk -F, 'NR > 1 && $2 == "S1" {if ($5 > t) t = $5; if ($6 > p) p = $6; if ($3 > s) s = $3}
-  END {print t + 1, p + 1, s + 1}' "$dir/radiance.csv")"
-mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/radiance.csv" | awk '!seen[$0]++')
+# In-plane cut at x = 0 from angular.csv (ppbench writes the Table 2 cells' radiance per bin
+# with the bin centres): phi bin 0 (+theta, along t) and the last phi bin (-theta).
+mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/angular.csv" | awk '!seen[$0]++')
 for m in "${all_methods[@]}"; do
   for s in S1 S2; do
-    awk -F, -v m="$m" -v s="$s" -v nt="$nt" -v np="$np" -v ns="$nseg" '
-      $1 == m && $2 == s && ($3 == int(ns / 2) || $3 == int((ns - 1) / 2)) &&
-      ($6 == 0 || $6 == np - 1) {
-        th = atan2(sqrt(($5 + 0.5) / nt), sqrt(1 - ($5 + 0.5) / nt)) * 180 / 3.14159265358979;
-        key = ($6 == 0 ? th : -th); sum[key] += $7; cnt[key]++ }
-      END { for (k in sum) print k, sum[k] / cnt[k] }' "$dir/radiance.csv" | sort -g \
-      > "$tmp/ang_${m//+/_}_$s.dat"
+    awk -F, -v m="$m" -v s="$s" '
+      NR == 1 {for (i = 1; i <= NF; i++) c[$i] = i; next}
+      {rows[NR] = $0; if ($c["phi_bin"] + 0 > np) np = $c["phi_bin"] + 0}
+      END {for (r in rows) { split(rows[r], f, ",");
+             if (f[c["method"]] != m || f[c["surface"]] != s) continue;
+             if (f[c["phi_bin"]] == 0) print f[c["theta_deg"]], f[c["radiance"]];
+             else if (f[c["phi_bin"]] == np) print -f[c["theta_deg"]], f[c["radiance"]] }}' \
+      "$dir/angular.csv" | sort -g > "$tmp/ang_${m//+/_}_$s.dat"
   done
 done
 plot_ang() {

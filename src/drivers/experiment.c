@@ -183,6 +183,9 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
     out_path(ex, "totals.csv", path, sizeof path);
     if (ppb_write_totals_csv(path, ex->res, ex->n, err))
         return -1;
+    out_path(ex, "angular.csv", path, sizeof path);
+    if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
+        return -1;
     if (write_comparisons(ex, err) || write_timings(ex, err) || write_provenance(ex, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);

@@ -1,5 +1,6 @@
 #include "io/csv.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "base/atomic_file.h"
@@ -104,6 +105,45 @@ int ppb_write_regions_csv(const char *path, const ppb_scene *sc, const ppb_resul
             fprintf(af.f, "%s,%s,%.6g,%.6g,%.6g\n", rs[m].method, ppb_region_name(region),
                     e.rms_rel, e.noise_rel, e.rms_excess);
         }
+    }
+    return ppb_afile_commit(&af, err);
+}
+
+/* One surface's Table 2 cell of one result, bin by bin: the mean over the cell's points and the
+ * standard error of that mean (independent segments: sqrt(sum se^2) / n). */
+static void write_angular_cell(FILE *f, const ppb_scene *sc, const ppb_result *r, int cell,
+                               const char *surf)
+{
+    const ppb_layout *lo = &r->layout;
+    int cap = lo->nseg[PPB_S1] > lo->nseg[PPB_S2] ? lo->nseg[PPB_S1] : lo->nseg[PPB_S2];
+    ppb_point pts[cap > 0 ? cap : 1];
+    int np = ppb_cell_points(lo, cell, pts, cap);
+    for (int it = 0; np > 0 && it < sc->ntheta; it++)
+        for (int ip = 0; ip < sc->nphi; ip++) {
+            int b = it * sc->nphi + ip;
+            double sum = 0.0, var = 0.0;
+            for (int i = 0; i < np; i++) {
+                size_t c = ppb_cell(lo, pts[i].surf, pts[i].seg, b);
+                sum += r->radiance[c];
+                var += r->se[c] * r->se[c];
+            }
+            double theta = ppb_theta_bin_centre(it, sc->ntheta) * 180.0 / PPB_PI;
+            double phi = ppb_phi_bin_centre(ip, sc->nphi) * 180.0 / PPB_PI;
+            fprintf(f, "%s,%s,%d,%d,%.6g,%.6g,%.10g,%.6g\n", r->method, surf, it, ip, theta, phi,
+                    sum / np, sqrt(var) / np);
+        }
+}
+
+int ppb_write_angular_csv(const char *path, const ppb_scene *sc, const ppb_result *rs, int n,
+                          ppb_err *err)
+{
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    fprintf(af.f, "method,surface,theta_bin,phi_bin,theta_deg,phi_deg,radiance,se\n");
+    for (int m = 0; m < n; m++) {
+        write_angular_cell(af.f, sc, &rs[m], PPB_CELL_R_X0, "S1");
+        write_angular_cell(af.f, sc, &rs[m], PPB_CELL_T_X0, "S2");
     }
     return ppb_afile_commit(&af, err);
 }

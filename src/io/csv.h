@@ -22,6 +22,11 @@ int ppb_write_summary_csv(const char *path, const ppb_result *rs, int n, const p
                           const char *skip, ppb_err *err);
 int ppb_write_regions_csv(const char *path, const ppb_scene *sc, const ppb_result *rs, int n,
                           const ppb_result *ref, const char *skip, ppb_err *err);
+/* angular.csv: every result's radiance at the Table 2 cells (S1's R_x0, S2's T_x0 points),
+ * averaged over the cell's segments, per bin with the bin centre's theta and phi in degrees and
+ * the mean's standard error: what the angular plot (paper Fig. 5) reads. */
+int ppb_write_angular_csv(const char *path, const ppb_scene *sc, const ppb_result *rs, int n,
+                          ppb_err *err);
 int ppb_write_totals_csv(const char *path, const ppb_result *rs, int n, ppb_err *err);
 
 #endif
