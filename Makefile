@@ -45,15 +45,16 @@ $(BUILD)/obj/%.o: src/%.c | $(BUILD)/deps.mk
 # The version provenance.txt records (drivers/experiment.c): `git describe --always` of HEAD,
 # "-dirty" when tracked files differ from it, "unknown" outside git. git diff-index never
 # writes the index (a build takes no git lock); a file merely touched may read as dirty.
-# version.txt changes only with the version, so experiment.o is rebuilt then and only then.
+# version.txt changes only with the version, so experiment.o and main.o (`ppbench --version`)
+# are rebuilt then and only then.
 PPB_VERSION := $(shell v=$$(git describe --always 2>/dev/null) && \
                  { git diff-index --quiet HEAD -- 2>/dev/null || v=$$v-dirty; } && echo $$v || \
                  echo unknown)
 $(BUILD)/version.txt: FORCE
 	@mkdir -p $(@D)
 	@echo '$(PPB_VERSION)' | cmp -s - $@ || echo '$(PPB_VERSION)' > $@
-$(BUILD)/obj/drivers/experiment.o: $(BUILD)/version.txt
-$(BUILD)/obj/drivers/experiment.o: CPPFLAGS += -DPPB_VERSION='"$(PPB_VERSION)"'
+$(BUILD)/obj/drivers/experiment.o $(BUILD)/obj/drivers/main.o: $(BUILD)/version.txt
+$(BUILD)/obj/drivers/experiment.o $(BUILD)/obj/drivers/main.o: CPPFLAGS += -DPPB_VERSION='"$(PPB_VERSION)"'
 FORCE:
 
 $(LIB): $(OBJ)

@@ -117,7 +117,7 @@ static void test_devices_and_keys(void **state)
     assert_int_equal(system(cmd), 0);
     expect("run --device no-such-device-xyz --quiet --set experiment.methods=mc "
            "--set mc.photons=1000 --out /nonexistent-dir/x configs/uniform_g0_normal.ini",
-           1, "no device name contains it");
+           2, "--device no-such-device-xyz: no device name contains it");
 }
 
 int main(void)

@@ -1,10 +1,17 @@
-/* main.c: the command line. Parses options, dispatches to the experiment runner, the sweep
- * driver, the device list and the benchmarks, and maps failures to the documented exit
- * codes. Everything else lives in its module. */
+/* main.c: the command line. Parses options, checks everything that can be checked before any
+ * work (options, the device, every config, the output directories), dispatches to the
+ * experiment runner, the sweep driver, the device list and the benchmarks, and maps failures to
+ * the documented exit codes. Everything else lives in its module. */
+#include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include "base/atomic_file.h"
 #include "base/progress.h"
 #include "drivers/experiment.h"
 #include "drivers/mc_shard.h"
@@ -16,107 +23,185 @@
 #include "model/grid.h"
 #include "runtime/ocl.h"
 
+#ifndef PPB_VERSION
+#define PPB_VERSION "unknown"
+#endif
+
 enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
 
-static void usage(FILE *out)
-{
-    fprintf(out,
-            "usage: ppbench COMMAND [options]\n"
-            "\n"
-            "commands:\n"
-            "  run CONFIG...       run every method of each experiment config and write\n"
-            "                      SPEC.md section 8's outputs under [output] dir\n"
-            "  sweep CONFIG        run a grid sweep (keys holding lists) into <dir>/sweep.csv\n"
-            "  merge DIR...        merge sweep shards (--out DIR) into one sweep.csv\n"
-            "  mc-shard CONFIG     trace part --shard I/N of the config's photons into\n"
-            "                      <--out>/mc_tallies.bin\n"
-            "  mc-merge CONFIG DIR...  add the shards' tallies and write mc, mc1 outputs to\n"
-            "                      --out, byte-identical to one run of the whole budget\n"
-            "  devices             list OpenCL devices (index: platform / device)\n"
-            "  keys                print every config key with its default and range\n"
-            "  perf                benchmarks: solver, ray marcher, Monte Carlo\n"
-            "  report DIR CASE...  table2.csv/.md and README.md of a study from its cases\n"
-            "\n"
-            "options:\n"
-            "  --device SEL        OpenCL device: index or name substring\n"
-            "                      (default: $PPBENCH_DEVICE, else device 0)\n"
-            "  --out DIR           output directory (overrides [output] dir)\n"
-            "  --set SEC.KEY=VAL   override a config key (may repeat)\n"
-            "  --shard I/N         sweep: run only the I-th of N parts (1-based)\n"
-            "  --jobs J            sweep: J processes on this machine (default 1)\n"
-            "  --yes               sweep: allow a grid larger than the safety limit\n"
-            "  --quiet             no progress lines on stderr\n"
-            "  -h, --help          this text\n"
-            "\n"
-            "methods:\n");
-    for (int i = 0; i < ppb_method_count(); i++)
-        fprintf(out, "  %-8s %s\n", ppb_method_at(i)->id, ppb_method_at(i)->summary);
-    fprintf(out,
-            "\n"
-            "examples:\n"
-            "  ppbench run configs/uniform_g0_normal.ini\n"
-            "  ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini\n"
-            "  ppbench sweep --shard 2/3 configs/sweep_example.ini\n"
-            "  PPBENCH_DEVICE=pthread ppbench devices\n"
-            "\n"
-            "exit codes: 0 success; 1 a run failed (OpenCL, I/O, numerics); 2 bad command\n"
-            "line or config; 130 interrupted (what was done is written, marked partial).\n");
-}
+/* The options; each command lists those that apply to it, and any other is refused (an option
+ * a command silently ignored looked as if it had been used). */
+enum {
+    OPT_DEVICE = 1 << 0,
+    OPT_OUT = 1 << 1,
+    OPT_SET = 1 << 2,
+    OPT_SHARD = 1 << 3,
+    OPT_JOBS = 1 << 4,
+    OPT_YES = 1 << 5,
+    OPT_QUIET = 1 << 6,
+};
 
+static const struct option_doc {
+    unsigned bit;
+    const char *name, *arg, *help; /* help: lines after the first are indented under it */
+} option_docs[] = {
+    {OPT_DEVICE, "--device", "SEL",
+     "OpenCL device: index or name substring\n(default: $PPBENCH_DEVICE, else device 0)"},
+    {OPT_OUT, "--out", "DIR", "output directory (overrides [output] dir)"},
+    {OPT_SET, "--set", "SEC.KEY=VAL", "override a config key (may repeat)"},
+    {OPT_SHARD, "--shard", "I/N",
+     "run only the I-th of N parts (1-based): sweep points,\nmc-shard photons"},
+    {OPT_JOBS, "--jobs", "J", "sweep: J processes on this machine (1 to 64, default 1)"},
+    {OPT_YES, "--yes", NULL, "sweep: allow a grid larger than the safety limit"},
+    {OPT_QUIET, "--quiet", NULL, "no progress lines on stderr"},
+};
+enum { NOPTIONS = sizeof option_docs / sizeof option_docs[0] };
+
+/* The parsed command line. sets and args point into argv (no fixed limit on either). */
 typedef struct cli {
     const char *device, *out;
-    const char *sets[64];
+    const char **sets;
     int nsets;
     int quiet, yes;
     int shard_i, shard_n;
     int jobs;
-    const char *args[256];
+    const char **args;
     int nargs;
 } cli;
 
-static int parse_shard(const char *s, cli *c)
+typedef struct command {
+    const char *name;
+    const char *operands; /* after the options, e.g. "CONFIG..."; NULL: none */
+    unsigned required;    /* OPT_* bits it cannot do without (shown in the synopsis) */
+    const char *summary;  /* what it does; '\n' breaks the line in the overview */
+    const char *example;
+    unsigned opts;  /* OPT_* bits that apply */
+    int takes_args; /* 0: any operand is refused */
+    int (*run)(const cli *c);
+} command;
+
+/* A whole decimal number in [lo, hi]: digits only, no sign, fraction, exponent or trailing text
+ * (atoi took "2x" and "2.9" as 2), and no overflow; stop is the character that must follow
+ * it ('\0': the end of the string). */
+static int parse_int(const char *s, long lo, long hi, int *v, char stop)
 {
-    return sscanf(s, "%d/%d", &c->shard_i, &c->shard_n) == 2 && c->shard_n >= 1 &&
-           c->shard_i >= 1 && c->shard_i <= c->shard_n;
+    if (*s < '0' || *s > '9')
+        return 0;
+    errno = 0;
+    char *end;
+    long x = strtol(s, &end, 10);
+    if (errno || *end != stop || x < lo || x > hi)
+        return 0;
+    *v = (int)x;
+    return 1;
 }
 
-/* Returns 0, or EXIT_USAGE having printed why. */
-static int parse_cli(int argc, char **argv, cli *c)
+static int parse_shard(const char *s, cli *c)
+{
+    const char *slash = strchr(s, '/');
+    return slash && parse_int(s, 1, INT_MAX, &c->shard_i, '/') &&
+           parse_int(slash + 1, 1, INT_MAX, &c->shard_n, '\0') && c->shard_i <= c->shard_n;
+}
+
+enum { PARSE_HELP = -1 };
+
+/* The longest directory --out may name: what ppb_config holds (it was cut silently, and the
+ * results landed in the shorter path). */
+enum { OUT_MAX = sizeof(((ppb_config *)0)->out_dir) - 1 };
+
+/* Parses argv[2..] for cmd. Returns 0, PARSE_HELP for -h/--help, or EXIT_USAGE having printed
+ * why: an unknown option, a missing or malformed value, or an option that does not apply to
+ * cmd. */
+static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
 {
     memset(c, 0, sizeof *c);
     c->shard_i = c->shard_n = 1;
+    c->sets = calloc((size_t)argc, sizeof *c->sets);
+    c->args = calloc((size_t)argc, sizeof *c->args);
+    if (!c->sets || !c->args) {
+        fprintf(stderr, "ppbench: out of memory\n");
+        return EXIT_RUN;
+    }
     for (int i = 2; i < argc; i++) {
         const char *a = argv[i];
-        int has_next = i + 1 < argc;
-        if (!strcmp(a, "--quiet")) {
-            c->quiet = 1;
-        } else if (!strcmp(a, "--yes")) {
-            c->yes = 1;
-        } else if (!strcmp(a, "--device") && has_next) {
-            c->device = argv[++i];
-        } else if (!strcmp(a, "--out") && has_next) {
-            c->out = argv[++i];
-        } else if (!strcmp(a, "--set") && has_next && c->nsets < 64) {
-            c->sets[c->nsets++] = argv[++i];
-        } else if (!strcmp(a, "--jobs") && has_next) {
-            c->jobs = atoi(argv[++i]);
-            if (c->jobs < 1 || c->jobs > 64) {
-                fprintf(stderr, "ppbench: --jobs %s: expected 1 to 64\n", argv[i]);
-                return EXIT_USAGE;
-            }
-        } else if (!strcmp(a, "--shard") && has_next) {
-            if (!parse_shard(argv[++i], c)) {
-                fprintf(stderr, "ppbench: --shard %s: expected I/N with 1 <= I <= N\n", argv[i]);
-                return EXIT_USAGE;
-            }
-        } else if (a[0] == '-') {
-            fprintf(stderr, "ppbench: %s: unknown option or missing value (see --help)\n", a);
-            return EXIT_USAGE;
-        } else if (c->nargs < 256) {
+        if (a[0] != '-' || !a[1]) {
             c->args[c->nargs++] = a;
+            continue;
+        }
+        if (!strcmp(a, "-h") || !strcmp(a, "--help"))
+            return PARSE_HELP;
+        const struct option_doc *o = NULL;
+        for (int k = 0; k < NOPTIONS; k++)
+            if (!strcmp(a, option_docs[k].name))
+                o = &option_docs[k];
+        if (!o) {
+            fprintf(stderr, "ppbench: %s: unknown option (see ppbench %s --help)\n", a, cmd->name);
+            return EXIT_USAGE;
+        }
+        if (!(cmd->opts & o->bit)) {
+            fprintf(stderr,
+                    "ppbench %s: %s does not apply to this command (see ppbench %s --help)\n",
+                    cmd->name, a, cmd->name);
+            return EXIT_USAGE;
+        }
+        const char *v = NULL;
+        if (o->arg) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "ppbench: %s: missing value %s (see ppbench %s --help)\n", a,
+                        o->arg, cmd->name);
+                return EXIT_USAGE;
+            }
+            v = argv[++i];
+        }
+        switch (o->bit) {
+        case OPT_QUIET:
+            c->quiet = 1;
+            break;
+        case OPT_YES:
+            c->yes = 1;
+            break;
+        case OPT_DEVICE:
+            c->device = v;
+            break;
+        case OPT_OUT:
+            if (!*v || strlen(v) > OUT_MAX) {
+                fprintf(stderr, "ppbench: --out: %s (%zu characters; 1 to %d)\n",
+                        *v ? "too long" : "empty", strlen(v), (int)OUT_MAX);
+                return EXIT_USAGE;
+            }
+            c->out = v;
+            break;
+        case OPT_SET:
+            c->sets[c->nsets++] = v;
+            break;
+        case OPT_JOBS:
+            if (!parse_int(v, 1, 64, &c->jobs, '\0')) {
+                fprintf(stderr, "ppbench: --jobs %s: expected a whole number from 1 to 64\n", v);
+                return EXIT_USAGE;
+            }
+            break;
+        case OPT_SHARD:
+            if (!parse_shard(v, c)) {
+                fprintf(stderr,
+                        "ppbench: --shard %s: expected I/N, whole numbers with 1 <= I <= N <= %d\n",
+                        v, INT_MAX);
+                return EXIT_USAGE;
+            }
+            break;
         }
     }
+    if (!cmd->takes_args && c->nargs > 0) {
+        fprintf(stderr, "ppbench %s: unexpected argument '%s' (see ppbench %s --help)\n", cmd->name,
+                c->args[0], cmd->name);
+        return EXIT_USAGE;
+    }
     return 0;
+}
+
+static void free_cli(cli *c)
+{
+    free(c->sets);
+    free(c->args);
 }
 
 /* Loads a config with its grid (the keys holding lists) and applies --set and --out. The
@@ -148,61 +233,193 @@ static int usage_error(const ppb_err *err)
     return EXIT_USAGE;
 }
 
+/* Resolves --device (or $PPBENCH_DEVICE) before any work, so a bad one is a usage error even
+ * when no method of the run needs OpenCL. The enumeration runs in a child process: this one
+ * stays untouched by the OpenCL runtime until it opens the device itself, as before (a sweep
+ * forks its --jobs workers, and a runtime initialised before fork() is unusable in them). */
+static int check_device(const cli *c)
+{
+    const char *env = getenv("PPBENCH_DEVICE");
+    if (!(c->device && *c->device) && !(env && *env))
+        return 0; /* device 0, opened at first use; a CPU-only run needs none */
+    int fd[2];
+    ppb_err err = {{0}};
+    fflush(NULL);
+    pid_t pid = pipe(fd) < 0 ? -1 : fork();
+    if (pid < 0) {
+        fprintf(stderr, "ppbench: --device: cannot start the device check: %s\n", strerror(errno));
+        return EXIT_RUN;
+    }
+    if (pid == 0) {
+        close(fd[0]);
+        int rc = ppb_ocl_select(c->device, &err) < 0;
+        if (rc && write(fd[1], err.msg, strlen(err.msg)) < 0)
+            rc = 1;
+        _exit(rc);
+    }
+    close(fd[1]);
+    size_t n = 0;
+    ssize_t r;
+    while (n < sizeof err.msg - 1 && (r = read(fd[0], err.msg + n, sizeof err.msg - 1 - n)) != 0)
+        if (r > 0)
+            n += (size_t)r;
+        else if (errno != EINTR)
+            break;
+    err.msg[n] = '\0';
+    close(fd[0]);
+    int st;
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
+        ;
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 0)
+        return 0;
+    if (!n)
+        ppb_fail(&err, "--device %s: the device check failed", c->device ? c->device : env);
+    return usage_error(&err);
+}
+
+/* Whether dir can be an output directory: it is one, or every prefix of it that exists is one
+ * (mkdir -p makes the rest). Checked before any work: an --out naming a file used to fail only
+ * after the computing. what names the setting ("--out", "file: [output] dir"). */
+static int check_out_dir(const char *dir, const char *what, ppb_err *err)
+{
+    char buf[PPB_PATH_MAX];
+    if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf)
+        return ppb_fail(err, "%s: too long", what);
+    for (size_t i = 1, len = strlen(buf); i <= len; i++) {
+        if (buf[i] != '/' && buf[i] != '\0')
+            continue;
+        char keep = buf[i];
+        buf[i] = '\0';
+        struct stat st;
+        int rc = stat(buf, &st);
+        if (rc < 0 && errno == ENOENT)
+            return 0;
+        if (rc < 0)
+            return ppb_fail(err, "%s %s: %s: %s", what, dir, buf, strerror(errno));
+        if (!S_ISDIR(st.st_mode))
+            return ppb_fail(err, "%s %s: %s is not a directory", what, dir, buf);
+        buf[i] = keep;
+    }
+    if (access(dir, W_OK | X_OK) < 0)
+        return ppb_fail(err, "%s %s: not writable: %s", what, dir, strerror(errno));
+    return 0;
+}
+
+/* The output directory of a loaded config, checked; exit code 2 when it cannot be one. */
+static int check_config_out(const cli *c, const ppb_config *cfg)
+{
+    char what[1100];
+    snprintf(what, sizeof what, "%s%s", c->out ? "--out" : cfg->path,
+             c->out ? "" : ": [output] dir");
+    ppb_err err = {{0}};
+    return check_out_dir(cfg->out_dir, what, &err) ? usage_error(&err) : 0;
+}
+
+/* The same directory spelled alike but for trailing slashes. */
+static int same_dir(const char *a, const char *b)
+{
+    size_t na = strlen(a), nb = strlen(b);
+    while (na > 1 && a[na - 1] == '/')
+        na--;
+    while (nb > 1 && b[nb - 1] == '/')
+        nb--;
+    return na == nb && !memcmp(a, b, na);
+}
+
+/* Every config of `run`, loaded and checked before the first one runs (the second config's
+ * error used to appear only after the first had run): each a single experiment, with an
+ * output directory that can be one and is its own (two configs never share one; with --out
+ * they would). */
 static int cmd_run(const cli *c)
 {
     if (c->nargs == 0) {
-        fprintf(stderr, "ppbench run: no config given (see --help)\n");
+        fprintf(stderr, "ppbench run: no config given (see ppbench run --help)\n");
+        return EXIT_USAGE;
+    }
+    if (c->out && c->nargs > 1) {
+        fprintf(stderr,
+                "ppbench: --out %s: %d configs would share it; give one config per --out\n"
+                "(or no --out: each config writes its own [output] dir)\n",
+                c->out, c->nargs);
         return EXIT_USAGE;
     }
     ppb_grid *grid = ppb_grid_new();
-    if (!grid) {
+    ppb_config *cfgs = calloc((size_t)c->nargs, sizeof *cfgs);
+    if (!grid || !cfgs) {
+        ppb_grid_free(grid);
+        free(cfgs);
         fprintf(stderr, "ppbench: out of memory\n");
         return EXIT_RUN;
     }
     ppb_err err = {{0}};
     int code = EXIT_OK;
     for (int i = 0; i < c->nargs && code == EXIT_OK; i++) {
-        ppb_config cfg;
-        if (load_config(c, c->args[i], &cfg, grid, &err)) {
+        if (load_config(c, c->args[i], &cfgs[i], grid, &err)) {
             code = usage_error(&err);
-            break;
-        }
-        if (grid->naxes > 0) {
+        } else if (grid->naxes > 0) {
             fprintf(stderr, "ppbench: %s: keys hold lists (a sweep): use `ppbench sweep`\n",
-                    cfg.path);
+                    cfgs[i].path);
             code = EXIT_USAGE;
-            break;
+        } else {
+            code = check_config_out(c, &cfgs[i]);
+            for (int j = 0; j < i && code == EXIT_OK; j++)
+                if (same_dir(cfgs[j].out_dir, cfgs[i].out_dir)) {
+                    fprintf(stderr,
+                            "ppbench: %s and %s both write [output] dir %s: two configs never "
+                            "share one output directory\n",
+                            cfgs[j].path, cfgs[i].path, cfgs[i].out_dir);
+                    code = EXIT_USAGE;
+                }
         }
+    }
+    ppb_grid_free(grid);
+    for (int i = 0; i < c->nargs && code == EXIT_OK; i++) {
+        const ppb_config *cfg = &cfgs[i];
         ppb_experiment ex = {0};
         ppb_run_ctx ctx = {.device_selector = c->device, .quiet = c->quiet};
-        int rc = ppb_experiment_compute(&ex, &cfg, &ctx, &err);
+        int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
         int partial = ex.partial;
         ppb_experiment_free(&ex);
         ppb_ctx_close(&ctx);
         if (rc) {
-            fprintf(stderr, "ppbench: %s: %s\n", cfg.path, err.msg);
+            fprintf(stderr, "ppbench: %s: %s\n", cfg->path, err.msg);
             code = EXIT_RUN;
         } else {
             if (!c->quiet)
-                fprintf(stderr, "%s: wrote %s%s\n", cfg.name, cfg.out_dir,
+                fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
                         partial ? " (partial: interrupted)" : "");
             if (partial)
                 code = EXIT_INTERRUPTED;
         }
     }
-    ppb_grid_free(grid);
+    free(cfgs);
     return code;
 }
 
-static int cmd_devices(void)
+static int cmd_devices(const cli *c)
 {
+    (void)c;
     ppb_err err = {{0}};
     if (ppb_ocl_list(stdout, &err) < 0) {
         fprintf(stderr, "ppbench: %s\n", err.msg);
         return EXIT_RUN;
     }
+    return EXIT_OK;
+}
+
+static int cmd_keys(const cli *c)
+{
+    (void)c;
+    ppb_config_write_keys(stdout);
+    return EXIT_OK;
+}
+
+static int cmd_version(const cli *c)
+{
+    (void)c;
+    printf("ppbench %s\n", PPB_VERSION);
     return EXIT_OK;
 }
 
@@ -222,7 +439,7 @@ static int cmd_perf(const cli *c)
 static int cmd_sweep(const cli *c)
 {
     if (c->nargs != 1) {
-        fprintf(stderr, "ppbench sweep: give exactly one config (see --help)\n");
+        fprintf(stderr, "ppbench sweep: give exactly one config (see ppbench sweep --help)\n");
         return EXIT_USAGE;
     }
     ppb_grid *grid = ppb_grid_new();
@@ -235,6 +452,11 @@ static int cmd_sweep(const cli *c)
     if (load_config(c, c->args[0], &cfg, grid, &err)) {
         ppb_grid_free(grid);
         return usage_error(&err);
+    }
+    int code = check_config_out(c, &cfg);
+    if (code) {
+        ppb_grid_free(grid);
+        return code;
     }
     ppb_sweep_opts o = {.device = c->device,
                         .quiet = c->quiet,
@@ -258,18 +480,22 @@ static int cmd_sweep(const cli *c)
 static int cmd_merge(const cli *c)
 {
     if (c->nargs < 1 || !c->out) {
-        fprintf(stderr, "ppbench merge: usage: ppbench merge --out DIR SHARD_DIR...\n");
+        fprintf(stderr, "ppbench merge: usage: ppbench merge --out DIR SHARD_DIR... (see "
+                        "ppbench merge --help)\n");
         return EXIT_USAGE;
     }
     ppb_err err = {{0}};
-    if (ppb_sweep_merge(c->args, c->nargs, c->out, &err)) {
+    if (check_out_dir(c->out, "--out", &err))
+        return usage_error(&err);
+    int rc = ppb_sweep_merge(c->args, c->nargs, c->out, &err);
+    if (rc) {
         fprintf(stderr, "ppbench merge: %s\n", err.msg);
-        return EXIT_RUN;
+        return rc == PPB_SWEEP_BAD_CONFIG ? EXIT_USAGE : EXIT_RUN; /* shards of another grid */
     }
     return EXIT_OK;
 }
 
-static int cmd_mc_shard(const cli *c, int merge)
+static int mc_shard_or_merge(const cli *c, int merge)
 {
     if (c->nargs < (merge ? 2 : 1) || (!merge && c->nargs != 1) || !c->out) {
         fprintf(stderr, "ppbench: usage: ppbench mc-shard --shard I/N --out DIR CONFIG | "
@@ -281,19 +507,33 @@ static int cmd_mc_shard(const cli *c, int merge)
     ppb_err err = {{0}};
     if (load_config(c, c->args[0], &cfg, NULL, &err))
         return usage_error(&err);
+    int code = check_config_out(c, &cfg);
+    if (code)
+        return code;
     int rc = merge ? ppb_mc_shard_merge(&cfg, c->args + 1, c->nargs - 1, &err)
                    : ppb_mc_shard_run(&cfg, c->device, c->quiet, c->shard_i, c->shard_n, &err);
     if (rc) {
         fprintf(stderr, "ppbench: %s: %s\n", cfg.path, err.msg);
-        return EXIT_RUN;
+        return ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_RUN;
     }
     return EXIT_OK;
+}
+
+static int cmd_mc_shard(const cli *c)
+{
+    return mc_shard_or_merge(c, 0);
+}
+
+static int cmd_mc_merge(const cli *c)
+{
+    return mc_shard_or_merge(c, 1);
 }
 
 static int cmd_report(const cli *c)
 {
     if (c->nargs < 2) {
-        fprintf(stderr, "ppbench report: usage: ppbench report STUDY_DIR CASE...\n");
+        fprintf(stderr, "ppbench report: usage: ppbench report STUDY_DIR CASE... (see ppbench "
+                        "report --help)\n");
         return EXIT_USAGE;
     }
     ppb_err err = {{0}};
@@ -304,37 +544,156 @@ static int cmd_report(const cli *c)
     return EXIT_OK;
 }
 
+static const command commands[] = {
+    {"run", "CONFIG...", 0,
+     "run every method of each experiment config and write\nSPEC.md section 8's outputs under "
+     "[output] dir",
+     "ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini",
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET, 1, cmd_run},
+    {"sweep", "CONFIG", 0, "run a grid sweep (keys holding lists) into <dir>/sweep.csv",
+     "ppbench sweep --shard 2/3 --jobs 2 configs/sweep_example.ini",
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARD | OPT_JOBS | OPT_YES | OPT_QUIET, 1, cmd_sweep},
+    {"merge", "SHARD_DIR...", OPT_OUT, "merge sweep shards (--out DIR) into one sweep.csv",
+     "ppbench merge --out /tmp/sweep /tmp/part1 /tmp/part2 /tmp/part3", OPT_OUT, 1, cmd_merge},
+    {"mc-shard", "CONFIG", OPT_OUT,
+     "trace part --shard I/N of the config's photons into\n<--out>/mc_tallies.bin",
+     "ppbench mc-shard --shard 1/2 --out /tmp/p1 configs/uniform_g0_normal.ini",
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARD | OPT_QUIET, 1, cmd_mc_shard},
+    {"mc-merge", "CONFIG SHARD_DIR...", OPT_OUT,
+     "add the shards' tallies and write mc, mc1 outputs to\n--out, byte-identical to one run of "
+     "the whole budget",
+     "ppbench mc-merge --out /tmp/mc configs/uniform_g0_normal.ini /tmp/p1 /tmp/p2",
+     OPT_OUT | OPT_SET, 1, cmd_mc_merge},
+    {"devices", NULL, 0, "list OpenCL devices (index: platform / device)",
+     "PPBENCH_DEVICE=pthread ppbench devices", 0, 0, cmd_devices},
+    {"keys", NULL, 0, "print every config key with its default and range", "ppbench keys", 0, 0,
+     cmd_keys},
+    {"perf", NULL, 0, "benchmarks: solver, ray marcher, Monte Carlo", "ppbench perf --device 0",
+     OPT_DEVICE, 0, cmd_perf},
+    {"report", "STUDY_DIR CASE...", 0, "table2.csv/.md and README.md of a study from its cases",
+     "ppbench report results uniform_g0_normal density_step", 0, 1, cmd_report},
+    {"version", NULL, 0, "print the version (as --version)", "ppbench version", 0, 0, cmd_version},
+};
+enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
+
+/* Text with '\n' continuation lines indented to the help column. */
+static void print_indented(FILE *out, const char *head, const char *text)
+{
+    fprintf(out, strlen(head) < 19 ? "  %-19s " : "  %s  ", head);
+    for (const char *s = text; *s; s++) {
+        fputc(*s, out);
+        if (*s == '\n')
+            fprintf(out, "%22s", "");
+    }
+    fputc('\n', out);
+}
+
+static void print_option(FILE *out, const struct option_doc *o)
+{
+    char head[64];
+    snprintf(head, sizeof head, "%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
+    print_indented(out, head, o->help);
+}
+
+static void usage(FILE *out)
+{
+    fprintf(out, "usage: ppbench COMMAND [options]\n"
+                 "       ppbench COMMAND --help   (that command's options and an example)\n"
+                 "\n"
+                 "commands:\n");
+    for (int i = 0; i < NCOMMANDS; i++) {
+        char head[64];
+        snprintf(head, sizeof head, "%s%s%s", commands[i].name, commands[i].operands ? " " : "",
+                 commands[i].operands ? commands[i].operands : "");
+        print_indented(out, head, commands[i].summary);
+    }
+    fprintf(out, "\noptions (each applies to the commands its help names):\n");
+    for (int i = 0; i < NOPTIONS; i++)
+        print_option(out, &option_docs[i]);
+    fprintf(out, "  -h, --help          this text; `ppbench COMMAND --help`: that command's\n"
+                 "                      options and an example\n"
+                 "  --version           the version (as `ppbench version`)\n"
+                 "\n"
+                 "methods:\n");
+    for (int i = 0; i < ppb_method_count(); i++)
+        fprintf(out, "  %-8s %s\n", ppb_method_at(i)->id, ppb_method_at(i)->summary);
+    fprintf(out,
+            "\n"
+            "examples:\n"
+            "  ppbench run configs/uniform_g0_normal.ini\n"
+            "  ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini\n"
+            "  ppbench sweep --shard 2/3 configs/sweep_example.ini\n"
+            "  PPBENCH_DEVICE=pthread ppbench devices\n"
+            "\n"
+            "exit codes: 0 success; 1 a run failed (OpenCL, I/O, numerics); 2 bad command\n"
+            "line or config (found before any work starts); 130 interrupted (what was done\n"
+            "is written, marked partial).\n");
+}
+
+/* `ppbench CMD --help`: the command's synopsis, what it does, its options, one example. */
+static void command_usage(FILE *out, const command *cmd)
+{
+    fprintf(out, "usage: ppbench %s", cmd->name);
+    for (int i = 0; i < NOPTIONS; i++)
+        if (cmd->required & option_docs[i].bit)
+            fprintf(out, " %s %s", option_docs[i].name, option_docs[i].arg);
+    fprintf(out, "%s%s%s\n\n%s.\n", cmd->opts & ~cmd->required ? " [options]" : "",
+            cmd->operands ? " " : "", cmd->operands ? cmd->operands : "", cmd->summary);
+    if (cmd->opts) {
+        fprintf(out, "\noptions:\n");
+        for (int i = 0; i < NOPTIONS; i++)
+            if (cmd->opts & option_docs[i].bit)
+                print_option(out, &option_docs[i]);
+    }
+    fprintf(out, "\nexample:\n  %s\n", cmd->example);
+}
+
+static const command *find_command(const char *name)
+{
+    for (int i = 0; i < NCOMMANDS; i++)
+        if (!strcmp(commands[i].name, name))
+            return &commands[i];
+    return NULL;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") ||
         !strcmp(argv[1], "help")) {
-        usage(argc < 2 ? stderr : stdout);
+        /* `ppbench help CMD` is `ppbench CMD --help`. */
+        const command *cmd = argc > 2 ? find_command(argv[2]) : NULL;
+        if (argc > 2 && !cmd) {
+            fprintf(stderr, "ppbench: %s: unknown command (see ppbench --help)\n", argv[2]);
+            return EXIT_USAGE;
+        }
+        if (argc > 3) {
+            fprintf(stderr, "ppbench %s: unexpected argument '%s'\n", argv[1], argv[3]);
+            return EXIT_USAGE;
+        }
+        if (cmd)
+            command_usage(stdout, cmd);
+        else
+            usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? EXIT_USAGE : EXIT_OK;
     }
+    const command *cmd = find_command(strcmp(argv[1], "--version") ? argv[1] : "version");
+    if (!cmd) {
+        fprintf(stderr, "ppbench: %s: unknown command (see --help)\n", argv[1]);
+        return EXIT_USAGE;
+    }
     cli c;
-    int rc = parse_cli(argc, argv, &c);
-    if (rc)
-        return rc;
-    ppb_progress_install_signals();
-    const char *cmd = argv[1];
-    if (!strcmp(cmd, "run"))
-        return cmd_run(&c);
-    if (!strcmp(cmd, "devices"))
-        return cmd_devices();
-    if (!strcmp(cmd, "keys")) {
-        ppb_config_write_keys(stdout);
+    int rc = parse_cli(argc, argv, cmd, &c);
+    if (rc == PARSE_HELP) {
+        command_usage(stdout, cmd);
+        free_cli(&c);
         return EXIT_OK;
     }
-    if (!strcmp(cmd, "perf"))
-        return cmd_perf(&c);
-    if (!strcmp(cmd, "sweep"))
-        return cmd_sweep(&c);
-    if (!strcmp(cmd, "merge"))
-        return cmd_merge(&c);
-    if (!strcmp(cmd, "mc-shard") || !strcmp(cmd, "mc-merge"))
-        return cmd_mc_shard(&c, !strcmp(cmd, "mc-merge"));
-    if (!strcmp(cmd, "report"))
-        return cmd_report(&c);
-    fprintf(stderr, "ppbench: %s: unknown command (see --help)\n", cmd);
-    return EXIT_USAGE;
+    if (rc == 0 && (cmd->opts & OPT_DEVICE))
+        rc = check_device(&c);
+    if (rc == 0) {
+        ppb_progress_install_signals();
+        rc = cmd->run(&c);
+    }
+    free_cli(&c);
+    return rc;
 }

@@ -161,8 +161,9 @@ static int contains_nocase(const char *hay, const char *needle)
     return 0;
 }
 
-/* Index when the selector is all digits, else the first name containing it. */
-static int choose(const dev_entry *devs, int n, const char *sel, ppb_err *err)
+/* Index when the selector is all digits, else the first name containing it; `what` names where
+ * the selector came from ("--device" or "$PPBENCH_DEVICE") in the error. */
+static int choose(const dev_entry *devs, int n, const char *sel, const char *what, ppb_err *err)
 {
     if (!sel || !*sel)
         return 0;
@@ -170,14 +171,40 @@ static int choose(const dev_entry *devs, int n, const char *sel, ppb_err *err)
     long idx = strtol(sel, &end, 10);
     if (*end == '\0') {
         if (idx < 0 || idx >= n)
-            return ppb_fail(
-                err, "--device %s: no such device (there are %d; see `ppbench devices`)", sel, n);
+            return ppb_fail(err, "%s %s: no such device (there are %d; see `ppbench devices`)",
+                            what, sel, n);
         return (int)idx;
     }
     for (int i = 0; i < n; i++)
         if (contains_nocase(devs[i].name, sel))
             return i;
-    return ppb_fail(err, "--device %s: no device name contains it (see `ppbench devices`)", sel);
+    return ppb_fail(err, "%s %s: no device name contains it (see `ppbench devices`)", what, sel);
+}
+
+/* The selector in effect: the given one, else $PPBENCH_DEVICE; *what names its origin. */
+static const char *effective(const char *selector, const char **what)
+{
+    *what = "--device";
+    if (selector && *selector)
+        return selector;
+    *what = "$PPBENCH_DEVICE";
+    return getenv("PPBENCH_DEVICE");
+}
+
+int ppb_ocl_select(const char *selector, ppb_err *err)
+{
+    const char *what;
+    const char *sel = effective(selector, &what);
+    dev_entry devs[MAX_DEVICES];
+    int n = enumerate(devs, MAX_DEVICES, err);
+    if (n < 0) {
+        if (sel && *sel) {
+            ppb_err why = *err;
+            return ppb_fail(err, "%s %s: %s", what, sel, why.msg);
+        }
+        return -1;
+    }
+    return choose(devs, n, sel, what, err);
 }
 
 /* The device limits the launches are sized by; a query that fails, or a work-group limit of
@@ -220,9 +247,9 @@ int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err)
     int n = enumerate(devs, MAX_DEVICES, err);
     if (n < 0)
         return -1;
-    if (!selector || !*selector)
-        selector = getenv("PPBENCH_DEVICE");
-    int i = choose(devs, n, selector, err);
+    const char *what;
+    selector = effective(selector, &what);
+    int i = choose(devs, n, selector, what, err);
     if (i < 0)
         return -1;
     ocl->platform = devs[i].platform;

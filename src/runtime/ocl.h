@@ -30,6 +30,11 @@ const char *ppb_cl_errname(cl_int code);
 /* Prints one line per device ("index: platform / device, units, memory"); returns the count. */
 int ppb_ocl_list(FILE *out, ppb_err *err);
 
+/* Resolves a selector as ppb_ocl_open does, opening nothing: the device's index, or -1 with an
+ * error naming the selector and its origin (--device, or $PPBENCH_DEVICE when selector is NULL
+ * or ""). The command line calls it before any work, so a bad choice is a usage error. */
+int ppb_ocl_select(const char *selector, ppb_err *err);
+
 int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err);
 void ppb_ocl_close(ppb_ocl *ocl);
 
