@@ -3,7 +3,8 @@
  * A photon enters S1 uniformly over the lit part along w_L, flies free paths sampled in optical
  * depth through the piecewise-constant medium (traced exactly across the density step plane
  * x = step_x), scatters by Henyey-Greenstein, loses weight by implicit capture (w *= alpha) with
- * unbiased Russian roulette, and leaves at its first boundary crossing (n = 1). Its exit weight
+ * unbiased Russian roulette (applied at every event past an event cap, kernels/mc_params.h, so
+ * no photon can run forever), and leaves at its first boundary crossing (n = 1). Its exit weight
  * goes into integer fixed-point tallies (kernels/mc_params.h), so sums do not depend on the
  * order of the atomic additions.
  *
@@ -105,7 +106,7 @@ inline ulong ppb_mc_fixed(float w)
 
 /* Per-work-item sums of the totals: integers, added to the batch's totals once at the end. */
 typedef struct ppb_mc_sums {
-    ulong ballistic, capture, rgain, rloss, events;
+    ulong ballistic, capture, rgain, rloss, events, capped;
 } ppb_mc_sums;
 
 /* The state of every lane, kept in private arrays so that one lane can be finished and
@@ -115,6 +116,7 @@ typedef struct ppb_mc_lanes {
     float weight[LANES], capture[LANES], rgain[LANES], rloss[LANES], tau[LANES];
     uint ctr0[LANES], ctr1[LANES], step[LANES];
     int nscat[LANES], need_tau[LANES], active[LANES], done[LANES], left[LANES], side[LANES];
+    int capped[LANES]; /* roulettes forced by the event cap */
 } ppb_mc_lanes;
 
 /* Starts photon `photon` in lane l: entry on S1 (y = 0) along w_L. */
@@ -130,7 +132,7 @@ inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong p
     s->x[l] = x, s->y[l] = 0.0f;
     s->wx[l] = p->light_x, s->wy[l] = p->light_y, s->wz[l] = 0.0f;
     s->weight[l] = 1.0f, s->capture[l] = s->rgain[l] = s->rloss[l] = 0.0f, s->tau[l] = 0.0f;
-    s->nscat[l] = 0, s->need_tau[l] = -1, s->active[l] = -1;
+    s->nscat[l] = 0, s->need_tau[l] = -1, s->active[l] = -1, s->capped[l] = 0;
 }
 
 /* Tallies lane l's photon, which has left (s->left) or died. */
@@ -156,6 +158,7 @@ inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_lanes *s, int l,
     }
     sums->capture += ppb_mc_fixed(s->capture[l]);
     sums->events += (ulong)s->nscat[l];
+    sums->capped += (ulong)s->capped[l];
     sums->rgain += ppb_mc_fixed(s->rgain[l]);
     sums->rloss += ppb_mc_fixed(s->rloss[l]);
 }
@@ -218,7 +221,8 @@ inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *me
     VSTORE(VLOAD(0, s->capture) + select((vfloat)0.0f, weight * (1.0f - alpha), inter), 0,
            s->capture);
     weight = select(weight, weight * alpha, inter);
-    VSTORE(VLOAD(0, s->nscat) - inter, 0, s->nscat);
+    vint nscat = VLOAD(0, s->nscat) - inter;
+    VSTORE(nscat, 0, s->nscat);
 
     vfloat ct = ppb_mc_hg_cos(p->g, 0.5f / p->g, ppb_mc_uniform(c.v1));
     vfloat cp, sp = ppb_mc_sincos2pi(ppb_mc_uniform(c.v2), &cp);
@@ -239,8 +243,11 @@ inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *me
     wz = select(wz, nz * renorm, inter);
 
     /* Russian roulette: survive with probability 1/M at M times the weight (M = 8, so the test
-     * u < 1/M on the 2^-23 grid has probability exactly 1/M). alpha = 0 ends a photon too. */
-    vint roulette = inter & (weight < PPB_MC_ROULETTE_W);
+     * u < 1/M on the 2^-23 grid has probability exactly 1/M). alpha = 0 ends a photon too.
+     * Past the event cap every interaction is a roulette (mc_params.h). */
+    vint over_cap = inter & (nscat > PPB_MC_EVENT_CAP) & (weight < PPB_MC_CAP_WMAX);
+    VSTORE(VLOAD(0, s->capped) - over_cap, 0, s->capped);
+    vint roulette = inter & ((weight < PPB_MC_ROULETTE_W) | over_cap);
     vint survive = ppb_mc_uniform(c.v3) < 1.0f / PPB_MC_ROULETTE_M;
     VSTORE(VLOAD(0, s->rgain) +
                select((vfloat)0.0f, weight * (PPB_MC_ROULETTE_M - 1.0f), roulette & survive),
@@ -286,7 +293,7 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     medium[4] = (float)ppb_albedo_at(p.step_x - 1.0, p.step, p.step_x, p.albedo, p.albedo_right);
     medium[5] = (float)ppb_albedo_at(p.step_x, p.step, p.step_x, p.albedo, p.albedo_right);
 
-    ppb_mc_sums sums = {0, 0, 0, 0, 0};
+    ppb_mc_sums sums = {0, 0, 0, 0, 0, 0};
     ppb_mc_lanes s;
     ulong m = q0;
     for (int l = 0; l < LANES; l++) {
@@ -322,6 +329,7 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     atom_add(tot + PPB_MC_T_EVENTS, sums.events);
     atom_add(tot + PPB_MC_T_RGAIN, sums.rgain);
     atom_add(tot + PPB_MC_T_RLOSS, sums.rloss);
+    atom_add(tot + PPB_MC_T_CAPPED, sums.capped);
 }
 
 /* Self-check for tests/test_mc.c: the vector Philox above against Random123's philox4x32 on

@@ -28,6 +28,22 @@ typedef uint32_t ppb_u32;
 #define PPB_MC_ROULETTE_W 1e-3f
 #define PPB_MC_ROULETTE_M 8.0f
 
+/* Event cap (issue 15): past PPB_MC_EVENT_CAP scatterings every further interaction is a
+ * roulette with the same survival probability 1 / PPB_MC_ROULETTE_M and weight factor, whatever
+ * the weight. Roulette is unbiased wherever it is applied, so the estimate keeps its
+ * expectation; what changes is the work: a photon that would wander on (at albedo 1 in a thick
+ * medium the weight never falls, so the weight test never ends it) survives k more events with
+ * probability 8^-k. So that no weight can overflow the fixed-point tallies, the capped roulette
+ * stops once the weight has reached PPB_MC_CAP_WMAX (after three survivals, probability 1/512
+ * per capped photon); such a photon goes on unrouletted until it leaves, which it does in
+ * finite expected time in every geometry here (the medium is bounded in y), and its weight, at
+ * most 8 PPB_MC_CAP_WMAX, keeps every tally within range. No photon of the study reaches the
+ * cap (its albedos are below 1: a weight falls below PPB_MC_ROULETTE_W within a few hundred
+ * events and each roulette ends it with probability 7/8), so its results are unchanged bit for
+ * bit; PPB_MC_T_CAPPED counts the capped roulettes. */
+#define PPB_MC_CAP_WMAX  512.0f
+#define PPB_MC_EVENT_CAP 10000
+
 /* Per-batch totals (each a fixed-point weight sum unless noted). */
 enum {
     PPB_MC_T_BALLISTIC = 0, /* unscattered exits, any surface */
@@ -35,6 +51,7 @@ enum {
     PPB_MC_T_RGAIN = 2,     /* weight added by roulette survivors */
     PPB_MC_T_RLOSS = 3,     /* weight of photons ended by roulette */
     PPB_MC_T_EVENTS = 4,    /* scattering events (a plain count) */
+    PPB_MC_T_CAPPED = 5,    /* roulettes forced by PPB_MC_EVENT_CAP (a plain count) */
     PPB_MC_NTOT = 8         /* padded: room for more without changing the file format */
 };
 

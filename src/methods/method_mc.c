@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "model/metrics.h"
+#include "base/memory.h"
 #include "base/progress.h"
 
 /* Host and kernel must agree on the parameter block passed by value (kernels/mc_params.h). */
@@ -409,11 +410,28 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
     ppb_mc_tallies t;
-    if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
+    /* Issue 15: the tallies live three times (host, its copy read back for noise checks, the
+     * device buffer), each batches x 2 tallies x cells of 8 bytes; estimated first. */
+    double tally = (double)cfg->mc.batches * PPB_MC_NTALLY *
+                   (double)ppb_scene_layout(&cfg->scene).ncells * sizeof(uint64_t);
+    char detail[128];
+    snprintf(detail, sizeof detail, "tallies of %d batches, %.3g GB x 3", cfg->mc.batches,
+             tally / 1e9);
+    if (ppb_memory_check(3.0 * tally, cfg->memory_limit, "mc", detail, err) ||
+        ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
         return -1;
     ppb_mc_trace_info info;
     int status = ppb_mc_trace(ctx, cfg->mc.first, cfg->mc.photons, &t, &info, err);
     if (status == 0) {
+        /* Said, not hidden: interactions past the event cap were rouletted (mc_params.h). */
+        uint64_t capped = 0;
+        for (int b = 0; b < t.batches; b++)
+            capped += t.totals[(size_t)b * PPB_MC_NTOT + PPB_MC_T_CAPPED];
+        if (capped)
+            fprintf(stderr,
+                    "%s: mc: note: %llu interactions past the event cap of %d scatterings per "
+                    "photon were Russian-rouletted (unbiased; it bounds the work per photon)\n",
+                    cfg->name, (unsigned long long)capped, PPB_MC_EVENT_CAP);
         ppb_mc_tallies_to_results(&t, &cfg->scene, &out[0], &out[1]);
         for (int i = 0; i < 2; i++) {
             out[i].partial = info.interrupted;

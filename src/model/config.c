@@ -122,6 +122,9 @@ static const key_def keys[] = {
      "quadrature nodes per mfp over the lit strip"},
     {"output", "dir", K_PATH, F(out_dir), 0, 0, "", NULL,
      "output directory; default results/<name>"},
+    {"run", "memory_limit", K_REAL, F(memory_limit), 0, 1e6, "0", NULL,
+     "GB a method may allocate, estimated before it allocates (over it: refused); 0 = half "
+     "the machine's memory"},
 };
 #undef F
 #define NKEYS ((int)(sizeof keys / sizeof keys[0]))

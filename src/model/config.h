@@ -64,6 +64,7 @@ typedef struct ppb_config {
     ppb_pp_settings pp;
     ppb_mp_settings mp;
     char out_dir[1024];
+    double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
     ppb_key_origin origin[PPB_MAX_KEYS]; /* per key of the table */
 } ppb_config;
 

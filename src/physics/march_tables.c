@@ -115,6 +115,29 @@ static int alloc_common(const ppb_scene *sc, const table_key *k, ppb_march_table
     return 0;
 }
 
+double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
+                              int tau_per_mfp, int with_modes, double *tables)
+{
+    table_key k = plan(sc, pp, nsamp, tau_per_mfp, with_modes);
+    double ndir = ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                 ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
+    double ntau = 0.0, ntau_max = 0.0;
+    for (int c = 0; c < k.ncols; c++) {
+        ntau += k.ntau[c];
+        ntau_max = k.ntau[c] > ntau_max ? k.ntau[c] : ntau_max;
+    }
+    double d = sizeof(double), coef = k.ncols * k.nalb * ndir * d;
+    if (!with_modes) {
+        *tables = coef;
+        return coef;
+    }
+    double n = pp->directions, m = 2.0 * n; /* solver cells per hemisphere, and modes */
+    double tab = (k.want_s ? 2.0 : 1.0) * k.nalb * ndir * ntau * d;
+    double scratch = (ndir * 4.0 + (k.want_s ? 2.0 : 1.0) * ndir * m + ntau_max * m) * d;
+    *tables = tab + coef;
+    return tab + coef + scratch + 24.0 * n * n * d;
+}
+
 int ppb_march_tables_ss(const ppb_scene *sc, int nsamp, ppb_march_tables *t, ppb_err *err)
 {
     table_key k = plan(sc, NULL, nsamp, 0, 0);

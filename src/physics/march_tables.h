@@ -71,6 +71,13 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
 
 void ppb_march_tables_free(ppb_march_tables *t);
 
+/* Bytes a build of those tables (pp when with_modes, else ss) takes at its peak, estimated
+ * before anything is allocated: the tables themselves (*tables, what the march uploads) plus
+ * the build's scratch and the slab solver's matrices (about 24 of M/2 x M/2 doubles: phase
+ * blocks, eigenproblem, boundary system, and the first solution kept for sharing). */
+double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
+                              int tau_per_mfp, int with_modes, double *tables);
+
 /* Cache of built tables for runs that follow each other (a sweep's grid points): it keeps the
  * last tables of each kind (pp, ss) with the parameters that shaped them (geometry, bins,
  * direction samples, g, theta_L, H, the columns' sigma_t, the albedo nodes, the solver's
