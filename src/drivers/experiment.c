@@ -31,8 +31,20 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
     if (!ctx->quiet)
         fprintf(stderr, "%s: %s ...\n", ex->cfg->name, m->id);
     double t0 = ppb_now();
-    if (m->run(ctx, out, err))
-        return -1;
+    ppb_err why = {{0}};
+    if (m->run(ctx, out, &why)) {
+        /* Issue 15: this method's failure is its own; the others run on. */
+        for (int i = 0; i < nout; i++)
+            ppb_result_free(&out[i]);
+        ex->n -= nout;
+        if (ex->nfailed < PPB_MAX_METHODS) {
+            snprintf(ex->failed[ex->nfailed], sizeof ex->failed[0], "%s", m->id);
+            snprintf(ex->failed_why[ex->nfailed], sizeof ex->failed_why[0], "%s", why.msg);
+            ex->nfailed++;
+        }
+        fprintf(stderr, "%s: %s failed: %s\n", ex->cfg->name, m->id, why.msg);
+        return 0;
+    }
     for (int i = 0; i < nout; i++) {
         ex->seconds[ex->n - nout + i] = ppb_now() - t0;
         ex->partial |= out[i].partial;
@@ -53,6 +65,8 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
         ex->partial = 1;
     if (ctx->ocl_open)
         snprintf(ex->device, sizeof ex->device, "%s", ctx->ocl.name);
+    if (ex->n == 0 && ex->nfailed > 0)
+        return ppb_fail(err, "%s", ex->failed_why[0]);
     return 0;
 }
 
@@ -140,6 +154,8 @@ static int write_provenance(const ppb_experiment *ex, ppb_err *err)
             fprintf(af.f, "%s.photons_traced = %lld\n", ex->res[i].method, ex->res[i].photons);
     for (int i = 0; i < ex->n; i++)
         fprintf(af.f, "%s.seconds = %.4f\n", ex->res[i].method, ex->seconds[i]);
+    for (int i = 0; i < ex->nfailed; i++)
+        fprintf(af.f, "%s.failed = %s\n", ex->failed[i], ex->failed_why[i]);
     ppb_config_write_resolved(ex->cfg, af.f);
     return ppb_afile_commit(&af, err);
 }
@@ -189,6 +205,11 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
     if (write_comparisons(ex, err) || write_timings(ex, err) || write_provenance(ex, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
-    return ppb_images_write(ex->cfg->out_dir, &ex->cfg->scene, ex->res, ex->n,
-                            ref ? (int)(ref - ex->res) : -1, err);
+    if (ppb_images_write(ex->cfg->out_dir, &ex->cfg->scene, ex->res, ex->n,
+                         ref ? (int)(ref - ex->res) : -1, err))
+        return -1;
+    if (ex->nfailed > 0)
+        return ppb_fail(err, "%d method(s) failed, the others' outputs are written: %s: %s",
+                        ex->nfailed, ex->failed[0], ex->failed_why[0]);
+    return 0;
 }

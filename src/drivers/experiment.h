@@ -21,10 +21,18 @@ typedef struct ppb_experiment {
     double seconds[PPB_MAX_RESULTS]; /* wall time of the method run that produced it */
     char device[512];                /* "" when no method used OpenCL */
     int partial;                     /* interrupted: results are incomplete */
+    /* Methods that failed at this point (issue 15): no results of theirs, their reasons kept,
+     * the other methods run on. */
+    int nfailed;
+    char failed[PPB_MAX_METHODS][32];
+    char failed_why[PPB_MAX_METHODS][2048];
 } ppb_experiment;
 
+/* Runs every method. A method that fails is recorded in ex->failed (and said on stderr) while
+ * the others go on; fails only when no method produced a result (with the first reason). */
 int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx *ctx,
                            ppb_err *err);
+/* Writes the outputs of the methods that ran; then fails, naming them, if any method failed. */
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err);
 void ppb_experiment_free(ppb_experiment *ex);
 

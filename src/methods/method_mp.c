@@ -13,8 +13,11 @@
 #include "methods/method_mp.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 #include "methods/method_ss.h"
+#include "methods/result_check.h"
 #include "physics/maps.h"
 #include "physics/multipole.h"
 
@@ -76,6 +79,33 @@ static void fill_bins(ppb_result *out, int surf, int seg, double radiance)
         out->radiance[ppb_cell(&out->layout, surf, seg, b)] = radiance;
 }
 
+/* Issue 15: the diffusion flux through a surface can come out negative (the dipole images
+ * outweigh the real sources where the slab is thin against the extrapolation distance, and at
+ * strongly anisotropic g). Radiance cannot be negative, so such a segment is set to 0, counted,
+ * and the count reported: never clamped silently. */
+typedef struct clamp_count {
+    long n;
+    double low; /* most negative flux */
+} clamp_count;
+
+static double clamp_flux(clamp_count *c, double flux)
+{
+    if (!(flux < 0.0))
+        return flux;
+    c->n++;
+    c->low = fmin(c->low, flux);
+    return 0.0;
+}
+
+static void clamp_report(const ppb_config *cfg, const ppb_result *out, const clamp_count *c)
+{
+    if (c->n)
+        fprintf(stderr,
+                "%s: %s: warning: the diffusion flux was negative at %ld segments or faces (down "
+                "to %.3g per unit irradiance); set to 0\n",
+                cfg->name, out->method, c->n, c->low);
+}
+
 static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
@@ -86,15 +116,18 @@ static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
     double cos_l = ppb_scene_cos_theta_l(sc);
     double power = ppb_scene_power_in(sc); /* entering the lit S1 per unit z */
     double surface_power[PPB_NSURF] = {0};
+    clamp_count neg = {0, 0.0};
     for (int surf = 0; surf < PPB_NSURF; surf++) {
         int nseg = out->layout.nseg[surf];
         double len = ppb_scene_segment_length(sc, surf);
         for (int seg = 0; seg < nseg; seg++) {
-            double flux = cos_l * mp_segment_flux(cfg, piece, npiece, surf, seg, len);
+            double flux =
+                clamp_flux(&neg, cos_l * mp_segment_flux(cfg, piece, npiece, surf, seg, len));
             fill_bins(out, surf, seg, flux / PPB_PI);
             surface_power[surf] += flux * len;
         }
     }
+    clamp_report(cfg, out, &neg);
     double scale = power > 0 ? 1.0 / power : 0.0;
     out->totals.R = surface_power[PPB_S1] * scale;
     out->totals.T = surface_power[PPB_S2] * scale;
@@ -110,8 +143,10 @@ static int mp_slab(const ppb_config *cfg, ppb_result *out, ppb_err *err)
     if (ppb_multipole_init(&mp, sc->sigma_t, sc->albedo, sc->g, sc->height, cfg->mp.pairs, err))
         return -1;
     double cos_l = ppb_scene_cos_theta_l(sc);
-    out->totals.R = ppb_multipole_total_R(&mp);
-    out->totals.T = ppb_multipole_total_T(&mp);
+    clamp_count neg = {0, 0.0};
+    out->totals.R = clamp_flux(&neg, ppb_multipole_total_R(&mp));
+    out->totals.T = clamp_flux(&neg, ppb_multipole_total_T(&mp));
+    clamp_report(cfg, out, &neg);
     out->totals.sides = 0;
     out->totals.ballistic = ppb_ballistic_fraction(sc);
     fill_bins(out, PPB_S1, 0, cos_l * out->totals.R / PPB_PI);
@@ -125,9 +160,36 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     if (cfg->mp.samples < 1)
         return ppb_fail(err, "mp: mp.samples = %d, needs >= 1", cfg->mp.samples);
     out->totals.absorbed_tracked = 0; /* absorbed = 1 - the rest, by the writer */
-    if (cfg->scene.geometry == PPB_GEOM_SLAB)
-        return mp_slab(cfg, out, err);
-    return mp_tube(cfg, out, err);
+    if (ppb_mp_check(cfg, err))
+        return -1;
+    int rc = cfg->scene.geometry == PPB_GEOM_SLAB ? mp_slab(cfg, out, err) : mp_tube(cfg, out, err);
+    if (rc || ppb_radiance_check(cfg->name, out, NULL, err))
+        return -1;
+    if (strcmp(out->method, "mp") != 0)
+        return 0; /* mp+ss checks its own sum */
+    ppb_totals t = out->totals;
+    ppb_totals_complete(&t);
+    ppb_result probe = *out;
+    probe.totals = t;
+    return ppb_totals_check(cfg->name, &probe, err);
+}
+
+int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    /* Where the model has no meaning, say so before any work (issue 15). */
+    if (sc->albedo >= 1.0)
+        return ppb_config_key_fail(
+            cfg, "medium", "albedo", err,
+            "mp, mp+ss: albedo = 1 gives sigma_tr = 0, where the multipole's image series of a "
+            "finite slab converges only conditionally (truncated, it gives T = 0); use albedo < 1 "
+            "or leave mp out");
+    if (sc->geometry == PPB_GEOM_TUBE && sc->step == PPB_STEP_ALBEDO && sc->albedo_right >= 1.0)
+        return ppb_config_key_fail(
+            cfg, "medium", "albedo_right", err,
+            "mp, mp+ss: albedo = 1 gives sigma_tr = 0, where the multipole's image series of a "
+            "finite slab converges only conditionally; use albedo < 1 or leave mp out");
+    return 0;
 }
 
 int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
@@ -147,5 +209,7 @@ int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     out->totals.T += ss.totals.T; /* it twice, as the paper's energy remark says */
     out->totals.sides += ss.totals.sides;
     ppb_result_free(&ss);
-    return 0;
+    ppb_result probe = *out;
+    ppb_totals_complete(&probe.totals);
+    return ppb_totals_check(ctx->cfg->name, &probe, err);
 }

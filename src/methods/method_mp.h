@@ -9,6 +9,10 @@
 /* `mp`: fills out[0] (already initialised with the scene's layout). */
 int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
+/* Whether mp (and mp+ss) has a meaning at cfg's point: not at albedo 1 (sigma_tr = 0). Fails
+ * with the key and the reason; called at config time (ppb_methods_check) and by the method. */
+int ppb_mp_check(const ppb_config *cfg, ppb_err *err);
+
 /* `mp+ss`: `mp` plus ppb_method_ss's radiance, cell by cell. */
 int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 

@@ -52,6 +52,9 @@ int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
         if (m->slab_only && !slab)
             return ppb_config_key_fail(cfg, "experiment", "methods", err,
                                        "method '%s' runs in slab mode only", m->id);
+        /* A point where the method's model has no meaning is refused here, before any work. */
+        if ((strcmp(m->id, "mp") == 0 || strcmp(m->id, "mp+ss") == 0) && ppb_mp_check(cfg, err))
+            return -1;
     }
     return 0;
 }
