@@ -1,6 +1,13 @@
+/* _GNU_SOURCE: renameat2 (RENAME_EXCHANGE), the atomic swap of two directories. */
+#define _GNU_SOURCE
 #include "base/atomic_file.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -41,15 +48,33 @@ int ppb_afile_open(ppb_afile *af, const char *path, ppb_err *err)
     return 0;
 }
 
+/* Why a stream's earlier write failed. errno at the time is long gone (any call since, a sqrt of
+ * a negative, may have set it), so the write is tried again: what is still buffered, or one
+ * byte more (the temporary is removed anyway), fails with the OS's reason. */
+static int write_errno(FILE *f)
+{
+    clearerr(f);
+    errno = 0;
+    if (fflush(f) != 0)
+        return errno ? errno : EIO;
+    if (fputc('\n', f) == EOF || fflush(f) != 0)
+        return errno ? errno : EIO;
+    return 0;
+}
+
 int ppb_afile_commit(ppb_afile *af, ppb_err *err)
 {
-    int bad = ferror(af->f);
-    if (fclose(af->f) != 0)
-        bad = 1;
+    int bad = ferror(af->f) != 0, e = bad ? write_errno(af->f) : 0;
+    errno = 0;
+    if (!bad && fflush(af->f) != 0)
+        e = errno, bad = 1;
+    if (fclose(af->f) != 0 && !bad)
+        e = errno, bad = 1;
     af->f = NULL;
     if (bad) {
         ppb_apath_abort(&af->name);
-        return ppb_fail(err, "%s: write failed", af->name.path);
+        return ppb_fail(err, "%s: write failed: %s", af->name.path,
+                        e ? strerror(e) : "an earlier write failed (the cause has passed)");
     }
     return ppb_apath_commit(&af->name, err);
 }
@@ -81,4 +106,305 @@ int ppb_mkdirs(const char *dir, ppb_err *err)
             break;
     }
     return 0;
+}
+
+/* A pid written in decimal, the whole of s; 0 if s is not one. */
+static long parse_pid(const char *s)
+{
+    long pid = 0;
+    int digits = 0;
+    for (; *s; s++, digits++) {
+        if (*s < '0' || *s > '9' || digits >= 9)
+            return 0;
+        pid = 10 * pid + (*s - '0');
+    }
+    return digits > 0 ? pid : 0;
+}
+
+long ppb_temp_pid(const char *name, int old)
+{
+    const char *tag = old ? ".old." : ".tmp.";
+    const char *p = NULL;
+    for (const char *q = strstr(name, tag); q; q = strstr(q + 1, tag))
+        p = q;
+    return p && p != name ? parse_pid(p + 5) : 0;
+}
+
+int ppb_pid_alive(long pid)
+{
+    if (pid <= 0 || pid > INT_MAX)
+        return 0;
+    return kill((pid_t)pid, 0) == 0 || errno != ESRCH;
+}
+
+/* rm -r of dirfd/name; shown is its path for messages. */
+static int remove_at(int dirfd, const char *name, const char *shown, ppb_err *err)
+{
+    struct stat st;
+    if (fstatat(dirfd, name, &st, AT_SYMLINK_NOFOLLOW) != 0)
+        return errno == ENOENT ? 0 : ppb_fail(err, "%s: cannot remove: %s", shown, strerror(errno));
+    if (S_ISDIR(st.st_mode)) {
+        int fd = openat(dirfd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW);
+        DIR *d = fd < 0 ? NULL : fdopendir(fd);
+        if (!d) {
+            int e = errno;
+            if (fd >= 0)
+                close(fd);
+            return ppb_fail(err, "%s: cannot remove: %s", shown, strerror(e));
+        }
+        int rc = 0;
+        struct dirent *de;
+        while (rc == 0 && (de = readdir(d))) {
+            if (!strcmp(de->d_name, ".") || !strcmp(de->d_name, ".."))
+                continue;
+            char sub[PPB_PATH_MAX];
+            snprintf(sub, sizeof sub, "%s/%s", shown, de->d_name);
+            rc = remove_at(fd, de->d_name, sub, err);
+        }
+        closedir(d);
+        if (rc)
+            return -1;
+    }
+    if (unlinkat(dirfd, name, S_ISDIR(st.st_mode) ? AT_REMOVEDIR : 0) != 0 && errno != ENOENT)
+        return ppb_fail(err, "%s: cannot remove: %s", shown, strerror(errno));
+    return 0;
+}
+
+int ppb_remove_tree(const char *path, ppb_err *err)
+{
+    return remove_at(AT_FDCWD, path, path, err);
+}
+
+/* The parent directory and last name of path (which has no trailing slash). */
+static void split_path(const char *path, char *parent, size_t cap, const char **base)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash) {
+        snprintf(parent, cap, ".");
+        *base = path;
+    } else {
+        snprintf(parent, cap, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+        *base = slash + 1;
+    }
+}
+
+int ppb_adir_name(ppb_adir *ad, const char *dir, ppb_err *err)
+{
+    memset(ad, 0, sizeof *ad);
+    char buf[PPB_PATH_MAX], parent[PPB_PATH_MAX], abs[PATH_MAX];
+    if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf)
+        return ppb_fail(err, "%.64s...: path too long", dir);
+    size_t len = strlen(buf);
+    while (len > 1 && buf[len - 1] == '/')
+        buf[--len] = '\0';
+    if (!len)
+        return ppb_fail(err, "the output directory is empty");
+    struct stat st;
+    const char *base;
+    if (stat(buf, &st) == 0) {
+        if (!S_ISDIR(st.st_mode))
+            return ppb_fail(err, "%s: not a directory", dir);
+        if (!realpath(buf, abs))
+            return ppb_fail(err, "%s: %s", dir, strerror(errno));
+        snprintf(ad->path, sizeof ad->path, "%s", abs);
+    } else if (errno != ENOENT) {
+        return ppb_fail(err, "%s: %s", dir, strerror(errno));
+    } else {
+        split_path(buf, parent, sizeof parent, &base);
+        if (!strcmp(base, ".") || !strcmp(base, ".."))
+            return ppb_fail(err, "%s: does not exist", dir);
+        /* Where the parent exists, the names are made absolute as above; otherwise mkdir -p
+         * makes it and nothing of a previous run can be there. */
+        if (realpath(parent, abs)) {
+            if (snprintf(ad->path, sizeof ad->path, "%s%s%s", abs, strcmp(abs, "/") ? "/" : "",
+                         base) >= (int)sizeof ad->path)
+                return ppb_fail(err, "%.64s...: path too long", dir);
+        } else {
+            snprintf(ad->path, sizeof ad->path, "%s", buf);
+        }
+    }
+    if (!strcmp(ad->path, "/"))
+        return ppb_fail(err, "%s: the root directory cannot be an output directory", dir);
+    char cwd[PATH_MAX];
+    if (ad->path[0] == '/' && realpath(".", cwd)) {
+        size_t n = strlen(ad->path);
+        if (!strncmp(cwd, ad->path, n) && (cwd[n] == '\0' || cwd[n] == '/'))
+            return ppb_fail(err,
+                            "%s: is the working directory or holds it; it cannot be "
+                            "replaced by a run's outputs",
+                            dir);
+    }
+    if (strlen(ad->path) + 24 >= sizeof ad->path)
+        return ppb_fail(err, "%.64s...: path too long", dir);
+    snprintf(ad->tmp, sizeof ad->tmp, "%s.tmp.%d", ad->path, (int)getpid());
+    snprintf(ad->old, sizeof ad->old, "%s.old.%d", ad->path, (int)getpid());
+    return 0;
+}
+
+/* Temporaries under dirfd (shown: its path), at most depth levels down: with remove unset,
+ * fails on the first one of a live process; with remove set, deletes those of dead ones. */
+static int clean_inside(int dirfd, const char *shown, int depth, int remove, ppb_err *err)
+{
+    int fd = dup(dirfd);
+    DIR *d = fd < 0 ? NULL : fdopendir(fd);
+    if (!d) {
+        if (fd >= 0)
+            close(fd);
+        return ppb_fail(err, "%s: cannot read: %s", shown, strerror(errno));
+    }
+    rewinddir(d); /* the dup shares dirfd's offset, at the end after an earlier pass */
+    int rc = 0;
+    struct dirent *de;
+    while (rc == 0 && (de = readdir(d))) {
+        const char *name = de->d_name;
+        if (!strcmp(name, ".") || !strcmp(name, ".."))
+            continue;
+        char sub[PPB_PATH_MAX];
+        snprintf(sub, sizeof sub, "%s/%s", shown, name);
+        struct stat st;
+        if (fstatat(dirfd, name, &st, AT_SYMLINK_NOFOLLOW) != 0)
+            continue;
+        long pid = ppb_temp_pid(name, 0);
+        if (S_ISDIR(st.st_mode) && !pid) {
+            int sfd = depth > 0 ? openat(dirfd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW) : -1;
+            if (sfd >= 0) {
+                rc = clean_inside(sfd, sub, depth - 1, remove, err);
+                close(sfd);
+            }
+        } else if (pid && pid != getpid()) {
+            if (ppb_pid_alive(pid)) {
+                if (!remove)
+                    rc = ppb_fail(err, "%s: process %ld is writing it (%s)", shown, pid, sub);
+            } else if (remove) {
+                rc = remove_at(dirfd, name, sub, err);
+            }
+        }
+    }
+    closedir(d);
+    return rc;
+}
+
+/* The staging and aside directories of ad->path beside it (see clean_inside for remove). */
+static int clean_beside(const ppb_adir *ad, int remove, ppb_err *err)
+{
+    char parent[PPB_PATH_MAX];
+    const char *base;
+    split_path(ad->path, parent, sizeof parent, &base);
+    size_t nbase = strlen(base);
+    DIR *d = opendir(parent);
+    if (!d)
+        return errno == ENOENT ? 0 : ppb_fail(err, "%s: cannot read: %s", parent, strerror(errno));
+    int rc = 0;
+    struct dirent *de;
+    while (rc == 0 && (de = readdir(d))) {
+        const char *name = de->d_name;
+        if (strncmp(name, base, nbase) || strlen(name) < nbase + 6)
+            continue;
+        int old = !strncmp(name + nbase, ".old.", 5);
+        if (!old && strncmp(name + nbase, ".tmp.", 5))
+            continue;
+        long pid = parse_pid(name + nbase + 5);
+        if (!pid || pid == getpid())
+            continue;
+        char path[PPB_PATH_MAX + 300];
+        snprintf(path, sizeof path, "%s/%s", parent, name);
+        if (ppb_pid_alive(pid)) {
+            if (!remove)
+                rc = ppb_fail(err, "%s: process %ld is writing it (%s)", ad->path, pid, path);
+        } else if (remove) {
+            rc = ppb_remove_tree(path, err);
+        }
+    }
+    closedir(d);
+    return rc;
+}
+
+int ppb_adir_clean(const ppb_adir *ad, ppb_err *err)
+{
+    int fd = open(ad->path, O_RDONLY | O_DIRECTORY);
+    if (fd < 0 && errno != ENOENT)
+        return ppb_fail(err, "%s: cannot read: %s", ad->path, strerror(errno));
+    /* First look for a live process's, so that a refusal has removed nothing. */
+    int rc = clean_beside(ad, 0, err);
+    if (rc == 0 && fd >= 0)
+        rc = clean_inside(fd, ad->path, 8, 0, err);
+    if (rc == 0)
+        rc = clean_beside(ad, 1, err);
+    if (rc == 0 && fd >= 0)
+        rc = clean_inside(fd, ad->path, 8, 1, err);
+    if (fd >= 0)
+        close(fd);
+    return rc;
+}
+
+int ppb_adir_begin(ppb_adir *ad, ppb_err *err)
+{
+    char parent[PPB_PATH_MAX];
+    const char *base;
+    split_path(ad->path, parent, sizeof parent, &base);
+    if (ppb_mkdirs(parent, err))
+        return -1;
+    /* A leftover of this pid is a dead process's (pids are reused) or of this process's own
+     * failed attempt: never a live writer's. */
+    if (ppb_remove_tree(ad->tmp, err))
+        return -1;
+    if (mkdir(ad->tmp, 0777) != 0)
+        return ppb_fail(err, "%s: cannot create directory: %s", ad->tmp, strerror(errno));
+    ad->made = 1;
+    /* The new directory keeps the previous one's permissions. */
+    struct stat st;
+    if (stat(ad->path, &st) == 0 && chmod(ad->tmp, st.st_mode & 07777) != 0) {
+        int e = errno;
+        ppb_adir_abort(ad);
+        return ppb_fail(err, "%s: cannot set permissions: %s", ad->tmp, strerror(e));
+    }
+    return 0;
+}
+
+int ppb_adir_commit(ppb_adir *ad, ppb_err *err)
+{
+    struct stat st;
+    int e = 0;
+    if (lstat(ad->path, &st) != 0) {
+        /* No previous directory: one rename. */
+        if (rename(ad->tmp, ad->path) == 0) {
+            ad->made = 0;
+            return 0;
+        }
+        e = errno;
+    } else if (renameat2(AT_FDCWD, ad->tmp, AT_FDCWD, ad->path, RENAME_EXCHANGE) == 0) {
+        /* Swapped in one step; the staging name now holds the previous set. */
+        ad->made = 0;
+        ppb_err ignored;
+        ppb_remove_tree(ad->tmp, &ignored); /* a leftover is a dead pid's: the next run's */
+        return 0;
+    } else if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP) {
+        e = errno;
+    } else if (rename(ad->path, ad->old) != 0) {
+        /* The file system cannot exchange: the previous directory is put aside, then the new
+         * one renamed in; the window between holds no directory at path, never a mix. */
+        e = errno;
+    } else if (rename(ad->tmp, ad->path) != 0) {
+        e = errno;
+        rename(ad->old, ad->path);
+    } else {
+        ad->made = 0;
+        ppb_err ignored;
+        ppb_remove_tree(ad->old, &ignored);
+        return 0;
+    }
+    ppb_adir_abort(ad);
+    return ppb_fail(err,
+                    "%s: cannot put the new outputs in place: %s (the previous ones are "
+                    "kept)",
+                    ad->path, strerror(e));
+}
+
+void ppb_adir_abort(ppb_adir *ad)
+{
+    if (!ad->made)
+        return;
+    ppb_err ignored;
+    ppb_remove_tree(ad->tmp, &ignored);
+    ad->made = 0;
 }

@@ -4,7 +4,12 @@
  * Owns the temporary name (path.tmp.<pid>: shards and jobs writing one directory never share
  * one) and the commit/abort rules. Two forms: ppb_afile for code that writes through a FILE *,
  * and ppb_apath for libraries that open the file by name themselves (OpenEXR, gnuplot): they
- * are handed apath.tmp, and the caller commits or aborts. */
+ * are handed apath.tmp, and the caller commits or aborts. A third, ppb_adir, does the same for
+ * a whole directory (an experiment's output set, issue 14): it is written under a staging name
+ * beside it (dir.tmp.<pid>) and swapped into place when complete, so a reader sees the previous
+ * set or the new one, never a mix. Also owns the clean-up of the temporaries a killed process
+ * left (a name's <pid> no longer alive). Every failure message names the path and the OS's
+ * reason. */
 #ifndef PPB_ATOMIC_FILE_H
 #define PPB_ATOMIC_FILE_H
 
@@ -37,5 +42,39 @@ void ppb_afile_abort(ppb_afile *af);
 
 /* mkdir -p. */
 int ppb_mkdirs(const char *dir, ppb_err *err);
+
+/* A directory written whole. path is dir made absolute when it (or its parent) exists; tmp is
+ * the staging directory <path>.tmp.<pid> and old <path>.old.<pid>, in the same parent so that
+ * the final rename is atomic. */
+typedef struct ppb_adir {
+    char path[PPB_PATH_MAX], tmp[PPB_PATH_MAX + 32], old[PPB_PATH_MAX + 32];
+    int made; /* tmp exists (ppb_adir_begin) */
+} ppb_adir;
+
+/* Names the directory's staging and aside names; creates nothing. Fails if dir names no
+ * directory that can be replaced: a file, "/", the working directory or one above it. */
+int ppb_adir_name(ppb_adir *ad, const char *dir, ppb_err *err);
+/* Removes what dead processes left of this directory: staging and aside directories beside it
+ * (<path>.tmp.<pid>, <path>.old.<pid>) and temporaries inside it (<name>.tmp.<pid>, at any
+ * depth). A live process's are never touched: their presence fails (another run is writing
+ * it), naming the process and the file. */
+int ppb_adir_clean(const ppb_adir *ad, ppb_err *err);
+/* Creates the parent directories and an empty staging directory ad->tmp. */
+int ppb_adir_begin(ppb_adir *ad, ppb_err *err);
+/* Puts the staging directory in place of path (atomically where the file system allows it:
+ * renameat2 RENAME_EXCHANGE) and removes the previous directory. On failure the previous
+ * directory stays as it was and the staging directory is removed. */
+int ppb_adir_commit(ppb_adir *ad, ppb_err *err);
+/* Removes the staging directory and all in it. */
+void ppb_adir_abort(ppb_adir *ad);
+
+/* The pid in a temporary's name ("<name>.tmp.<pid>", or ".old.<pid>" when old is set), or 0
+ * when name is no such temporary. */
+long ppb_temp_pid(const char *name, int old);
+/* Whether process pid exists (kill(pid, 0) succeeds or fails for a reason but ESRCH). */
+int ppb_pid_alive(long pid);
+/* rm -r path, never following a symbolic link; fails naming the first entry it could not
+ * remove and why. */
+int ppb_remove_tree(const char *path, ppb_err *err);
 
 #endif

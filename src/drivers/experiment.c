@@ -1,5 +1,7 @@
 #include "drivers/experiment.h"
 
+#include <dirent.h>
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -48,6 +50,18 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
     for (int i = 0; i < nout; i++) {
         ex->seconds[ex->n - nout + i] = ppb_now() - t0;
         ex->partial |= out[i].partial;
+    }
+    if (out[0].partial && m->reference != 1) {
+        /* Issue 14: a deterministic method stopped midway holds cells it never computed, which
+         * would read as zero radiance, like data: none of its rows are written (README:
+         * outputs). The Monte Carlo's partial result is an estimate from fewer photons: kept. */
+        for (int i = 0; i < nout; i++)
+            ppb_result_free(&out[i]);
+        ex->n -= nout;
+        if (ex->nincomplete < PPB_MAX_METHODS)
+            snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", m->id);
+        fprintf(stderr, "%s: %s interrupted before it finished: none of its rows written\n",
+                ex->cfg->name, m->id);
     }
     return 0;
 }
@@ -117,15 +131,18 @@ static const char *skip_for(const ppb_result *ref)
     return p ? p->id : NULL;
 }
 
-static void out_path(const ppb_experiment *ex, const char *file, char *buf, size_t n)
+/* The first line of provenance.txt: what marks a directory as a ppbench output set. */
+static const char provenance_mark[] = "# ppbench provenance";
+
+static void out_path(const char *dir, const char *file, char *buf, size_t n)
 {
-    snprintf(buf, n, "%s/%s", ex->cfg->out_dir, file);
+    snprintf(buf, n, "%s/%s", dir, file);
 }
 
-static int write_timings(const ppb_experiment *ex, ppb_err *err)
+static int write_timings(const ppb_experiment *ex, const char *dir, ppb_err *err)
 {
-    char path[1200];
-    out_path(ex, "timings.csv", path, sizeof path);
+    char path[PPB_PATH_MAX + 256];
+    out_path(dir, "timings.csv", path, sizeof path);
     ppb_afile af;
     if (ppb_afile_open(&af, path, err))
         return -1;
@@ -135,16 +152,16 @@ static int write_timings(const ppb_experiment *ex, ppb_err *err)
     return ppb_afile_commit(&af, err);
 }
 
-static int write_provenance(const ppb_experiment *ex, ppb_err *err)
+static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *err)
 {
-    char path[1200], when[64];
-    out_path(ex, "provenance.txt", path, sizeof path);
+    char path[PPB_PATH_MAX + 256], when[64];
+    out_path(dir, "provenance.txt", path, sizeof path);
     ppb_afile af;
     if (ppb_afile_open(&af, path, err))
         return -1;
     time_t now = time(NULL);
     strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
-    fprintf(af.f, "# ppbench provenance: what produced the files beside this one\n");
+    fprintf(af.f, "%s: what produced the files beside this one\n", provenance_mark);
     fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
             when);
     fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
@@ -156,23 +173,26 @@ static int write_provenance(const ppb_experiment *ex, ppb_err *err)
         fprintf(af.f, "%s.seconds = %.4f\n", ex->res[i].method, ex->seconds[i]);
     for (int i = 0; i < ex->nfailed; i++)
         fprintf(af.f, "%s.failed = %s\n", ex->failed[i], ex->failed_why[i]);
+    for (int i = 0; i < ex->nincomplete; i++)
+        fprintf(af.f, "%s.incomplete = interrupted before it finished: no rows written\n",
+                ex->incomplete[i]);
     ppb_config_write_resolved(ex->cfg, af.f);
     return ppb_afile_commit(&af, err);
 }
 
-static int write_comparisons(const ppb_experiment *ex, ppb_err *err)
+static int write_comparisons(const ppb_experiment *ex, const char *dir, ppb_err *err)
 {
     const ppb_scene *sc = &ex->cfg->scene;
-    char path[1200];
+    char path[PPB_PATH_MAX + 256];
     const ppb_result *ref = ppb_experiment_reference(ex);
     if (ref) {
-        out_path(ex, "rms.csv", path, sizeof path);
+        out_path(dir, "rms.csv", path, sizeof path);
         if (ppb_write_rms_csv(path, sc, ex->res, ex->n, ref, skip_for(ref), err))
             return -1;
-        out_path(ex, "summary.csv", path, sizeof path);
+        out_path(dir, "summary.csv", path, sizeof path);
         if (ppb_write_summary_csv(path, ex->res, ex->n, ref, skip_for(ref), err))
             return -1;
-        out_path(ex, "regions.csv", path, sizeof path);
+        out_path(dir, "regions.csv", path, sizeof path);
         if (ppb_write_regions_csv(path, sc, ex->res, ex->n, ref, skip_for(ref), err))
             return -1;
     }
@@ -181,32 +201,93 @@ static int write_comparisons(const ppb_experiment *ex, ppb_err *err)
             continue;
         char file[128];
         snprintf(file, sizeof file, "summary_%s.csv", ex->res[i].method);
-        out_path(ex, file, path, sizeof path);
+        out_path(dir, file, path, sizeof path);
         if (ppb_write_summary_csv(path, ex->res, ex->n, &ex->res[i], skip_for(&ex->res[i]), err))
             return -1;
     }
     return 0;
 }
 
-int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
+/* Whether the existing directory ad->path may be replaced: it is empty (but for temporaries,
+ * which ppb_adir_clean sorts out) or its provenance.txt says ppbench wrote it. */
+static int check_owned(const ppb_adir *ad, const char *dir, ppb_err *err)
 {
-    char path[1200];
-    if (ppb_mkdirs(ex->cfg->out_dir, err))
+    DIR *d = opendir(ad->path);
+    if (!d)
+        return errno == ENOENT ? 0 : ppb_fail(err, "%s: cannot read: %s", dir, strerror(errno));
+    char other[256] = "";
+    struct dirent *de;
+    while (!other[0] && (de = readdir(d)))
+        if (strcmp(de->d_name, ".") && strcmp(de->d_name, "..") && !ppb_temp_pid(de->d_name, 0))
+            snprintf(other, sizeof other, "%s", de->d_name);
+    closedir(d);
+    if (!other[0])
+        return 0;
+    char path[PPB_PATH_MAX + 256], line[128] = "";
+    out_path(ad->path, "provenance.txt", path, sizeof path);
+    FILE *f = fopen(path, "r");
+    if (f) {
+        if (!fgets(line, sizeof line, f))
+            line[0] = '\0';
+        fclose(f);
+    }
+    if (!strncmp(line, provenance_mark, sizeof provenance_mark - 1))
+        return 0;
+    return ppb_fail(err,
+                    "%s: holds files ppbench did not write (%s; no ppbench provenance.txt): a run "
+                    "replaces its whole output directory, so it will not take this one; give "
+                    "an empty or new directory",
+                    dir, other);
+}
+
+/* The output directory named and claimed: see experiment.h. */
+static int claim_out(const char *dir, ppb_adir *ad, ppb_err *err)
+{
+    if (ppb_adir_name(ad, dir, err) || check_owned(ad, dir, err))
         return -1;
-    out_path(ex, "radiance.csv", path, sizeof path);
+    return ppb_adir_clean(ad, err);
+}
+
+int ppb_experiment_claim_out(const char *dir, ppb_err *err)
+{
+    ppb_adir ad;
+    return claim_out(dir, &ad, err);
+}
+
+/* Every file of the output set, under dir. */
+static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 256];
+    out_path(dir, "radiance.csv", path, sizeof path);
     if (ppb_write_radiance_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
-    out_path(ex, "totals.csv", path, sizeof path);
+    out_path(dir, "totals.csv", path, sizeof path);
     if (ppb_write_totals_csv(path, ex->res, ex->n, err))
         return -1;
-    out_path(ex, "angular.csv", path, sizeof path);
+    out_path(dir, "angular.csv", path, sizeof path);
     if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
-    if (write_comparisons(ex, err) || write_timings(ex, err) || write_provenance(ex, err))
+    if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err) ||
+        write_provenance(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
-    if (ppb_images_write(ex->cfg->out_dir, &ex->cfg->scene, ex->res, ex->n,
-                         ref ? (int)(ref - ex->res) : -1, err))
+    return ppb_images_write(dir, &ex->cfg->scene, ex->res, ex->n, ref ? (int)(ref - ex->res) : -1,
+                            err);
+}
+
+int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
+{
+    /* Issue 14: the set is written whole into a staging directory beside the output directory
+     * and swapped into place, so a failure midway (a full disk) leaves the previous set as it
+     * was and a smaller set never sits beside a previous run's files. */
+    ppb_adir ad;
+    if (claim_out(ex->cfg->out_dir, &ad, err) || ppb_adir_begin(&ad, err))
+        return -1;
+    if (write_set(ex, ad.tmp, err)) {
+        ppb_adir_abort(&ad);
+        return -1;
+    }
+    if (ppb_adir_commit(&ad, err))
         return -1;
     if (ex->nfailed > 0)
         return ppb_fail(err, "%d method(s) failed, the others' outputs are written: %s: %s",

@@ -4,7 +4,8 @@
  * Computing and writing are separate so that a sweep can take the in-memory results of each
  * grid point. The Monte Carlo (`reference` in the method registry) is what rms.csv and
  * summary.csv measure against; the exact answers `mc1` (the tube's single scattering) and
- * `ppslab` (the slab) get their own summary_<id>.csv, the basis of CI's regression gate. */
+ * `ppslab` (the slab) get their own summary_<id>.csv, the basis of CI's regression gate.
+ * The output directory is the run's own: the set is written whole or not at all. */
 #ifndef PPB_EXPERIMENT_H
 #define PPB_EXPERIMENT_H
 
@@ -26,13 +27,25 @@ typedef struct ppb_experiment {
     int nfailed;
     char failed[PPB_MAX_METHODS][32];
     char failed_why[PPB_MAX_METHODS][2048];
+    /* Deterministic methods interrupted midway (issue 14): none of their rows are written. */
+    int nincomplete;
+    char incomplete[PPB_MAX_METHODS][32];
 } ppb_experiment;
 
 /* Runs every method. A method that fails is recorded in ex->failed (and said on stderr) while
  * the others go on; fails only when no method produced a result (with the first reason). */
 int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx *ctx,
                            ppb_err *err);
-/* Writes the outputs of the methods that ran; then fails, naming them, if any method failed. */
+/* Whether dir may take an output set (issue 14: a run owns its output directory, and replaces
+ * it whole): it does not exist, is empty, or holds a ppbench output set (its provenance.txt
+ * says so). Removes what dead processes left in and beside it (ppb_adir_clean). Fails,
+ * having touched nothing, for a directory holding files ppbench did not write or one another
+ * live process is writing. Callers check it before any work; ppb_experiment_write checks it
+ * again. */
+int ppb_experiment_claim_out(const char *dir, ppb_err *err);
+/* Writes the outputs of the methods that ran as one set: into a staging directory beside
+ * cfg->out_dir, swapped into its place when every file is written (a failure leaves the
+ * previous directory as it was); then fails, naming them, if any method failed. */
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err);
 void ppb_experiment_free(ppb_experiment *ex);
 

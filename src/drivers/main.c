@@ -362,6 +362,9 @@ static int cmd_run(const cli *c)
             code = EXIT_USAGE;
         } else {
             code = check_config_out(c, &cfgs[i]);
+            /* The directory is the run's own: refused, untouched, if ppbench did not write it. */
+            if (code == EXIT_OK && ppb_experiment_claim_out(cfgs[i].out_dir, &err))
+                code = usage_error(&err);
             for (int j = 0; j < i && code == EXIT_OK; j++)
                 if (same_dir(cfgs[j].out_dir, cfgs[i].out_dir)) {
                     fprintf(stderr,
@@ -510,6 +513,8 @@ static int mc_shard_or_merge(const cli *c, int merge)
     int code = check_config_out(c, &cfg);
     if (code)
         return code;
+    if (merge && ppb_experiment_claim_out(cfg.out_dir, &err))
+        return usage_error(&err);
     int rc = merge ? ppb_mc_shard_merge(&cfg, c->args + 1, c->nargs - 1, &err)
                    : ppb_mc_shard_run(&cfg, c->device, c->quiet, c->shard_i, c->shard_n, &err);
     if (rc) {
@@ -537,9 +542,10 @@ static int cmd_report(const cli *c)
         return EXIT_USAGE;
     }
     ppb_err err = {{0}};
-    if (ppb_report_write(c->args[0], c->args + 1, c->nargs - 1, &err)) {
+    int rc = ppb_report_write(c->args[0], c->args + 1, c->nargs - 1, &err);
+    if (rc) {
         fprintf(stderr, "ppbench report: %s\n", err.msg);
-        return EXIT_RUN;
+        return rc == PPB_REPORT_REFUSED ? EXIT_USAGE : EXIT_RUN;
     }
     return EXIT_OK;
 }

@@ -79,6 +79,48 @@ static int read_summary(const char *dir, const char *name, summary_row *rows, in
     return rc < 0 ? -1 : n;
 }
 
+/* The first line of each file report writes, by which it knows its own (issue 14). table2.csv
+ * and table2.md start with their header rows, which no other file has; README.md with an HTML
+ * comment (invisible on the rendered page). A README.md an earlier ppbench report wrote starts
+ * with its title line instead, also accepted. */
+static const char readme_mark[] = "<!-- written by ppbench report: it replaces only a file that "
+                                  "starts with this line -->";
+static const char readme_mark_v1[] = "# The accuracy study (written by `make bench`)";
+static const char csv_header[] = "case,cell,method,rms_rel,noise_rel,rms_excess,paper_rms_rel";
+static const char md_header[] = "| case | cell | method | RMS % | noise floor % | excess % | "
+                                "paper % |";
+
+/* Whether report may write path: it does not exist, or it is a file whose first line is one of
+ * marks (NULL-terminated). */
+static int check_own(const char *path, const char *const *marks, ppb_err *err)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0; /* a missing file is written; another failure shows when it is written */
+    char line[512] = "";
+    if (!fgets(line, sizeof line, f))
+        line[0] = '\0';
+    int is_file = !ferror(f);
+    fclose(f);
+    line[strcspn(line, "\r\n")] = '\0';
+    for (int i = 0; is_file && marks[i]; i++)
+        if (!strcmp(line, marks[i]))
+            return 0;
+    return ppb_fail(err,
+                    "%s: not written by ppbench report (its first line is not \"%s\"): it is "
+                    "not replaced; move it away or report into another directory",
+                    path, marks[0]);
+}
+
+/* Commits af, saying so. */
+static int commit_said(ppb_afile *af, ppb_err *err)
+{
+    if (ppb_afile_commit(af, err))
+        return -1;
+    fprintf(stderr, "ppbench report: wrote %s\n", af->name.path);
+    return 0;
+}
+
 static void md_cell(FILE *f, double v)
 {
     fprintf(f, isnan(v) ? " - |" : " %.1f |", v);
@@ -96,8 +138,8 @@ static int write_tables(const char *dir, const char *const *cases, int ncases, p
         ppb_afile_abort(&csv);
         return -1;
     }
-    fprintf(csv.f, "case,cell,method,rms_rel,noise_rel,rms_excess,paper_rms_rel\n");
-    fputs("| case | cell | method | RMS % | noise floor % | excess % | paper % |\n", md.f);
+    fprintf(csv.f, "%s\n", csv_header);
+    fprintf(md.f, "%s\n", md_header);
     fprintf(md.f, "|---|---|---|---|---|---|---|\n");
     summary_row rows[512]; /* 36 KB */
     for (int c = 0; c < ncases; c++) {
@@ -122,11 +164,11 @@ static int write_tables(const char *dir, const char *const *cases, int ncases, p
             fputc('\n', md.f);
         }
     }
-    if (ppb_afile_commit(&csv, err)) {
+    if (commit_said(&csv, err)) {
         ppb_afile_abort(&md);
         return -1;
     }
-    return ppb_afile_commit(&md, err);
+    return commit_said(&md, err);
 }
 
 static void copy_file(FILE *dst, const char *path)
@@ -149,7 +191,7 @@ static int write_readme(const char *dir, const char *const *cases, int ncases, p
     if (ppb_afile_open(&af, path, err))
         return -1;
     FILE *f = af.f;
-    fprintf(f, "# The accuracy study (written by `make bench`)\n\n");
+    fprintf(f, "%s\n%s\n\n", readme_mark, readme_mark_v1);
     fprintf(f, "RMS error against the Monte Carlo (SPEC.md section 5) at the two segments next "
                "to x = 0 on S1 (R) and S2 (T), beside the paper's Table 2 and the Monte "
                "Carlo's own noise floor. `excess` removes the noise: sqrt(rms^2 - noise^2).\n\n");
@@ -169,11 +211,25 @@ static int write_readme(const char *dir, const char *const *cases, int ncases, p
     fprintf(f, "\nEach case's directory holds radiance.csv, rms.csv, summary.csv, totals.csv, "
                "summary_mc1.csv, timings.csv and provenance.txt (config, seed, photons, "
                "device, version, timings).\n");
-    return ppb_afile_commit(&af, err);
+    return commit_said(&af, err);
 }
 
 int ppb_report_write(const char *dir, const char *const *cases, int ncases, ppb_err *err)
 {
+    /* Every file checked before any is written: a refusal leaves the directory as it was. */
+    static const char *const csv_marks[] = {csv_header, NULL};
+    static const char *const md_marks[] = {md_header, NULL};
+    static const char *const readme_marks[] = {readme_mark, readme_mark_v1, NULL};
+    static const struct {
+        const char *file;
+        const char *const *marks;
+    } outs[] = {{"table2.csv", csv_marks}, {"table2.md", md_marks}, {"README.md", readme_marks}};
+    for (size_t i = 0; i < sizeof outs / sizeof outs[0]; i++) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s", dir, outs[i].file);
+        if (check_own(path, outs[i].marks, err))
+            return PPB_REPORT_REFUSED;
+    }
     if (write_tables(dir, cases, ncases, err))
         return -1;
     return write_readme(dir, cases, ncases, err);
