@@ -2,13 +2,28 @@
 
 #include <signal.h>
 #include <stdio.h>
+#include <unistd.h>
 
 static volatile sig_atomic_t interrupted;
 
+/* Only async-signal-safe calls here (write, _exit). The first signal asks the running loop to
+ * stop at its next check and write what it has; the second exits at once, for the stretches no
+ * check reaches (a LAPACK call, one long kernel launch), writing nothing more. */
 static void on_signal(int sig)
 {
     (void)sig;
+    static const char first[] = "\nppbench: interrupted: stopping at the next check, writing "
+                                "what is done (interrupt again to exit at once)\n";
+    static const char second[] = "\nppbench: interrupted again: exiting now, nothing more is "
+                                 "written\n";
+    if (interrupted) {
+        ssize_t w = write(STDERR_FILENO, second, sizeof second - 1);
+        (void)w;
+        _exit(130);
+    }
     interrupted = 1;
+    ssize_t w = write(STDERR_FILENO, first, sizeof first - 1);
+    (void)w;
 }
 
 void ppb_progress_install_signals(void)
@@ -16,6 +31,8 @@ void ppb_progress_install_signals(void)
     struct sigaction sa = {0};
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT); /* one handler at a time: the count stays exact */
+    sigaddset(&sa.sa_mask, SIGTERM);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 }

@@ -2,8 +2,9 @@
  *
  * Long loops call ppb_progress_update() between units of work and stop when
  * ppb_interrupted() turns true (SIGINT or SIGTERM caught by ppb_progress_install_signals()),
- * then write what they have, marked partial. Lines are throttled to a few per second and
- * suppressed when quiet is set or stderr is not wanted. */
+ * then write what they have, marked partial. A second SIGINT or SIGTERM exits at once with
+ * status 130 from the handler (_exit: nothing is flushed or written). Lines are throttled to a few
+ * per second and suppressed when quiet is set or stderr is not wanted. */
 #ifndef PPB_PROGRESS_H
 #define PPB_PROGRESS_H
 

@@ -39,6 +39,17 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
         for (int i = 0; i < nout; i++)
             ppb_result_free(&out[i]);
         ex->n -= nout;
+        if (ppb_interrupted()) {
+            /* SIGINT/SIGTERM stopped it in its setup or solve, before it had a result: not a
+             * failure, an incomplete method (no rows), as when it stops midway (below). */
+            ex->partial = 1;
+            if (ex->nincomplete < PPB_MAX_METHODS)
+                snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", m->id);
+            fprintf(stderr,
+                    "%s: %s interrupted before it finished (%s): none of its rows written\n",
+                    ex->cfg->name, m->id, why.msg);
+            return 0;
+        }
         if (ex->nfailed < PPB_MAX_METHODS) {
             snprintf(ex->failed[ex->nfailed], sizeof ex->failed[0], "%s", m->id);
             snprintf(ex->failed_why[ex->nfailed], sizeof ex->failed_why[0], "%s", why.msg);

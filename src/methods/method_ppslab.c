@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "base/progress.h"
 #include "physics/ppsolver.h"
 
 /* Bin average over samples x samples directions uniform in projected solid angle (SPEC.md
@@ -35,12 +36,21 @@ int ppb_method_ppslab(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     if (pp_solve(&p, &s, err) != 0)
         return -1;
     int samples = cfg->samples_dir > 0 ? cfg->samples_dir : 1;
+    ppb_progress pr; /* the bins take longer than the solve at large directions */
+    ppb_progress_begin(&pr, out->method, "bins", out->layout.nbins, ctx->quiet);
     for (int bin = 0; bin < out->layout.nbins; bin++) {
+        if (ppb_interrupted()) {
+            ppb_progress_end(&pr, bin);
+            pp_free(s);
+            return ppb_fail(err, "ppslab: interrupted");
+        }
+        ppb_progress_update(&pr, bin);
         out->radiance[ppb_cell(&out->layout, PPB_S1, 0, bin)] =
             bin_average(s, sc, PPB_S1, bin, samples, 0.0);
         out->radiance[ppb_cell(&out->layout, PPB_S2, 0, bin)] =
             bin_average(s, sc, PPB_S2, bin, samples, tau0);
     }
+    ppb_progress_end(&pr, out->layout.nbins);
     ppb_totals *t = &out->totals;
     pp_totals(s, &t->R, &t->T, &t->ballistic);
     t->sides = 0.0;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/progress.h"
 #include "kernels/march_params.h"
 
 /* Direction sample `dir` in the table order of ppb_march_dir_index. */
@@ -262,7 +263,7 @@ static void fill_s(const pp_build *b, const ppb_march_col *col, const double *R,
         }
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ndir, ntau, ne, 1.0, b->A2, ne, b->E, ne,
                 0.0, S, ntau);
-    for (int dir = 0; dir < ndir; dir++)
+    for (int dir = 0; dir < ndir && !ppb_interrupted(); dir++)
         s_row(b, col, dir, ne, lin, R + (size_t)dir * ntau, S + (size_t)dir * ntau);
 }
 
@@ -328,7 +329,7 @@ static int adopt_mode_count(pp_build *b, int nm, ppb_err *err)
  * march multiplies by the local sigma_s, hence the division by alb. */
 static void block_coeffs(pp_build *b, const pp_solution *sol, double alb, int ne, double *C)
 {
-    for (int dir = 0; dir < b->t->ndir; dir++) {
+    for (int dir = 0; dir < b->t->ndir && !ppb_interrupted(); dir++) {
         const double *w = b->wdir + 3 * dir;
         double bcoef;
         pp_source_coeffs(sol, w, b->a, &bcoef);
@@ -385,6 +386,8 @@ static int build_block(pp_build *b, int c, int node, ppb_err *err)
         b->first = sol;
     else
         pp_free(sol);
+    if (ppb_interrupted()) /* block_coeffs stopped early: A is incomplete */
+        return ppb_fail(err, "march tables: interrupted");
     fill_exponentials(b, col, ne);
     fill_r(b, col, t->R + off, ne, lin);
     if (b->want_s)
@@ -402,9 +405,13 @@ int ppb_march_tables_pp(const ppb_scene *sc, const ppb_pp_settings *pp, int nsam
     if (build_begin(&b, &key, err))
         return -1;
     int rc = 0;
+    /* SIGINT or SIGTERM: checked between slab solves and within their direction loops. */
     for (int c = 0; c < t->ncols && rc == 0; c++)
         for (int node = 0; node < t->nalb && rc == 0; node++)
-            rc = build_block(&b, c, node, err);
+            rc = ppb_interrupted() ? ppb_fail(err, "march tables: interrupted")
+                                   : build_block(&b, c, node, err);
+    if (rc == 0 && ppb_interrupted()) /* fill_s stopped early */
+        rc = ppb_fail(err, "march tables: interrupted");
     return build_end(&b, rc);
 }
 

@@ -3,6 +3,7 @@
 
 #include "kernels/ppb_conventions.h"
 
+#include "base/progress.h"
 #include "base/quadrature.h"
 
 #include <math.h>
@@ -254,6 +255,8 @@ static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, pp
         zm[i] = pp_dirs_zmirror(d, i), cr[i] = cos(d->radius[i]), sr[i] = sin(d->radius[i]);
     int rc = 0;
     for (int i = 0; rc == 0 && i < d->n; i++) {
+        if (ppb_interrupted()) /* SIGINT or SIGTERM, checked row by row */
+            rc = ppb_fail(err, "phase matrix: interrupted");
         for (int j = i; rc == 0 && j < d->n; j++) {
             if (done[i * n + j])
                 continue;

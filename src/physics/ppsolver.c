@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "base/progress.h"
 #include "physics/directions.h"
 #include "physics/phase.h"
 
@@ -466,9 +467,15 @@ static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp
     if (phase_stage(s, share, err) != 0)
         return -1;
     double t1 = ppb_now();
+    /* SIGINT/SIGTERM between the stages; LAPACK's eigen solve cannot be interrupted inside
+     * (it grows as directions^3: 1.5 s at 1500), so it is checked before and after. */
+    if (ppb_interrupted())
+        return ppb_fail(err, "pp solver: interrupted");
     build_h(s, w);
     if (eigen_modes(s, w, err) != 0)
         return -1;
+    if (ppb_interrupted())
+        return ppb_fail(err, "pp solver: interrupted");
     avoid_resonance(s, w);
     double t2 = ppb_now();
     if (pp_phase_row(&s->dirs, s->p.g, s->wL, w->F, err) != 0)
