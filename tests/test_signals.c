@@ -226,12 +226,42 @@ static void test_second_signal_exits(void **state)
     expect_in(slurp(c.log), "interrupted again", "stderr");
 }
 
+/* Item 2, the documented choice (README, exit codes): an interrupted Monte Carlo keeps its
+ * photons; the methods not yet started are skipped, each named on stderr; what ran is written,
+ * marked partial = 1. Before: skipped without a word. */
+static void test_interrupted_mc_skips_the_rest(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("sig-mc");
+    char cfg[1200], args[3000];
+    snprintf(cfg, sizeof cfg, "%s",
+             cli_config("sig-mc", "[experiment]\nname = t\nmethods = mc, mp\n"
+                                  "[mc]\nphotons = 1e10\n"));
+    snprintf(args, sizeof args, "run --out '%s/out' '%s'", dir, cfg);
+    child c;
+    start(&c, dir, args);
+    wait_for(&c, "t: mc ...", 60);
+    sleep_s(1.5);
+    send(&c, SIGINT);
+    assert_int_equal(expect_exit(&c), 130);
+    const char *log = slurp(c.log);
+    expect_in(log, "t: mp skipped: interrupted before it started", "stderr");
+    expect_in(log, "(partial: interrupted)", "stderr");
+    const char *prov = slurp(out_file(dir, "provenance.txt"));
+    expect_in(prov, "partial = 1", "provenance.txt");
+    expect_in(prov, "mc.photons_traced = ", "provenance.txt");
+    const char *rad = slurp(out_file(dir, "radiance.csv"));
+    expect_in(rad, "\nmc,", "radiance.csv");
+    expect_not_in(rad, "\nmp,", "radiance.csv");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sigint_pp_setup),
         cmocka_unit_test(test_sigint_ppslab),
         cmocka_unit_test(test_second_signal_exits),
+        cmocka_unit_test(test_interrupted_mc_skips_the_rest),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -83,11 +83,18 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
     memset(ex, 0, sizeof *ex);
     ex->cfg = cfg;
     ctx->cfg = cfg;
-    for (int i = 0; i < cfg->nmethods && !ppb_interrupted(); i++)
+    int i = 0;
+    for (; i < cfg->nmethods && !ppb_interrupted(); i++)
         if (run_method(ex, ppb_method_find(cfg->methods[i]), ctx, err))
             return -1;
-    if (ppb_interrupted())
+    if (ppb_interrupted()) {
+        /* After an interrupt the methods not yet started are skipped, and said so; the outputs
+         * of those that ran are written, marked partial (README: exit codes). */
         ex->partial = 1;
+        for (; i < cfg->nmethods; i++)
+            fprintf(stderr, "%s: %s skipped: interrupted before it started\n", cfg->name,
+                    cfg->methods[i]);
+    }
     if (ctx->ocl_open)
         snprintf(ex->device, sizeof ex->device, "%s", ctx->ocl.name);
     if (ex->n == 0 && ex->nfailed > 0)
