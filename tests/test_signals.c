@@ -150,6 +150,22 @@ static const char *out_file(const char *dir, const char *file)
     return path;
 }
 
+/* How many completion lines `label` printed: progress lines start with \r (ppb_progress), the
+ * last one reads "label: N unit in T s". */
+static int count_done(const char *text, const char *label)
+{
+    char pre[64];
+    snprintf(pre, sizeof pre, "\r%s: ", label);
+    int n = 0;
+    for (const char *p = strstr(text, pre); p; p = strstr(p + 1, pre)) {
+        char line[256];
+        size_t span = strcspn(p + 1, "\r\n");
+        snprintf(line, sizeof line, "%.*s", (int)(span < 255 ? span : 255), p + 1);
+        n += strstr(line, " in ") != NULL && strchr(line, '%') == NULL;
+    }
+    return n;
+}
+
 /* SIGINT while pp builds its tables (nine albedo nodes of an albedo step: some 25 s of slab
  * solves): it stops within seconds, exit 130, says "interrupted", writes what was done marked
  * partial, and writes no pp rows (it had no result). Before: 13-15 s to the next check. */
@@ -255,6 +271,81 @@ static void test_interrupted_mc_skips_the_rest(void **state)
     expect_not_in(rad, "\nmp,", "radiance.csv");
 }
 
+/* Every method prints a completion line: mp did not. */
+static void test_mp_completion_line(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("mp-line");
+    char cfg[1200], args[3000];
+    snprintf(cfg, sizeof cfg, "%s",
+             cli_config("mp-line", "[experiment]\nname = t\ngeometry = slab\nmethods = mp\n"));
+    snprintf(args, sizeof args, "run --out '%s/out' '%s'", dir, cfg);
+    cli_expect(args, 0, "t: wrote");
+    assert_int_equal(count_done(cli_out, "mp"), 1);
+    expect_in(cli_out, "mp: 2 segments in ", "stderr");
+}
+
+/* The mp+ss rows of radiance.csv, from the line after the header on (a static buffer). */
+static const char *mp_ss_rows(const char *csv)
+{
+    static char rows[1 << 16];
+    rows[0] = '\0';
+    for (const char *p = strstr(csv, "\nmp+ss,"); p; p = strstr(p + 1, "\nmp+ss,")) {
+        const char *e = strchr(p + 1, '\n');
+        size_t len = e ? (size_t)(e - p) : strlen(p), have = strlen(rows);
+        if (have + len + 1 >= sizeof rows)
+            fail_msg("too many mp+ss rows");
+        memcpy(rows + have, p, len);
+        rows[have + len] = '\0';
+    }
+    return rows;
+}
+
+/* The radiance column (7th) of the row starting with `key` (method,surface,segment,s,theta,phi). */
+static double radiance_of(const char *csv, const char *method, const char *rest)
+{
+    char key[256];
+    snprintf(key, sizeof key, "\n%s,%s", method, rest);
+    const char *p = strstr(csv, key);
+    if (!p)
+        fail_msg("radiance.csv lacks a row '%s%s'", method, rest);
+    p++;
+    for (int comma = 0; comma < 6; p++)
+        comma += *p == ',';
+    return strtod(p, NULL);
+}
+
+/* mp+ss after mp and ss takes their results: ss is marched once (one "ss: ... rows" line, two
+ * before), and mp+ss's rows are byte-identical to an mp+ss run alone, which computes both
+ * itself. Its radiance is mp's plus ss's (SPEC.md section 7), to the CSV's 10 digits. */
+static void test_mp_ss_reuses_mp_and_ss(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("mpss");
+    char cfg[1200], args[3000], alone[1 << 16];
+    snprintf(cfg, sizeof cfg, "%s",
+             cli_config("mpss", "[experiment]\nname = t\ngeometry = slab\n"
+                                "methods = ss, mp, mp+ss\n"));
+    snprintf(args, sizeof args, "run --out '%s/out' '%s'", dir, cfg);
+    cli_expect(args, 0, "t: wrote");
+    assert_int_equal(count_done(cli_out, "ss"), 1);
+    assert_int_equal(count_done(cli_out, "mp+ss"), 1); /* its completion line */
+    expect_in(cli_out, "mp and ss reused", "stderr");
+    char both[1 << 16];
+    snprintf(both, sizeof both, "%s", slurp(out_file(dir, "radiance.csv")));
+    snprintf(args, sizeof args, "run --set experiment.methods=mp+ss --out '%s/out' '%s'", dir, cfg);
+    cli_expect(args, 0, "t: wrote");
+    assert_int_equal(count_done(cli_out, "ss"), 1);
+    snprintf(alone, sizeof alone, "%s", mp_ss_rows(slurp(out_file(dir, "radiance.csv"))));
+    assert_true(strlen(alone) > 0);
+    assert_string_equal(mp_ss_rows(both), alone);
+    const char *rows[] = {"S1,0,", "S2,0,"};
+    for (int i = 0; i < 2; i++) {
+        double sum = radiance_of(both, "mp", rows[i]) + radiance_of(both, "ss", rows[i]);
+        assert_rel(radiance_of(both, "mp+ss", rows[i]), sum, 2e-9);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -262,6 +353,8 @@ int main(void)
         cmocka_unit_test(test_sigint_ppslab),
         cmocka_unit_test(test_second_signal_exits),
         cmocka_unit_test(test_interrupted_mc_skips_the_rest),
+        cmocka_unit_test(test_mp_completion_line),
+        cmocka_unit_test(test_mp_ss_reuses_mp_and_ss),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

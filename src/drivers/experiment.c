@@ -34,6 +34,8 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
         fprintf(stderr, "%s: %s ...\n", ex->cfg->name, m->id);
     double t0 = ppb_now();
     ppb_err why = {{0}};
+    ctx->prior = ex->res; /* what ran before it, for a method that combines others */
+    ctx->nprior = ex->n - nout;
     if (m->run(ctx, out, &why)) {
         /* Issue 15: this method's failure is its own; the others run on. */
         for (int i = 0; i < nout; i++)
@@ -87,6 +89,8 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
     for (; i < cfg->nmethods && !ppb_interrupted(); i++)
         if (run_method(ex, ppb_method_find(cfg->methods[i]), ctx, err))
             return -1;
+    ctx->prior = NULL;
+    ctx->nprior = 0;
     if (ppb_interrupted()) {
         /* After an interrupt the methods not yet started are skipped, and said so; the outputs
          * of those that ran are written, marked partial (README: exit codes). */

@@ -14,8 +14,9 @@
 
 struct ppb_march_cache;
 
-/* What a method gets: the experiment, an OpenCL device opened on first use, and caches that
- * outlive one experiment (a sweep reuses the marcher's tables across grid points). */
+/* What a method gets: the experiment, an OpenCL device opened on first use, caches that
+ * outlive one experiment (a sweep reuses the marcher's tables across grid points), and the
+ * results of the methods that ran before it in this experiment. */
 typedef struct ppb_run_ctx {
     const ppb_config *cfg;
     const char *device_selector; /* --device, or NULL */
@@ -23,11 +24,19 @@ typedef struct ppb_run_ctx {
     int ocl_open;
     int quiet;                           /* no progress lines */
     struct ppb_march_cache *march_cache; /* owned by the caller; NULL = build afresh */
+    /* The experiment's results so far, set by the runner before each method (NULL, 0: none).
+     * A method that combines others' results (mp+ss) takes them from here when they ran,
+     * byte-identical to computing them again, and computes them itself otherwise. */
+    const ppb_result *prior;
+    int nprior;
 } ppb_run_ctx;
 
 /* The device, opened on first call and shared by every method of the run. */
 int ppb_ctx_ocl(ppb_run_ctx *ctx, ppb_ocl **ocl, ppb_err *err);
 void ppb_ctx_close(ppb_run_ctx *ctx);
+
+/* The complete (not partial) result `id` among ctx->prior, or NULL. */
+const ppb_result *ppb_ctx_prior(const ppb_run_ctx *ctx, const char *id);
 
 /* out[0] is the method's result, out[1] its companion when `also` is set; both are already
  * initialised to zero with the scene's layout and their ids. */

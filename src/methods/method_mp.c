@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/progress.h"
 #include "methods/method_ss.h"
 #include "methods/result_check.h"
 #include "physics/maps.h"
@@ -162,7 +163,14 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     out->totals.absorbed_tracked = 0; /* absorbed = 1 - the rest, by the writer */
     if (ppb_mp_check(cfg, err))
         return -1;
+    int nseg = 0; /* over every surface: the slab's two faces are one segment each */
+    for (int surf = 0; surf < out->layout.nsurf; surf++)
+        nseg += out->layout.nseg[surf];
+    ppb_progress pr; /* the completion line, as every method prints one */
+    ppb_progress_begin(&pr, out->method, "segments", nseg, ctx->quiet);
     int rc = cfg->scene.geometry == PPB_GEOM_SLAB ? mp_slab(cfg, out, err) : mp_tube(cfg, out, err);
+    if (!rc)
+        ppb_progress_end(&pr, nseg);
     if (rc || ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
     if (strcmp(out->method, "mp") != 0)
@@ -192,23 +200,39 @@ int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
     return 0;
 }
 
+/* mp + ss, cell by cell. The parts are this experiment's mp and ss results when they ran before
+ * (ctx->prior: the same numbers, so nothing is computed twice), else computed here. */
 int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
-    if (ppb_method_mp(ctx, out, err))
-        return -1;
-    ppb_result ss;
-    if (ppb_result_init(&ss, "ss", &out->layout, err))
-        return -1;
-    if (ppb_method_ss(ctx, &ss, err)) {
-        ppb_result_free(&ss);
+    const ppb_result *mp = ppb_ctx_prior(ctx, "mp"), *ss = ppb_ctx_prior(ctx, "ss");
+    int reused = (mp != NULL) + (ss != NULL);
+    ppb_progress pr;
+    ppb_progress_begin(&pr, out->method, reused == 2 ? "cells, mp and ss reused," : "cells",
+                       (double)out->layout.ncells, ctx->quiet);
+    if (mp) {
+        memcpy(out->radiance, mp->radiance, out->layout.ncells * sizeof *out->radiance);
+        out->totals = mp->totals;
+    } else if (ppb_method_mp(ctx, out, err)) {
         return -1;
     }
+    ppb_result own = {0};
+    if (!ss) {
+        if (ppb_result_init(&own, "ss", &out->layout, err))
+            return -1;
+        if (ppb_method_ss(ctx, &own, err)) {
+            ppb_result_free(&own);
+            return -1;
+        }
+        ss = &own;
+    }
     for (size_t i = 0; i < out->layout.ncells; i++)
-        out->radiance[i] += ss.radiance[i];
-    out->totals.R += ss.totals.R; /* the diffusion already holds single scattering: MP+S counts */
-    out->totals.T += ss.totals.T; /* it twice, as the paper's energy remark says */
-    out->totals.sides += ss.totals.sides;
-    ppb_result_free(&ss);
+        out->radiance[i] += ss->radiance[i];
+    out->totals.R += ss->totals.R; /* the diffusion already holds single scattering: MP+S counts */
+    out->totals.T += ss->totals.T; /* it twice, as the paper's energy remark says */
+    out->totals.sides += ss->totals.sides;
+    out->partial |= ss->partial;
+    ppb_result_free(&own);
+    ppb_progress_end(&pr, (double)out->layout.ncells);
     ppb_result probe = *out;
     ppb_totals_complete(&probe.totals);
     return ppb_totals_check(ctx->cfg->name, &probe, err);
