@@ -254,7 +254,8 @@ static void test_set_override(void **state)
     /* A check across keys names the key --set gave, not the file. */
     assert_int_equal(ppb_config_set(&cfg, "experiment", "geometry", "slab", &err), 0);
     assert_int_equal(ppb_config_set(&cfg, "medium", "step", "density", &err), -1);
-    assert_string_equal(err.msg, "--set medium.step: steps are refused in slab mode (SPEC.md 2)");
+    assert_string_equal(err.msg, "--set medium.step: steps are refused in slab mode (SPEC.md 2; "
+                                 "geometry = slab from --set experiment.geometry)");
 }
 
 int main(void)

@@ -204,23 +204,15 @@ static void free_cli(cli *c)
     free(c->args);
 }
 
-/* Loads a config with its grid (the keys holding lists) and applies --set and --out. The
- * method ids are checked against the registry after the file and after each --set, where the
- * config checks its own keys. */
+/* Loads a config with its grid (the keys holding lists), applies every --set and then --out.
+ * The keys are checked against each other, and the method ids against the registry, once all
+ * --set are applied: their order does not matter (model/config.h). */
 static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_grid *grid,
                        ppb_err *err)
 {
-    if (ppb_config_load_grid(cfg, grid, path, err) || ppb_methods_check(cfg, err))
+    if (ppb_config_load_sets(cfg, grid, path, c->sets, c->nsets, err) ||
+        ppb_methods_check(cfg, err))
         return -1;
-    for (int i = 0; i < c->nsets; i++) {
-        char sec[64], key[64];
-        const char *eq = strchr(c->sets[i], '=');
-        const char *dot = strchr(c->sets[i], '.');
-        if (!eq || !dot || dot > eq || sscanf(c->sets[i], "%63[^.].%63[^=]", sec, key) != 2)
-            return ppb_fail(err, "--set %s: expected SECTION.KEY=VALUE", c->sets[i]);
-        if (ppb_config_set_grid(cfg, grid, sec, key, eq + 1, err) || ppb_methods_check(cfg, err))
-            return -1;
-    }
     if (c->out)
         snprintf(cfg->out_dir, sizeof cfg->out_dir, "%s", c->out);
     return 0;
@@ -357,9 +349,10 @@ static int cmd_run(const cli *c)
         if (load_config(c, c->args[i], &cfgs[i], grid, &err)) {
             code = usage_error(&err);
         } else if (grid->naxes > 0) {
-            fprintf(stderr, "ppbench: %s: keys hold lists (a sweep): use `ppbench sweep`\n",
-                    cfgs[i].path);
-            code = EXIT_USAGE;
+            /* Named where the list was given: the file's line or the --set option. */
+            ppb_config_axis_fail(&cfgs[i], grid, 0, &err,
+                                 "holds a list (a sweep): use `ppbench sweep`");
+            code = usage_error(&err);
         } else {
             code = check_config_out(c, &cfgs[i]);
             /* The directory is the run's own: refused, untouched, if ppbench did not write it. */

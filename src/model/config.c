@@ -2,13 +2,17 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <ini.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "kernels/march_params.h"
 
@@ -156,79 +160,205 @@ static char *trim(char *s)
     return s;
 }
 
-/* A number, with the key's type and range; integers accept "1e7" when exact. */
-static int parse_number(const key_def *k, const char *text, double *v, char *why, size_t n)
+/* Text from a config or the command line as a message may quote it: printable ASCII kept,
+ * every other byte as \xNN (so a message never sends raw bytes to a terminal), and cut to about
+ * 60 characters with "..." (a 100 KB value is not echoed). Returns buf. */
+static const char *shown(const char *s, char *buf, size_t cap)
 {
-    char *end;
-    errno = 0;
-    double x = strtod(text, &end);
-    if (end == text || *trim(end) != '\0' || errno == ERANGE || !isfinite(x)) {
-        snprintf(why, n, "'%s' is not a number", text);
-        return -1;
+    size_t len = 0;
+    for (; *s && len + 8 < cap; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (len >= 60) {
+            memcpy(buf + len, "...", 3);
+            len += 3;
+            break;
+        }
+        if (c >= 0x20 && c < 0x7f)
+            buf[len++] = (char)c;
+        else
+            len += (size_t)snprintf(buf + len, cap - len, "\\x%02x", c);
     }
+    buf[len] = '\0';
+    return buf;
+}
+
+/* Integers are exact in a double below 2^53 (IEEE 754 binary64's 53-bit significand): an
+ * integer written in floating-point form ("1e7") is taken below it, and so is a swept integer
+ * (the grid holds doubles). */
+#define EXACT_INT_MAX 9007199254740992.0 /* 2^53 */
+
+static int is_digits(const char *s)
+{
+    s += *s == '+' || *s == '-';
+    if (!isdigit((unsigned char)*s))
+        return 0;
+    while (isdigit((unsigned char)*s))
+        s++;
+    return *s == '\0';
+}
+
+/* A value is within the key's range (and an integer for an integer key). */
+static int check_value(const key_def *k, double x, const char *text, char *why, size_t n)
+{
+    char q[96];
     if ((k->type == K_INT || k->type == K_LLONG) && x != floor(x)) {
-        snprintf(why, n, "'%s' is not an integer", text);
+        snprintf(why, n, "'%s' is not an integer", shown(text, q, sizeof q));
         return -1;
     }
     if (x < k->min || x > k->max) {
-        snprintf(why, n, "%s is out of range [%g, %g]", text, k->min, k->max);
+        snprintf(why, n, "%s is out of range [%g, %g]", shown(text, q, sizeof q), k->min, k->max);
         return -1;
     }
-    *v = x;
     return 0;
 }
 
-/* "a, b, c" or "start:stop:step" (inclusive, step > 0), or a mix. */
-static int parse_list(const key_def *k, const char *text, double *vals, int *count, char *why,
-                      size_t n)
+/* A number, with the key's type and range. Integer keys read digits as integers (strtoll, so a
+ * seed above 2^53 keeps every digit, *exact holds it) and accept "1e7" when that double is an
+ * integer below 2^53, which it then holds exactly. */
+static int parse_number(const key_def *k, const char *text, double *v, long long *exact, char *why,
+                        size_t n)
 {
-    char buf[4096];
-    snprintf(buf, sizeof buf, "%s", text);
+    char q[96];
+    int integer = k->type == K_INT || k->type == K_LLONG;
+    char *end;
+    errno = 0;
+    if (integer && is_digits(text)) {
+        long long x = strtoll(text, &end, 10);
+        if (errno == ERANGE || (isfinite(k->min) && x < (long long)k->min) ||
+            (isfinite(k->max) && x > (long long)k->max)) {
+            snprintf(why, n, "%s is out of range [%g, %g]", shown(text, q, sizeof q), k->min,
+                     k->max);
+            return -1;
+        }
+        *v = (double)x;
+        if (exact)
+            *exact = x;
+        return 0;
+    }
+    double x = strtod(text, &end);
+    if (end == text || *trim(end) != '\0' || errno == ERANGE || !isfinite(x)) {
+        snprintf(why, n, "'%s' is not a number", shown(text, q, sizeof q));
+        return -1;
+    }
+    if (check_value(k, x, text, why, n))
+        return -1;
+    if (integer && fabs(x) >= EXACT_INT_MAX) {
+        snprintf(why, n,
+                 "'%s' is above 2^53, where a floating-point number is not exact: "
+                 "write the integer in digits",
+                 shown(text, q, sizeof q));
+        return -1;
+    }
+    *v = x;
+    if (exact)
+        *exact = integer ? (long long)x : 0;
+    return 0;
+}
+
+/* Value i of the m values of start:stop:step (a:b:st). The values are start + i * step
+ * up to the last one that exceeds stop by at most RANGE_TOL steps, and a last value within
+ * RANGE_TOL steps of stop is stop itself: "0:1:0.1" ends at 1 whatever the rounding of 0.1
+ * (configs/README.md states this rule). */
+#define RANGE_TOL 1e-9
+
+static double range_value(double a, double b, double st, long long m, long long i)
+{
+    double v = a + (double)i * st;
+    return i == m - 1 && fabs(v - b) <= RANGE_TOL * st ? b : v;
+}
+
+/* "a, b, c" or "start:stop:step" (inclusive, step > 0), or a mix. Every value, given or
+ * generated, is checked against the key's range here. *first_exact: the first value exactly,
+ * for an integer key (parse_number). */
+static int parse_list(const key_def *k, const char *text, double *vals, int *count,
+                      long long *first_exact, char *why, size_t n)
+{
+    char q[96];
+    char *buf = strdup(text);
+    if (!buf) {
+        snprintf(why, n, "out of memory");
+        return -1;
+    }
+    int rc = -1, big = 0; /* big: an integer of 2^53 or more */
     *count = 0;
     char *rest = buf;
     for (char *tok = strsep(&rest, ","); tok; tok = strsep(&rest, ",")) {
         tok = trim(tok);
         if (!*tok) {
-            snprintf(why, n, "empty value in list '%s'", text);
-            return -1;
+            snprintf(why, n, "empty value in list '%s'", shown(text, q, sizeof q));
+            goto out;
+        }
+        if (*count >= PPB_MAX_LIST) {
+            snprintf(why, n, "a list holds at most %d values", PPB_MAX_LIST);
+            goto out;
         }
         char *c1 = strchr(tok, ':');
         if (!c1) {
-            if (*count >= PPB_MAX_LIST || parse_number(k, tok, &vals[*count], why, n))
-                return *count >= PPB_MAX_LIST ? (snprintf(why, n, "list too long"), -1) : -1;
+            long long exact = 0;
+            if (parse_number(k, tok, &vals[*count], &exact, why, n))
+                goto out;
+            big |= llabs(exact) >= (long long)EXACT_INT_MAX;
+            if (*count == 0)
+                *first_exact = exact;
             (*count)++;
             continue;
         }
         char *c2 = strchr(c1 + 1, ':');
         if (!c2) {
-            snprintf(why, n, "range '%s' must read start:stop:step", tok);
-            return -1;
+            snprintf(why, n, "range '%s' must read start:stop:step", shown(tok, q, sizeof q));
+            goto out;
         }
+        char range[96];
+        shown(tok, range, sizeof range);
         *c1 = *c2 = '\0';
         double a, b, st;
         key_def wide = *k;
         wide.min = -INFINITY;
         wide.max = INFINITY;
-        if (parse_number(k, trim(tok), &a, why, n) || parse_number(k, trim(c1 + 1), &b, why, n) ||
-            parse_number(&wide, trim(c2 + 1), &st, why, n))
-            return -1;
+        long long exact = 0, exact_b = 0;
+        if (parse_number(k, trim(tok), &a, &exact, why, n) ||
+            parse_number(k, trim(c1 + 1), &b, &exact_b, why, n) ||
+            parse_number(&wide, trim(c2 + 1), &st, NULL, why, n))
+            goto out;
         if (!(st > 0) || b < a) {
-            snprintf(why, n, "range %g:%g:%g needs step > 0 and stop >= start", a, b, st);
-            return -1;
+            snprintf(why, n, "range %s needs step > 0 and stop >= start", range);
+            goto out;
         }
-        long long m = (long long)floor((b - a) / st * (1 + 1e-12)) + 1;
-        if (*count + m > PPB_MAX_LIST) {
-            snprintf(why, n, "range %g:%g:%g has more than %d values", a, b, st, PPB_MAX_LIST);
-            return -1;
+        /* The count as a double first: a tiny step (0:1:1e-19) makes it too large for any
+         * integer type. */
+        double steps = floor((b - a) / st + RANGE_TOL);
+        if (!(steps < PPB_MAX_LIST - *count)) {
+            snprintf(why, n, "range %s has more than %d values", range, PPB_MAX_LIST);
+            goto out;
         }
-        for (long long i = 0; i < m; i++)
-            vals[(*count)++] = a + (double)i * st;
+        long long m = (long long)steps + 1;
+        big |=
+            llabs(exact) >= (long long)EXACT_INT_MAX || llabs(exact_b) >= (long long)EXACT_INT_MAX;
+        if (*count == 0)
+            *first_exact = exact;
+        for (long long i = 0; i < m; i++) {
+            double v = range_value(a, b, st, m, i);
+            if (v < k->min || v > k->max) {
+                snprintf(why, n, "range %s yields %.17g, out of range [%g, %g]", range, v, k->min,
+                         k->max);
+                goto out;
+            }
+            vals[(*count)++] = v;
+        }
     }
     if (*count == 0) {
         snprintf(why, n, "empty value");
-        return -1;
+        goto out;
     }
-    return 0;
+    /* A swept integer goes through the grid's doubles: exact only below 2^53. */
+    if (*count > 1 && big) {
+        snprintf(why, n, "a swept integer must be below 2^53 (a grid holds doubles)");
+        goto out;
+    }
+    rc = 0;
+out:
+    free(buf);
+    return rc;
 }
 
 static void store_number(ppb_config *cfg, const key_def *k, double v)
@@ -340,17 +470,31 @@ static int set_key(ppb_config *cfg, ppb_grid *grid, int i, const char *text, cha
     }
     double vals[PPB_MAX_LIST];
     int count;
-    if (parse_list(k, text, vals, &count, why, n))
+    long long exact = 0;
+    if (parse_list(k, text, vals, &count, &exact, why, n))
         return -1;
     store_number(cfg, k, vals[0]);
-    if (count == 1)
+    if (count == 1) {
+        if (k->type == K_LLONG)
+            *(long long *)p = exact; /* every digit of a seed, also above 2^53 */
         return 0;
+    }
     if (!grid) {
         snprintf(why, n, "a list (a sweep) is not accepted here");
         return -1;
     }
     if (grid->naxes == PPB_MAX_AXES) {
         snprintf(why, n, "more than %d swept keys", PPB_MAX_AXES);
+        return -1;
+    }
+    /* The hard limit holds with --yes too: checking, hashing and tracking a grid costs time
+     * and memory per point before any point runs. */
+    long long points = ppb_grid_npoints(grid);
+    if (points > PPB_GRID_MAX_POINTS / count) {
+        snprintf(why, n,
+                 "%d values make a grid of %lld points, over the hard limit of %lld (--yes does "
+                 "not lift it)",
+                 count, points * count, (long long)PPB_GRID_MAX_POINTS);
         return -1;
     }
     if (ppb_grid_add(grid, i, vals, count)) {
@@ -360,40 +504,113 @@ static int set_key(ppb_config *cfg, ppb_grid *grid, int i, const char *text, cha
     return 0;
 }
 
-/* inih reports the line of the first error but passes no line to the handler (the system
- * library is built without INI_HANDLER_LINENO); reading through this counter gives the line
- * inih is on, which inih itself counts once per read. */
-typedef struct line_reader {
-    FILE *f;
-    int line;
-} line_reader;
-
-static char *read_line(char *str, int num, void *stream)
-{
-    line_reader *r = stream;
-    char *s = fgets(str, num, r->f);
-    r->line += s != NULL;
-    return s;
-}
+/* The file as inih reads it. The system's inih reads lines into a fixed buffer (INI_MAX_LINE,
+ * 200 bytes in Debian's build: the rest of a longer line was read as the next line, shifting
+ * every line number after it) and reads on after an error. So the config is read into memory
+ * first (a regular file of at most PPB_CONFIG_MAX_BYTES: a directory, a device such as
+ * /dev/zero or a FIFO is refused before anything is read) and handed to inih one line per call
+ * by next_line(), which
+ *  - hands a comment line as a blank line and a line without its inline comment (a ';' after a
+ *    blank), what inih skips anyway, so comments of any length are fine;
+ *  - refuses a NUL or control byte, and a line that still does not fit inih's buffer, as an
+ *    error of that line;
+ *  - returns end of file after the first error (the handler's, or inih's syntax error, found
+ *    by inih's own test), so the first error is reported and nothing after it is read.
+ * inih passes no line to the handler (INI_HANDLER_LINENO is off): it counts one line per call,
+ * and so does next_line. */
+#define PPB_CONFIG_MAX_BYTES (1 << 20)
 
 typedef struct parse_state {
     ppb_config *cfg;
     ppb_grid *grid;
-    line_reader *in;
+    const char *next, *end; /* the text not yet handed to inih */
+    int line;               /* lines handed to inih: the line it is on */
+    int in_key;             /* a key since the last section: an indented line continues it */
+    int stop;               /* the line handed last holds a syntax error */
     char seen[PPB_MAX_KEYS];
-    int err_line; /* line of the first key error, 0 = none */
+    int err_line; /* line of the first error (handler or text), 0 = none */
+    int text_err; /* that error is the text's: why says it all */
     char why[1200];
-    char what[128];
+    char what[160];
 } parse_state;
+
+static int text_fail(parse_state *st, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int text_fail(parse_state *st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(st->why, sizeof st->why, fmt, ap);
+    va_end(ap);
+    st->err_line = st->line;
+    st->text_err = 1;
+    return -1;
+}
+
+static char *next_line(char *str, int num, void *stream)
+{
+    parse_state *st = stream;
+    if (st->stop || st->err_line || st->next >= st->end)
+        return NULL;
+    const char *s = st->next;
+    const char *nl = memchr(s, '\n', (size_t)(st->end - s));
+    size_t len = nl ? (size_t)(nl - s) : (size_t)(st->end - s);
+    st->next = nl ? nl + 1 : st->end;
+    st->line++;
+    for (size_t j = 0; j < len; j++) {
+        unsigned char c = (unsigned char)s[j];
+        if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f) {
+            if (c == 0)
+                text_fail(st, "a NUL byte: not a text file");
+            else
+                text_fail(st, "control character \\x%02x: not a text file", c);
+            return NULL;
+        }
+    }
+    size_t b = 0; /* the first non-blank */
+    while (b < len && isspace((unsigned char)s[b]))
+        b++;
+    if (b == len || s[b] == ';' || s[b] == '#')
+        len = b = 0; /* a blank or comment line */
+    for (size_t j = b + 1; j < len; j++)
+        if (s[j] == ';' && isspace((unsigned char)s[j - 1])) {
+            len = j;
+            break;
+        }
+    while (len > b && isspace((unsigned char)s[len - 1]))
+        len--;
+    if (len + 2 > (size_t)num) {
+        text_fail(st, "a line of %zu characters (without comments); a line holds at most %d", len,
+                  num - 2);
+        return NULL;
+    }
+    /* inih's syntax test, in its order: a line indented under a key continues that key's value
+     * (inih's multi-line values; the handler sees the key again), a section needs its ']', a
+     * key line a '=' or ':'. */
+    if (len > 0 && !(st->in_key && b > 0)) {
+        if (s[b] == '[') {
+            st->stop = !memchr(s + b, ']', len - b);
+            st->in_key = 0;
+        } else {
+            st->stop = !memchr(s + b, '=', len - b) && !memchr(s + b, ':', len - b);
+            st->in_key = 1;
+        }
+    }
+    memcpy(str, s, len);
+    str[len] = '\n';
+    str[len + 1] = '\0';
+    return str;
+}
 
 static int on_key(void *user, const char *section, const char *name, const char *value)
 {
     parse_state *st = user;
     if (st->err_line)
-        return 1; /* inih reads on after an error; the first one is reported */
+        return 0; /* not reached: next_line ends the text after an error */
     int i = find_key(section, name);
-    snprintf(st->what, sizeof st->what, "[%s] %s", section, name);
-    st->err_line = st->in->line;
+    char qs[96], qn[96];
+    snprintf(st->what, sizeof st->what, "[%s] %s", shown(section, qs, sizeof qs),
+             shown(name, qn, sizeof qn));
+    st->err_line = st->line;
     if (i < 0) {
         snprintf(st->why, sizeof st->why, "%s",
                  section_known(section) ? "unknown key" : "unknown section");
@@ -404,11 +621,64 @@ static int on_key(void *user, const char *section, const char *name, const char 
         return 0;
     }
     st->seen[i] = 1;
-    st->cfg->origin[i].line = st->in->line;
+    st->cfg->origin[i].line = st->line;
     if (set_key(st->cfg, st->grid, i, value, st->why, sizeof st->why))
         return 0;
     st->err_line = 0;
     return 1;
+}
+
+/* The whole of a config file, NUL-terminated, into *text (the caller frees it). */
+static int read_text(const char *path, char **text, size_t *len, ppb_err *err)
+{
+    /* O_NONBLOCK: opening a FIFO does not wait for a writer; it is refused below. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return ppb_fail(err, "%s: cannot open config: %s", path, strerror(errno));
+    struct stat sb;
+    char *buf = NULL;
+    size_t n = 0;
+    int rc = -1;
+    if (fstat(fd, &sb) != 0)
+        ppb_fail(err, "%s: cannot read config: %s", path, strerror(errno));
+    else if (S_ISDIR(sb.st_mode))
+        ppb_fail(err, "%s: is a directory, not a config file", path);
+    else if (!S_ISREG(sb.st_mode))
+        ppb_fail(err, "%s: not a regular file (a config is a text file)", path);
+    else if (sb.st_size > PPB_CONFIG_MAX_BYTES)
+        ppb_fail(err, "%s: %lld bytes: a config holds at most %d", path, (long long)sb.st_size,
+                 PPB_CONFIG_MAX_BYTES);
+    else if (!(buf = malloc(PPB_CONFIG_MAX_BYTES + 1)))
+        ppb_fail(err, "%s: out of memory", path);
+    else
+        for (;;) {
+            /* Bounded even should the file grow while it is read. */
+            ssize_t r = read(fd, buf + n, PPB_CONFIG_MAX_BYTES + 1 - n);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r < 0) {
+                ppb_fail(err, "%s: cannot read config: %s", path, strerror(errno));
+                break;
+            }
+            n += (size_t)r;
+            if (n > PPB_CONFIG_MAX_BYTES) {
+                ppb_fail(err, "%s: a config holds at most %d bytes", path, PPB_CONFIG_MAX_BYTES);
+                break;
+            }
+            if (r == 0) {
+                rc = 0;
+                break;
+            }
+        }
+    close(fd);
+    if (rc) {
+        free(buf);
+        return -1;
+    }
+    buf[n] = '\0';
+    *text = buf;
+    *len = n;
+    return 0;
 }
 
 int ppb_config_key_fail(const ppb_config *cfg, const char *section, const char *key, ppb_err *err,
@@ -426,17 +696,45 @@ int ppb_config_key_fail(const ppb_config *cfg, const char *section, const char *
     return ppb_fail(err, "%s:%d: [%s] %s: %s", cfg->path, line, section, key, why);
 }
 
-/* Checks that involve more than one key. */
+int ppb_config_axis_fail(const ppb_config *cfg, const ppb_grid *grid, int a, ppb_err *err,
+                         const char *why)
+{
+    const key_def *k = &keys[grid->axes[a].key];
+    return ppb_config_key_fail(cfg, k->section, k->key, err, "%s", why);
+}
+
+/* Where key (section, key) got its value, for a message about two keys: "--set tube.width",
+ * "line 3" or "the default". */
+static const char *origin_of(const ppb_config *cfg, const char *section, const char *key, char *buf,
+                             size_t cap)
+{
+    int i = find_key(section, key);
+    if (cfg->origin[i].from_set)
+        snprintf(buf, cap, "--set %s.%s", section, key);
+    else if (cfg->origin[i].line > 0)
+        snprintf(buf, cap, "line %d", cfg->origin[i].line);
+    else
+        snprintf(buf, cap, "the default");
+    return buf;
+}
+
+/* Checks that involve more than one key; each names the key it fails and where the other
+ * one was set. */
 static int validate(const ppb_config *cfg, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     int slab = sc->geometry == PPB_GEOM_SLAB;
+    char where[160];
     if (slab && sc->step != PPB_STEP_NONE)
-        return ppb_config_key_fail(cfg, "medium", "step", err,
-                                   "steps are refused in slab mode (SPEC.md 2)");
+        return ppb_config_key_fail(
+            cfg, "medium", "step", err,
+            "steps are refused in slab mode (SPEC.md 2; geometry = slab from %s)",
+            origin_of(cfg, "experiment", "geometry", where, sizeof where));
     if (!slab && sc->step != PPB_STEP_NONE && fabs(sc->step_x) >= 0.5 * sc->width)
-        return ppb_config_key_fail(cfg, "medium", "step_x", err,
-                                   "the step must lie inside the tube");
+        return ppb_config_key_fail(
+            cfg, "medium", "step_x", err,
+            "the step must lie inside the tube (|step_x| < width / 2 = %g, width from %s)",
+            0.5 * sc->width, origin_of(cfg, "tube", "width", where, sizeof where));
     return 0;
 }
 
@@ -466,7 +764,8 @@ int ppb_config_defaults(ppb_config *cfg, ppb_err *err)
     return apply_defaults(cfg, err);
 }
 
-int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err *err)
+/* The file's keys, each checked alone; the checks across keys are left to the caller. */
+static int read_file(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err *err)
 {
     memset(cfg, 0, sizeof *cfg);
     if (grid)
@@ -474,13 +773,17 @@ int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_
     snprintf(cfg->path, sizeof cfg->path, "%s", path);
     if (apply_defaults(cfg, err))
         return -1;
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return ppb_fail(err, "%s: cannot open config: %s", path, strerror(errno));
-    line_reader in = {.f = f};
-    parse_state st = {.cfg = cfg, .grid = grid, .in = &in};
-    int rc = ini_parse_stream(read_line, &in, on_key, &st);
-    fclose(f);
+    char *text = NULL;
+    size_t len = 0;
+    if (read_text(path, &text, &len, err))
+        return -1;
+    parse_state st = {.cfg = cfg, .grid = grid, .next = text, .end = text + len};
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        st.next += 3; /* a UTF-8 byte order mark, which inih skips as well */
+    int rc = ini_parse_stream(next_line, &st, on_key, &st);
+    free(text);
+    if (st.text_err)
+        return ppb_fail(err, "%s:%d: %s", path, st.err_line, st.why);
     if (rc > 0 && rc == st.err_line)
         return ppb_fail(err, "%s:%d: %s: %s", path, rc, st.what, st.why);
     if (rc > 0)
@@ -491,6 +794,13 @@ int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_
         base_name(path, cfg->name, sizeof cfg->name);
     if (!cfg->out_dir[0])
         snprintf(cfg->out_dir, sizeof cfg->out_dir, "results/%s", cfg->name);
+    return 0;
+}
+
+int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err *err)
+{
+    if (read_file(cfg, grid, path, err))
+        return -1;
     return validate(cfg, err);
 }
 
@@ -499,12 +809,15 @@ int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)
     return ppb_config_load_grid(cfg, NULL, path, err);
 }
 
-int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, const char *key,
-                        const char *value, ppb_err *err)
+/* One key set from text, checked alone, as by --set. */
+static int override(ppb_config *cfg, ppb_grid *grid, const char *section, const char *key,
+                    const char *value, ppb_err *err)
 {
+    char qs[96], qk[96];
     int i = find_key(section, key);
     if (i < 0)
-        return ppb_fail(err, "--set %s.%s: %s", section, key,
+        return ppb_fail(err, "--set %s.%s: %s", shown(section, qs, sizeof qs),
+                        shown(key, qk, sizeof qk),
                         section_known(section) ? "unknown key" : "unknown section");
     char why[1200];
     /* A key set again replaces an earlier list on it. */
@@ -513,6 +826,14 @@ int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, co
     if (set_key(cfg, grid, i, value, why, sizeof why))
         return ppb_fail(err, "--set %s.%s: %s", section, key, why);
     cfg->origin[i].from_set = 1;
+    return 0;
+}
+
+int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, const char *key,
+                        const char *value, ppb_err *err)
+{
+    if (override(cfg, grid, section, key, value, err))
+        return -1;
     return validate(cfg, err);
 }
 
@@ -520,6 +841,32 @@ int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const 
                    ppb_err *err)
 {
     return ppb_config_set_grid(cfg, NULL, section, key, value, err);
+}
+
+int ppb_config_load_sets(ppb_config *cfg, ppb_grid *grid, const char *path, const char *const *sets,
+                         int nsets, ppb_err *err)
+{
+    if (read_file(cfg, grid, path, err))
+        return -1;
+    for (int j = 0; j < nsets; j++) {
+        char q[96];
+        const char *eq = strchr(sets[j], '=');
+        const char *dot = strchr(sets[j], '.');
+        if (!eq || !dot || dot > eq || dot == sets[j] || dot + 1 == eq)
+            return ppb_fail(err, "--set %s: expected SECTION.KEY=VALUE",
+                            shown(sets[j], q, sizeof q));
+        char section[64], key[64];
+        size_t ns = (size_t)(dot - sets[j]), nk = (size_t)(eq - dot - 1);
+        if (ns >= sizeof section || nk >= sizeof key)
+            return ppb_fail(err, "--set %s: no such key", shown(sets[j], q, sizeof q));
+        memcpy(section, sets[j], ns);
+        section[ns] = '\0';
+        memcpy(key, dot + 1, nk);
+        key[nk] = '\0';
+        if (override(cfg, grid, section, key, eq + 1, err))
+            return -1;
+    }
+    return validate(cfg, err);
 }
 
 int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, ppb_config *out,

@@ -7,6 +7,11 @@
  * a sweep: the lists go into a grid the caller owns (model/grid.h) and ppb_config_point()
  * resolves one grid point to plain values. Errors read "file:line: [section] key: reason".
  *
+ * A config is a regular text file of at most 1 MiB, read whole before parsing: anything else
+ * (a directory, a device, binary data, a line too long for the INI parser) is refused naming
+ * the file and line, and text quoted in a message is escaped (never raw bytes). Integer keys
+ * are read as integers: a seed keeps every digit.
+ *
  * The config knows no methods: `methods` is a list of id strings, checked against the method
  * registry by the methods layer (ppb_methods_check in methods/registry.h). For such later
  * checks the config records where each key was set (ppb_config_key_fail). */
@@ -77,8 +82,16 @@ int ppb_config_defaults(ppb_config *cfg, ppb_err *err);
 int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err *err);
 int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err); /* grid NULL */
 
-/* Sets one key from a string as if it stood in the file (used by tests and --set); a list
- * replaces the key's axis in grid (NULL: lists refused), a plain value removes it. */
+/* Loads a config as ppb_config_load_grid, then applies overrides "section.key=value" (the
+ * command line's --set) in order, each as if it stood in the file, and only then checks the
+ * keys against each other: the overrides' order does not matter, and a conflict names the
+ * --set option or the file line of each side. */
+int ppb_config_load_sets(ppb_config *cfg, ppb_grid *grid, const char *path, const char *const *sets,
+                         int nsets, ppb_err *err);
+
+/* Sets one key from a string as if it stood in the file, then checks the keys against each
+ * other (used by tests); a list replaces the key's axis in grid (NULL: lists refused), a plain
+ * value removes it. */
 int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, const char *key,
                         const char *value, ppb_err *err);
 int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const char *value,
@@ -92,6 +105,10 @@ int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, p
  * key: why" (line 0 when the key kept its default), or "--set section.key: why". Returns -1. */
 int ppb_config_key_fail(const ppb_config *cfg, const char *section, const char *key, ppb_err *err,
                         const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+
+/* ppb_config_key_fail about the key of grid axis a (where its list was given). */
+int ppb_config_axis_fail(const ppb_config *cfg, const ppb_grid *grid, int a, ppb_err *err,
+                         const char *why);
 
 /* Writes every resolved key as "section.key = value" lines: the canonical form hashed for
  * resume and recorded in provenance. */

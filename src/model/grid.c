@@ -1,5 +1,6 @@
 #include "model/grid.h"
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,7 +26,8 @@ void ppb_grid_free(ppb_grid *g)
 
 int ppb_grid_add(ppb_grid *g, int key, const double *values, int n)
 {
-    if (g->naxes == PPB_MAX_AXES || n < 2 || n > PPB_MAX_LIST)
+    if (g->naxes == PPB_MAX_AXES || n < 2 || n > PPB_MAX_LIST ||
+        ppb_grid_npoints(g) > PPB_GRID_MAX_POINTS / n)
         return -1;
     double *copy = malloc((size_t)n * sizeof *copy);
     if (!copy)
@@ -49,8 +51,11 @@ void ppb_grid_remove(ppb_grid *g, int key)
 long long ppb_grid_npoints(const ppb_grid *g)
 {
     long long n = 1;
-    for (int a = 0; g && a < g->naxes; a++)
+    for (int a = 0; g && a < g->naxes; a++) {
+        if (g->axes[a].n > 0 && n > LLONG_MAX / g->axes[a].n)
+            return LLONG_MAX;
         n *= g->axes[a].n;
+    }
     return n;
 }
 

@@ -11,6 +11,9 @@
 
 #define PPB_MAX_AXES 8    /* swept keys */
 #define PPB_MAX_LIST 1024 /* values of one swept key */
+/* Points of a grid, a hard limit (a sweep's --yes lifts only the drivers' soft one): keeps the
+ * point count far inside long long, however many axes multiply. */
+#define PPB_GRID_MAX_POINTS 10000000LL
 
 typedef struct ppb_axis {
     int key;        /* index in the key table (ppb_config_key_name) */
@@ -31,13 +34,16 @@ void ppb_grid_free(ppb_grid *g);
 void ppb_grid_clear(ppb_grid *g);
 
 /* Appends an axis over key with a copy of values[0..n). Returns -1 when the grid already has
- * PPB_MAX_AXES axes, n is outside [2, PPB_MAX_LIST] or memory runs out; nothing changes then. */
+ * PPB_MAX_AXES axes, n is outside [2, PPB_MAX_LIST], the grid would exceed PPB_GRID_MAX_POINTS
+ * points or memory runs out; nothing changes then. */
 int ppb_grid_add(ppb_grid *g, int key, const double *values, int n);
 
 /* Removes the axis over key, if any (a key set again replaces its earlier list). */
 void ppb_grid_remove(ppb_grid *g, int key);
 
-/* Number of grid points: the product of the axes' sizes, 1 for NULL or no axis. */
+/* Number of grid points: the product of the axes' sizes, 1 for NULL or no axis; at most
+ * PPB_GRID_MAX_POINTS for a grid built by ppb_grid_add (LLONG_MAX should a caller have filled
+ * the axes itself beyond that: never a wrapped count). */
 long long ppb_grid_npoints(const ppb_grid *g);
 
 /* Value of axis a at grid point i, 0 <= i < ppb_grid_npoints(g). */
