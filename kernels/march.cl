@@ -25,6 +25,7 @@
  * (P.telescope) and steps only through irregular pieces. Where a step's slope differs from the
  * slab's, the S formula does not hold and that step uses the R rule. */
 #include "march_params.h"
+#include "ppb_sort.h"
 
 /* (e^z - 1) / z, stable at z = 0. */
 inline double ppb_phi1(double z)
@@ -243,12 +244,7 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
         if (c > 1e-12 && c < lfar - 1e-12)
             brk[nb++] = c;
     }
-    for (int i = 2; i < nb; i++) /* insertion sort of at most three breaks */
-        for (int k = i; k > 1 && brk[k] < brk[k - 1]; k--) {
-            double s = brk[k];
-            brk[k] = brk[k - 1];
-            brk[k - 1] = s;
-        }
+    ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first; at most three breaks */
     brk[nb++] = lfar;
 
     double r0 = wy; /* d tau / (sigma_t dl) in a slab: tau = sigma_t depth, depth grows as wy l */

@@ -12,7 +12,7 @@
 #include "base/csv_read.h"
 #include "base/hash.h"
 #include "base/quadrature.h"
-#include "base/sort.h"
+#include "kernels/ppb_sort.h"
 
 static const char *write_text(const char *dir, const char *name, const char *text)
 {

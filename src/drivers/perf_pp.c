@@ -7,14 +7,14 @@
 #include <math.h>
 
 #include "base/clock.h"
-#include "base/sort.h"
+#include "kernels/ppb_sort.h"
 #include "physics/ppsolver.h"
 
 #define PERF_RUNS 7
 
 static double median(double *v, int n)
 {
-    ppb_sort_doubles(v, (size_t)n);
+    ppb_sort_doubles(v, n);
     return v[n / 2];
 }
 

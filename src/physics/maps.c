@@ -7,7 +7,7 @@
 #include "kernels/march_params.h"
 
 #include "base/quadrature.h"
-#include "base/sort.h"
+#include "kernels/ppb_sort.h"
 
 /* Fraction of a straight path whose x runs from x0 to x1 that lies right of the step
  * (x >= step_x); a vertical path is wholly on one side. */
@@ -168,7 +168,7 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
     for (int k = 0; k < 3; k++)
         if (cand[k] > a && cand[k] < b)
             brk[nb++] = cand[k];
-    ppb_sort_doubles(brk, (size_t)nb);
+    ppb_sort_doubles(brk, nb);
     double gx[5], gw[5]; /* 5-point Gauss-Legendre, summed in ascending x */
     ppb_gauss_legendre(5, gx, gw);
     const int panels = 64;
