@@ -6,6 +6,7 @@
 #include "methods/method_mp.h"
 #include "methods/method_pp.h"
 #include "methods/method_ppslab.h"
+#include "methods/method_rte2d.h"
 #include "methods/method_ss.h"
 
 /* The registry: the order here is the order of outputs. */
@@ -18,6 +19,8 @@ static const ppb_method methods[] = {
     {"mp+ss", NULL, 0, 0, "multipole diffusion plus single scattering", ppb_method_mp_ss},
     {"ppslab", NULL, 1, 2, "plane-parallel solution at the slab faces (slab mode only)",
      ppb_method_ppslab},
+    {"rte2d", NULL, 0, 0, "the tube's transfer solved: the paper's refinement iterated",
+     ppb_method_rte2d},
 };
 
 int ppb_method_count(void)

@@ -51,6 +51,14 @@ typedef struct ppb_mp_settings {
     int samples; /* quadrature nodes per mfp over the lit strip */
 } ppb_mp_settings;
 
+typedef struct ppb_rte2d_settings {
+    double spacing;  /* grid node spacing over the cross-section, mfp */
+    int directions;  /* direction cells per hemisphere */
+    double step;     /* march step in the x-y plane, mfp */
+    double tol;      /* relative residual of the converged solve */
+    int refinements; /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
+} ppb_rte2d_settings;
+
 /* Where a key's value came from, so that checks made after loading name the right place. */
 typedef struct ppb_key_origin {
     int line;     /* line of the key in the config file, 0 = not in the file */
@@ -68,6 +76,7 @@ typedef struct ppb_config {
     ppb_mc_settings mc;
     ppb_pp_settings pp;
     ppb_mp_settings mp;
+    ppb_rte2d_settings rte2d;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
     ppb_key_origin origin[PPB_MAX_KEYS]; /* per key of the table */

@@ -1,0 +1,191 @@
+/* rte2d.cl: the marches of `rte2d` (SPEC.md section 12; paper Sec. 3.1, Eq. 5).
+ *
+ * One refinement of Eq. 5, I_n = K I_(n-1) + I_0, is a march from every grid node in every
+ * direction cell through the piecewise-constant medium (ppb_rte_sweep); the exit radiance is the
+ * same march from every segment point in every direction sample of every bin (ppb_rte_exit), as
+ * `pp` averages its bins (SPEC.md section 4). Both integrate, along q = p - l w,
+ *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
+ * where J is the grid's scattered-light source per unit scattering coefficient (bilinear in the
+ * nodes, rte2d_params.h) and C E the direct beam's first scattering, exact: E = lit exp(-D) with
+ * D linear along each piece (C = the cell average of p(w.w_L) in the sweep, p(w.w_L) itself at
+ * the exit, as `ss`).
+ *
+ * The ray is cut into pieces where sigma_t, alpha or D's slope change or the light is cut off
+ * (the step plane x = step_x, the light lines x' = step_x and x' = -W/2), as march.cl cuts them.
+ * In a piece (sigma_t, sigma_s, lit constant):
+ *   beam: exactly  alpha C lit sigma_t len e^{-d_a - D_a} phi1(-(sigma_t len + D_b - D_a)),
+ *   grid source: steps of planar length <= hstep, J linear between a step's ends and the
+ *   exponential integrated exactly: alpha e^{-d_1} [J_1 a + (J_2 - J_1)(a / x - 1 + a)],
+ *   x = sigma_t h, a = 1 - e^{-x}; exact for a source linear along the step whatever its
+ *   optical length (directions close to z cross many mfp in a short planar distance). */
+#include "march_params.h"
+#include "rte2d_params.h"
+
+/* (e^z - 1) / z, stable at z = 0. */
+inline double rte_phi1(double z)
+{
+    return fabs(z) < 1e-300 ? 1.0 : expm1(z) / z;
+}
+
+/* exp(e_a) phi1(z) with e_b = e_a + z <= 0, in the scaled form where exp(e_a) underflows (as
+ * march.cl's ppb_beam_step). */
+inline double rte_beam_factor(double e_a, double z)
+{
+    if (e_a < -700.0 && z > 0.0)
+        return exp(e_a + z) * (-expm1(-z) / z);
+    return exp(e_a) * rte_phi1(z);
+}
+
+/* Weight of the slope term: (1 - e^{-x}) / x - e^{-x}, i.e. a / x - 1 + a, with its series where
+ * the difference cancels. */
+inline double rte_w1(double x, double a)
+{
+    if (x < 1e-4)
+        return x * (0.5 - x * (1.0 / 3.0 - x * 0.125));
+    return a / x - 1.0 + a;
+}
+
+/* Radiance leaving (px, py) in direction w = (wx, wy, .) (3-D unit vector; the march advances
+ * (-wx, -wy) in the plane per unit length): grid source from plane (if P->diffuse) plus the beam
+ * term with coefficient C (if P->beam). */
+inline double rte_ray(const ppb_rte_params *P, __global const double *plane, double C, double px,
+                      double py, double wx, double wy)
+{
+    double mx = -wx, my = -wy;
+    double lfar = INFINITY;
+    if (my > 0.0)
+        lfar = -py / my;
+    else if (my < 0.0)
+        lfar = (-P->height - py) / my;
+    if (P->tube) {
+        if (mx > 0.0)
+            lfar = fmin(lfar, (0.5 * P->width - px) / mx);
+        else if (mx < 0.0)
+            lfar = fmin(lfar, (-0.5 * P->width - px) / mx);
+    }
+    double sig_min =
+        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
+    lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
+    if (lfar <= 0.0)
+        return 0.0;
+
+    double brk[5];
+    int nb = 0;
+    brk[nb++] = 0.0;
+    if (P->tube) {
+        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
+        double cand[3] = {-1.0, -1.0, -1.0};
+        if ((P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO) && mx != 0.0)
+            cand[0] = (P->step_x - px) / mx;
+        if (P->step_kind != PPB_STEP_NONE && dxp != 0.0)
+            cand[1] = (P->step_x - xp) / dxp;
+        if (P->tan_theta_l > 0.0 && dxp != 0.0)
+            cand[2] = (-0.5 * P->width - xp) / dxp;
+        for (int k = 0; k < 3; k++)
+            if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
+                brk[nb++] = cand[k];
+    }
+    for (int i = 2; i < nb; i++)
+        for (int k = i; k > 1 && brk[k] < brk[k - 1]; k--) {
+            double s = brk[k];
+            brk[k] = brk[k - 1];
+            brk[k - 1] = s;
+        }
+    brk[nb++] = lfar;
+
+    double sperp = sqrt(mx * mx + my * my);
+    double d = 0.0, L = 0.0;
+    for (int k = 0; k + 1 < nb && d < P->d_cap; k++) {
+        double la = brk[k], lb = brk[k + 1], len = lb - la;
+        if (len <= 0.0)
+            continue;
+        double xm = px + 0.5 * (la + lb) * mx, ym = py + 0.5 * (la + lb) * my;
+        double sigma_t =
+            P->tube ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
+                    : P->sigma_t;
+        double alpha = P->tube
+                           ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
+                           : P->albedo;
+        double sum = 0.0;
+        if (P->beam && C != 0.0) {
+            double Dm, Da, Db;
+            int lit, la_lit, lb_lit;
+            ppb_rte_light(P, xm, ym, &Dm, &lit);
+            if (lit) {
+                ppb_rte_light(P, px + la * mx, py + la * my, &Da, &la_lit);
+                ppb_rte_light(P, px + lb * mx, py + lb * my, &Db, &lb_lit);
+                sum += C * sigma_t * len * rte_beam_factor(-(d + Da), -(sigma_t * len + Db - Da));
+            }
+        }
+        if (P->diffuse) {
+            int n = max(1, (int)ceil(len * sperp / P->hstep));
+            double h = len / n, x = sigma_t * h, a = -expm1(-x), w1 = rte_w1(x, a);
+            double att = exp(-x), e = exp(-d);
+            double J1 = ppb_rte_lookup(P, plane, px + la * mx, py + la * my);
+            for (int i = 0; i < n && d + x * i < P->d_cap; i++, e *= att) {
+                double l2 = la + h * (i + 1);
+                double J2 = ppb_rte_lookup(P, plane, px + l2 * mx, py + l2 * my);
+                sum += e * (J1 * a + (J2 - J1) * w1);
+                J1 = J2;
+            }
+        }
+        L += alpha * sum;
+        d += sigma_t * len;
+    }
+    return L;
+}
+
+/* One work-item per (direction cell, node): the cell's radiance at the node. */
+__kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
+                            __global const double *src, __global double *out)
+{
+    int nn = ppb_rte_nnodes(&P);
+    int gid = (int)get_global_id(0);
+    int cell = gid / nn, node = gid % nn;
+    if (cell >= P.ncell)
+        return;
+    int i = node % P.nx, j = node / P.nx;
+    double px = ppb_rte_node_x(&P, i), py = -j * P.hy;
+    __global const double *dc = dirs + 4 * cell;
+    out[gid] = rte_ray(&P, src + (long)cell * nn, dc[3], px, py, dc[0], dc[1]);
+}
+
+/* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
+ * and the bin's direction samples (SPEC.md section 4), as march.cl's ppb_march_kernel. */
+__kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
+                           __global const double *src, __global double *out)
+{
+    (void)dirs;
+    int nbins = ppb_bin_count(P.ntheta, P.nphi);
+    int gid = (int)get_global_id(0);
+    int row = P.row0 + gid / nbins, bin = gid % nbins;
+    int surf = -1;
+    for (int s = 0; s < PPB_NSURF; s++)
+        if (P.nseg[s] > 0 && row >= P.offset[s] && row < P.offset[s] + P.nseg[s])
+            surf = s;
+    if (surf < 0)
+        return;
+    int seg = row - P.offset[surf];
+    int nn = ppb_rte_nnodes(&P);
+    double cx = 0.0, cy = surf == PPB_S1 ? 0.0 : -P.height, seglen = 0.0;
+    int along_x = surf == PPB_S1 || surf == PPB_S2;
+    if (P.tube) {
+        ppb_segment_centre(surf, seg, P.nseg[surf], P.width, P.height, &cx, &cy);
+        seglen = ppb_segment_length(surf, P.nseg[surf], P.width, P.height);
+    }
+    int npts = P.tube ? P.npts : 1;
+    double sum = 0.0;
+    for (int ip = 0; ip < npts; ip++) {
+        double o = ((ip + 0.5) / npts - 0.5) * seglen;
+        double px = cx + (along_x ? o : 0.0), py = cy + (along_x ? 0.0 : o);
+        for (int a = 0; a < P.nsamp; a++)
+            for (int b = 0; b < P.nsamp; b++) {
+                double wx, wy, wz;
+                ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
+                int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
+                double C = ppb_hg_phase(P.g, wx * P.sin_theta_l - wy * P.cos_theta_l);
+                sum += rte_ray(&P, src + (long)dir * nn, C, px, py, wx, wy);
+            }
+    }
+    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
+}

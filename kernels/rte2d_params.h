@@ -1,0 +1,134 @@
+/* rte2d_params.h: the one definition of what the rte2d kernels (rte2d.cl) receive, shared by the
+ * host (src/methods/method_rte2d.c, src/physics/rte2d_grid.c) and the kernels (SPEC.md
+ * section 12).
+ *
+ * Owns: the launch parameters passed by value, the kernel argument indices, the source grid over
+ * the cross-section (node positions, the split of the x nodes at the step, the bilinear lookup of
+ * a source plane) and the exact direct beam at a point (optical depth D along the light path and
+ * whether S1's lit part is seen, SPEC.md section 3), which both the grid's first-scattering
+ * source and the exit march use, so the beam's first scattering is exact (as in `ss`).
+ *
+ * Grid: nodes x_i, y_j = -j hy (j = 0 on S1, ny - 1 on S2). In x the nodes are uniform on
+ * [-W/2, step_x] (nl cells) and on [step_x, W/2] (nr cells), sharing the node at step_x, so the
+ * step is a grid line (the source per unit scattering coefficient, J = sum_j P_ij I_j, is
+ * continuous across it but kinked; sigma_s, which jumps, is applied at the exact position).
+ * Without a step inside the tube nl = nx - 1, nr = 0. Slab mode has one column (nx = 1).
+ *
+ * Plain C that is also OpenCL C, like ppb_conventions.h. */
+#ifndef PPB_RTE2D_PARAMS_H
+#define PPB_RTE2D_PARAMS_H
+
+#include "ppb_conventions.h"
+
+#ifdef __OPENCL_VERSION__
+#define PPB_RTE_GMEM __global
+#else
+#define PPB_RTE_GMEM
+#endif
+
+/* Kernel arguments of both kernels, by index. */
+enum {
+    PPB_RTE_ARG_PARAMS = 0, /* ppb_rte_params by value */
+    PPB_RTE_ARG_DIRS = 1,   /* sweep: [ncell][4] = centre (x, y, z), beam coefficient q_i */
+    PPB_RTE_ARG_SRC = 2,    /* source planes J [nplanes][nnodes] (sweep: per cell; exit: per
+                               exit direction sample) */
+    PPB_RTE_ARG_OUT = 3,    /* sweep: I [ncell][nnodes]; exit: radiance [rows][nbins] */
+    PPB_RTE_NARGS = 4
+};
+
+/* Parameters of one launch. All doubles first, then an even number of ints (host asserts). */
+typedef struct ppb_rte_params {
+    double width, height;
+    double sigma_t, sigma_t_right, albedo, albedo_right, step_x;
+    double g;                                     /* HG asymmetry (the exit march's beam term) */
+    double sin_theta_l, cos_theta_l, tan_theta_l; /* light incidence */
+    double hxl, hxr, hy;                          /* node spacings left/right of the step, in y */
+    double hstep;                                 /* march step length in the x-y plane, mfp */
+    double d_cap;                                 /* optical distance where a march stops */
+    int tube, step_kind;
+    int nx, ny, nl; /* nodes in x (nl cells left of the split) and y */
+    int ncell;      /* sweep: direction cells marched */
+    int beam;       /* 1: add the direct beam's first scattering */
+    int diffuse;    /* 1: add the grid source J */
+    int ntheta, nphi, nsamp, npts;
+    int row0;      /* exit: first segment row of this launch */
+    int pad;       /* unused: keeps the count of ints even */
+    int nseg[4];   /* exit: segments per surface (slab: 1, 1, 0, 0) */
+    int offset[4]; /* exit: first row of each surface */
+} ppb_rte_params;
+
+PPB_FN int ppb_rte_nnodes(const ppb_rte_params *P)
+{
+    return P->nx * P->ny;
+}
+
+/* x of node column i. */
+PPB_FN double ppb_rte_node_x(const ppb_rte_params *P, int i)
+{
+    if (!P->tube)
+        return 0.0;
+    return i <= P->nl ? -0.5 * P->width + i * P->hxl : P->step_x + (i - P->nl) * P->hxr;
+}
+
+/* Fractional node column of x (tube), clamped to the grid. */
+PPB_FN double ppb_rte_fx(const ppb_rte_params *P, double x)
+{
+    double f = (P->nl == P->nx - 1 || x < P->step_x) ? (x + 0.5 * P->width) / P->hxl
+                                                     : P->nl + (x - P->step_x) / P->hxr;
+    return f < 0.0 ? 0.0 : (f > P->nx - 1 ? P->nx - 1 : f);
+}
+
+/* Bilinear value of a source plane (nnodes values, node = j nx + i) at (x, y). */
+PPB_FN double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM double *plane, double x,
+                             double y)
+{
+    double fy = -y / P->hy;
+    fy = fy < 0.0 ? 0.0 : (fy > P->ny - 1 ? P->ny - 1 : fy);
+    int j = (int)fy;
+    if (j > P->ny - 2)
+        j = P->ny - 2;
+    double ty = fy - j;
+    if (P->nx == 1)
+        return plane[j] + ty * (plane[j + 1] - plane[j]);
+    double fx = ppb_rte_fx(P, x);
+    int i = (int)fx;
+    if (i > P->nx - 2)
+        i = P->nx - 2;
+    double tx = fx - i;
+    const PPB_RTE_GMEM double *c = plane + (long)j * P->nx + i;
+    double top = c[0] + tx * (c[1] - c[0]);
+    double bot = c[P->nx] + tx * (c[P->nx + 1] - c[P->nx]);
+    return top + ty * (bot - top);
+}
+
+/* The exact direct beam at (x, y), y <= 0 (SPEC.md section 3): the ray toward the light meets
+ * S1's plane at x' = x + y tan(theta_L); the point is lit when x' lies on S1 (>= -W/2) and, with
+ * a shadow step, left of step_x. D = optical depth of that path through the piecewise-constant
+ * medium, continued where unlit (the caller multiplies by lit). Slab: sigma_t |y| / cos. */
+PPB_FN void ppb_rte_light(const ppb_rte_params *P, double x, double y, double *D, int *lit)
+{
+    double t = -y < 0.0 ? 0.0 : -y, len = t / P->cos_theta_l;
+    if (!P->tube) {
+        *D = P->sigma_t * len;
+        *lit = 1;
+        return;
+    }
+    double xp = x - t * P->tan_theta_l;
+    *lit = xp >= -0.5 * P->width - 1e-12 * P->width &&
+           (P->step_kind != PPB_STEP_SHADOW || xp < P->step_x);
+    if (P->step_kind != PPB_STEP_DENSITY) {
+        *D = P->sigma_t * len;
+        return;
+    }
+    /* The path's horizontal span is [xp, x]; the part left of the step has sigma_t. */
+    double fl;
+    if (x - xp <= 0.0)
+        fl = x < P->step_x ? 1.0 : 0.0;
+    else {
+        double s = P->step_x < xp ? xp : (P->step_x > x ? x : P->step_x);
+        fl = (s - xp) / (x - xp);
+    }
+    *D = len * (P->sigma_t * fl + P->sigma_t_right * (1.0 - fl));
+}
+
+#endif

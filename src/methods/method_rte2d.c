@@ -1,0 +1,317 @@
+/* method_rte2d.c: `rte2d` (method_rte2d.h): OpenCL marches, host scattering and GMRES. */
+#include "methods/method_rte2d.h"
+
+#include <cblas.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/clock.h"
+#include "base/memory.h"
+#include "base/progress.h"
+#include "kernels/march_params.h"
+#include "methods/march.h"
+#include "methods/result_check.h"
+#include "physics/gmres.h"
+#include "physics/rte2d_grid.h"
+
+_Static_assert(sizeof(ppb_rte_params) == 16 * sizeof(double) + 22 * sizeof(int),
+               "ppb_rte_params: doubles first, an even number of ints, no padding");
+
+/* Krylov vectors per GMRES cycle. */
+#define RTE_RESTART 30
+
+typedef struct rte_solver {
+    ppb_ocl *ocl;
+    ppb_rte_grid G;
+    cl_program prog;
+    cl_kernel sweep, exitk;
+    cl_mem dirs, src, out;
+    size_t nvec; /* nc x nnodes */
+    double *J;   /* [nc][nnodes] scratch */
+    int sweeps;
+    double t_sweeps;
+} rte_solver;
+
+static void solver_free(rte_solver *s)
+{
+    cl_mem bufs[] = {s->dirs, s->src, s->out};
+    for (size_t i = 0; i < 3; i++)
+        if (bufs[i])
+            clReleaseMemObject(bufs[i]);
+    if (s->sweep)
+        clReleaseKernel(s->sweep);
+    if (s->exitk)
+        clReleaseKernel(s->exitk);
+    if (s->prog)
+        clReleaseProgram(s->prog);
+    free(s->J);
+    ppb_rte_grid_free(&s->G);
+    memset(s, 0, sizeof *s);
+}
+
+static cl_mem buffer(ppb_ocl *ocl, cl_mem_flags flags, size_t n, const double *host,
+                     const char *what, ppb_err *err)
+{
+    cl_int rc;
+    cl_mem m = clCreateBuffer(ocl->context, flags | (host ? CL_MEM_COPY_HOST_PTR : 0),
+                              (n ? n : 1) * sizeof(double), (void *)host, &rc);
+    if (rc != CL_SUCCESS) {
+        ppb_fail(err, "OpenCL: clCreateBuffer(%s, %zu doubles) failed: %s", what, n,
+                 ppb_cl_errname(rc));
+        return NULL;
+    }
+    return m;
+}
+
+static int set_args(cl_kernel k, const ppb_rte_params *P, cl_mem dirs, cl_mem src, cl_mem out,
+                    ppb_err *err)
+{
+    if (ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_PARAMS, sizeof *P, P), "clSetKernelArg(rte2d)",
+                     err) ||
+        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_DIRS, sizeof(cl_mem), &dirs),
+                     "clSetKernelArg(rte2d)", err) ||
+        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_SRC, sizeof(cl_mem), &src),
+                     "clSetKernelArg(rte2d)", err) ||
+        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_OUT, sizeof(cl_mem), &out),
+                     "clSetKernelArg(rte2d)", err))
+        return -1;
+    return 0;
+}
+
+/* out = T (sigma_s J + beam): one march from every node in every transported cell. J NULL: the
+ * beam's first scattering alone; beam 0: the grid source alone. */
+static int sweep(rte_solver *s, const double *J, int beam, double *out, ppb_err *err)
+{
+    if (ppb_interrupted())
+        return ppb_fail(err, "rte2d: interrupted");
+    double t0 = ppb_now();
+    ppb_rte_params P = s->G.P;
+    P.beam = beam;
+    P.diffuse = J != NULL;
+    cl_command_queue q = s->ocl->queue;
+    size_t bytes = s->nvec * sizeof(double), global = s->nvec;
+    if (J && ppb_cl_check(clEnqueueWriteBuffer(q, s->src, CL_TRUE, 0, bytes, J, 0, NULL, NULL),
+                          "clEnqueueWriteBuffer(rte2d source)", err))
+        return -1;
+    if (set_args(s->sweep, &P, s->dirs, s->src, s->out, err) ||
+        ppb_cl_check(clEnqueueNDRangeKernel(q, s->sweep, 1, NULL, &global, NULL, 0, NULL, NULL),
+                     "clEnqueueNDRangeKernel(rte2d sweep)", err) ||
+        ppb_cl_check(clEnqueueReadBuffer(q, s->out, CL_TRUE, 0, bytes, out, 0, NULL, NULL),
+                     "clEnqueueReadBuffer(rte2d sweep)", err))
+        return -1;
+    s->sweeps++;
+    s->t_sweeps += ppb_now() - t0;
+    return 0;
+}
+
+/* y = (I - T S) x, the operator GMRES inverts. */
+static int matvec(void *ctx, const double *x, double *y, ppb_err *err)
+{
+    rte_solver *s = ctx;
+    ppb_rte_scatter(&s->G, x, s->J);
+    if (sweep(s, s->J, 0, y, err))
+        return -1;
+    for (size_t i = 0; i < s->nvec; i++)
+        y[i] = x[i] - y[i];
+    return 0;
+}
+
+static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_t src_planes,
+                       size_t out_cells, ppb_err *err)
+{
+    memset(s, 0, sizeof *s);
+    s->ocl = ocl;
+    const ppb_rte2d_settings *r = &cfg->rte2d;
+    if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, &s->G, err))
+        return -1;
+    s->nvec = (size_t)s->G.nc * s->G.nnodes;
+    size_t planes = src_planes > (size_t)s->G.nc ? src_planes : (size_t)s->G.nc;
+    size_t outn = out_cells > s->nvec ? out_cells : s->nvec;
+    s->J = malloc(sizeof(double) * s->nvec);
+    if (!s->J)
+        return ppb_fail(err, "rte2d: out of memory");
+    if (ppb_ocl_build(ocl, "rte2d.cl", "", &s->prog, err) ||
+        ppb_ocl_kernel(s->prog, "ppb_rte_sweep", &s->sweep, err) ||
+        ppb_ocl_kernel(s->prog, "ppb_rte_exit", &s->exitk, err))
+        return -1;
+    s->dirs = buffer(ocl, CL_MEM_READ_ONLY, 4 * (size_t)s->G.nc, s->G.dir4, "rte2d cells", err);
+    if (s->dirs)
+        s->src = buffer(ocl, CL_MEM_READ_ONLY, planes * s->G.nnodes, NULL, "rte2d source", err);
+    if (s->src)
+        s->out = buffer(ocl, CL_MEM_WRITE_ONLY, outn, NULL, "rte2d output", err);
+    return s->out ? 0 : -1;
+}
+
+/* The exit march: the grid source for every exit direction sample, then every (row, bin). */
+static int exit_march(rte_solver *s, const ppb_config *cfg, const double *rad, ppb_result *out,
+                      ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    const ppb_layout *lo = &out->layout;
+    int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
+    int nsurf = lo->nsurf, nbins = lo->nbins;
+    int ndir = ppb_march_ndir(nsurf, nbins, nsamp), nn = s->G.nnodes, nc = s->G.nc;
+    double *w = malloc(sizeof(double) * 3 * ndir), *F = malloc(sizeof(double) * ndir * nc);
+    double *Jx = malloc(sizeof(double) * (size_t)ndir * nn);
+    int rc = (w && F && Jx) ? 0 : ppb_fail(err, "rte2d: out of memory (exit source)");
+    for (int surf = 0; !rc && surf < nsurf; surf++)
+        for (int bin = 0; bin < nbins; bin++)
+            for (int a = 0; a < nsamp; a++)
+                for (int b = 0; b < nsamp; b++) {
+                    int d = ppb_march_dir_index(surf, bin, a, b, nsamp, nbins);
+                    ppb_march_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[3 * d],
+                                  &w[3 * d + 1], &w[3 * d + 2]);
+                }
+    if (!rc)
+        rc = ppb_rte_exit_coeffs(&s->G, sc->g, w, ndir, F, err);
+    if (!rc) {
+        cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, ndir, nn, nc, 1.0, F, nc, rad, nn,
+                    0.0, Jx, nn);
+        rc = ppb_cl_check(clEnqueueWriteBuffer(s->ocl->queue, s->src, CL_TRUE, 0,
+                                               sizeof(double) * (size_t)ndir * nn, Jx, 0, NULL,
+                                               NULL),
+                          "clEnqueueWriteBuffer(rte2d exit source)", err);
+    }
+    free(w);
+    free(F);
+    free(Jx);
+    ppb_rte_params P = s->G.P;
+    P.beam = P.diffuse = 1;
+    P.ntheta = sc->ntheta;
+    P.nphi = sc->nphi;
+    P.nsamp = nsamp;
+    P.npts = cfg->samples_seg < 1 ? 1 : cfg->samples_seg;
+    for (int k = 0; k < PPB_NSURF; k++) {
+        P.nseg[k] = lo->nseg[k];
+        P.offset[k] = lo->offset[k];
+    }
+    int rows = (int)(lo->ncells / (size_t)nbins);
+    const int chunk = 16;
+    for (int row0 = 0; !rc && row0 < rows; row0 += chunk) {
+        if (ppb_interrupted()) {
+            rc = ppb_fail(err, "rte2d: interrupted");
+            break;
+        }
+        P.row0 = row0;
+        size_t global = (size_t)(rows - row0 < chunk ? rows - row0 : chunk) * nbins;
+        rc = set_args(s->exitk, &P, s->dirs, s->src, s->out, err) ||
+             ppb_cl_check(clEnqueueNDRangeKernel(s->ocl->queue, s->exitk, 1, NULL, &global, NULL, 0,
+                                                 NULL, NULL),
+                          "clEnqueueNDRangeKernel(rte2d exit)", err) ||
+             ppb_cl_check(clFinish(s->ocl->queue), "clFinish(rte2d exit)", err);
+    }
+    if (!rc)
+        rc = ppb_cl_check(clEnqueueReadBuffer(s->ocl->queue, s->out, CL_TRUE, 0,
+                                              lo->ncells * sizeof(double), out->radiance, 0, NULL,
+                                              NULL),
+                          "clEnqueueReadBuffer(rte2d radiance)", err);
+    return rc;
+}
+
+static int rte_memory_check(const ppb_config *cfg, const ppb_layout *lo, ppb_err *err)
+{
+    const ppb_rte2d_settings *r = &cfg->rte2d;
+    int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
+    double solve = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, RTE_RESTART);
+    double nodes = solve / (8.0 * (r->directions + 10.0) * (RTE_RESTART + 8)); /* about */
+    double exitb = 8.0 * ppb_march_ndir(lo->nsurf, lo->nbins, nsamp) * nodes * 2.0;
+    char detail[160];
+    snprintf(detail, sizeof detail, "solve %.3g GB, exit source %.3g GB x 2", solve / 1e9,
+             exitb / 2e9);
+    return ppb_memory_check(solve + exitb, cfg->memory_limit, "rte2d", detail, err);
+}
+
+int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err)
+{
+    double t0 = ppb_now();
+    const ppb_config *cfg = ctx->cfg;
+    const ppb_scene *sc = &cfg->scene;
+    const ppb_layout *lo = &out->layout;
+    ppb_rte2d_stats st;
+    memset(&st, 0, sizeof st);
+    ppb_ocl *ocl;
+    if (rte_memory_check(cfg, lo, err) || ppb_ctx_ocl(ctx, &ocl, err))
+        return -1;
+    int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
+    size_t planes = (size_t)ppb_march_ndir(lo->nsurf, lo->nbins, nsamp);
+    rte_solver s;
+    if (solver_init(&s, ocl, cfg, planes, lo->ncells, err)) {
+        solver_free(&s);
+        return -1;
+    }
+    double *rad = malloc(sizeof(double) * s.nvec), *b = malloc(sizeof(double) * s.nvec);
+    double *phi = malloc(sizeof(double) * s.G.nnodes);
+    int rc = (rad && b && phi) ? 0 : ppb_fail(err, "rte2d: out of memory");
+    /* I_1: the exact first scattering marched to every node; I_pp: the start. */
+    if (!rc)
+        rc = sweep(&s, NULL, 1, b, err);
+    if (!rc)
+        rc = ppb_rte_initial_pp(&s.G, sc, rad, err);
+    int K = cfg->rte2d.refinements;
+    if (!rc && K == 0) {
+        ppb_gmres_opts o = {RTE_RESTART, 2000, cfg->rte2d.tol};
+        ppb_gmres_info info;
+        rc = ppb_gmres(s.nvec, matvec, &s, b, rad, &o, &info, err);
+        st.resid = info.resid;
+        st.converged = info.converged;
+        if (!rc && !info.converged)
+            fprintf(stderr, "%s: rte2d: not converged after %d sweeps (residual %.3g)\n", cfg->name,
+                    info.iters, info.resid);
+    }
+    /* K > 0: K - 1 plain refinements I <- T S I + I_1; the exit march is the K-th. */
+    for (int k = 1; !rc && k < K; k++) {
+        ppb_rte_scatter(&s.G, rad, s.J);
+        rc = sweep(&s, s.J, 0, rad, err);
+        for (size_t i = 0; !rc && i < s.nvec; i++)
+            rad[i] += b[i];
+    }
+    double te = ppb_now();
+    if (!rc)
+        rc = exit_march(&s, cfg, rad, out, err);
+    st.t_exit = ppb_now() - te;
+    if (!rc) {
+        ppb_rte_fluence(&s.G, rad, phi);
+        double in = ppb_scene_power_in(sc);
+        st.absorbed_beam = ppb_rte_absorbed_beam(sc) / in;
+        st.absorbed_scattered = ppb_rte_absorbed_scattered(&s.G, phi) / in;
+    }
+    if (!rc)
+        rc = ppb_radiance_check(cfg->name, out, NULL, err);
+    if (!rc) {
+        memset(out->se, 0, lo->ncells * sizeof *out->se);
+        ppb_march_totals(sc, lo, out->radiance, &out->totals);
+        /* R, T, sides from the cell field at the boundaries (rte2d_grid.h), as ppslab. */
+        double in = ppb_scene_power_in(sc), fl[4];
+        ppb_rte_boundary_flux(&s.G, rad, fl);
+        out->totals.R = fl[PPB_S1] / in;
+        out->totals.T = fl[PPB_S2] / in;
+        out->totals.sides = (fl[PPB_S3] + fl[PPB_S4]) / in;
+        out->totals.absorbed = st.absorbed_beam + st.absorbed_scattered;
+        out->totals.absorbed_tracked = 1;
+        rc = ppb_totals_check(cfg->name, out, err);
+    }
+    st.nodes = s.G.nnodes;
+    st.cells = s.G.nc;
+    st.sweeps = s.sweeps;
+    st.t_sweeps = s.t_sweeps;
+    st.t_total = ppb_now() - t0;
+    if (!rc && !ctx->quiet)
+        fprintf(stderr,
+                "%s: rte2d: %d nodes x %d cells, %d sweeps (%.2f s each), residual %.2g, "
+                "%.1f s\n",
+                cfg->name, st.nodes, st.cells, st.sweeps, st.sweeps ? st.t_sweeps / st.sweeps : 0.0,
+                st.resid, st.t_total);
+    free(rad);
+    free(b);
+    free(phi);
+    solver_free(&s);
+    if (stats)
+        *stats = st;
+    return rc;
+}
+
+int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
+{
+    return ppb_rte2d_run(ctx, out, NULL, err);
+}

@@ -1,0 +1,37 @@
+/* method_rte2d.h: `rte2d`, the tube's radiative transfer solved by iterating the paper's
+ * refinement (SPEC.md section 12; paper Sec. 3.1, Eq. 5) on a grid over the cross-section.
+ *
+ * Pipeline: the grid and direction cells (physics/rte2d_grid.h); I_1, the once-scattered
+ * radiance of every cell at every node, by one march of the exact direct beam's first
+ * scattering; the scattered field I from (I - T S) I = I_1 (T the march of kernels/rte2d.cl, S
+ * the folded phase matrix) by GMRES (physics/gmres.h) from I_pp, or K - 1 plain refinements
+ * I <- T S I + I_1 from I_pp when `[rte2d] refinements = K` > 0; then the exit march: from
+ * every segment point along every direction sample of every bin, the grid source for that
+ * exact direction (the cell integrals F_j(w) of phase.h) plus the exact first scattering, as
+ * `pp` averages its bins. So K = 1 is the paper's method (one march from I_pp) on the grid.
+ * Totals: R, T, sides from the bins (march.h), ballistic exact, and absorbed tracked: the beam's
+ * exact and sigma_a times the converged scattered fluence. */
+#ifndef PPB_METHOD_RTE2D_H
+#define PPB_METHOD_RTE2D_H
+
+#include "methods/method.h"
+
+/* What a solve took (for `make perf` and tests). */
+typedef struct ppb_rte2d_stats {
+    int nodes, cells;     /* grid nodes, direction cells transported */
+    int sweeps;           /* marches over the grid (I_1 included) */
+    double resid;         /* final relative residual of (I - T S) I = I_1 (0 when K > 0) */
+    int converged;        /* K = 0: the tolerance was reached */
+    double t_total;       /* seconds, the whole method */
+    double t_sweeps;      /* seconds in the grid marches */
+    double t_exit;        /* seconds in the exit march and its source */
+    double absorbed_beam; /* fractions of the power entering (totals.absorbed = their sum) */
+    double absorbed_scattered;
+} ppb_rte2d_stats;
+
+int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+/* The same, reporting what it took (stats may be NULL). */
+int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
+
+#endif

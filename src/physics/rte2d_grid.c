@@ -1,0 +1,362 @@
+/* rte2d_grid.c: grid, folded cells, scattering, I_pp and absorption of `rte2d` (rte2d_grid.h). */
+#include "physics/rte2d_grid.h"
+
+#include <cblas.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/quadrature.h"
+#include "physics/phase.h"
+#include "physics/ppsolver.h"
+
+/* x-node layout: a split at step_x when a step lies strictly inside the tube. */
+static void grid_x(const ppb_scene *sc, double spacing, int *nl, int *nr, double *hxl, double *hxr)
+{
+    double a = -0.5 * sc->width, b = 0.5 * sc->width;
+    int split = sc->step != PPB_STEP_NONE && sc->step_x > a + 1e-9 * sc->width &&
+                sc->step_x < b - 1e-9 * sc->width;
+    if (split) {
+        *nl = (int)ceil((sc->step_x - a) / spacing - 1e-9);
+        *nr = (int)ceil((b - sc->step_x) / spacing - 1e-9);
+        *nl = *nl < 1 ? 1 : *nl;
+        *nr = *nr < 1 ? 1 : *nr;
+        *hxl = (sc->step_x - a) / *nl;
+        *hxr = (b - sc->step_x) / *nr;
+    } else {
+        *nl = (int)ceil(sc->width / spacing - 1e-9);
+        *nl = *nl < 1 ? 1 : *nl;
+        *nr = 0;
+        *hxl = *hxr = sc->width / *nl;
+    }
+}
+
+static int grid_ny(const ppb_scene *sc, double spacing)
+{
+    int n = (int)ceil(sc->height / spacing - 1e-9);
+    return (n < 1 ? 1 : n) + 1;
+}
+
+double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart)
+{
+    int nl = 0, nr = 0, nx = 1;
+    double hl, hr;
+    if (sc->geometry == PPB_GEOM_TUBE) {
+        grid_x(sc, spacing, &nl, &nr, &hl, &hr);
+        nx = nl + nr + 1;
+    }
+    double nodes = (double)nx * grid_ny(sc, spacing), nc = directions + sqrt(directions) + 2;
+    /* Krylov vectors, the solve's work arrays (x, b, J, out x 2 for host and device) and the
+     * phase matrix. */
+    return 8.0 * (nodes * nc * (restart + 8) + 4.0 * directions * directions);
+}
+
+int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep,
+                      ppb_rte_grid *G, ppb_err *err)
+{
+    memset(G, 0, sizeof *G);
+    if (!(spacing > 0.0) || !(hstep > 0.0) || directions < 1)
+        return ppb_fail(err, "rte2d: spacing, step and directions must be positive");
+    int tube = sc->geometry == PPB_GEOM_TUBE;
+    ppb_rte_params *P = &G->P;
+    double th = sc->theta_deg * PPB_PI / 180.0;
+    P->width = sc->width;
+    P->height = sc->height;
+    P->sigma_t = sc->sigma_t;
+    P->sigma_t_right = sc->sigma_t_right;
+    P->albedo = sc->albedo;
+    P->albedo_right = sc->albedo_right;
+    P->step_x = sc->step_x;
+    P->g = sc->g;
+    P->sin_theta_l = ppb_scene_sin_theta_l(sc);
+    P->cos_theta_l = ppb_scene_cos_theta_l(sc);
+    P->tan_theta_l = ppb_scene_tan_theta_l(sc);
+    (void)th;
+    P->hstep = hstep;
+    P->d_cap = 40.0;
+    P->tube = tube;
+    P->step_kind = tube ? sc->step : PPB_STEP_NONE;
+    int nr = 0;
+    P->nl = 0;
+    P->nx = 1;
+    P->hxl = P->hxr = 1.0;
+    if (tube) {
+        grid_x(sc, spacing, &P->nl, &nr, &P->hxl, &P->hxr);
+        P->nx = P->nl + nr + 1;
+    }
+    P->ny = grid_ny(sc, spacing);
+    P->hy = sc->height / (P->ny - 1);
+    G->nnodes = P->nx * P->ny;
+
+    int rc = sc->g < 0 ? pp_dirs_make_antipodal(directions, &G->dirs, err)
+                       : pp_dirs_make(directions, &G->dirs, err);
+    if (rc)
+        return -1;
+    int m = 2 * G->dirs.n;
+    G->slot = malloc(sizeof(int) * m);
+    G->rep = malloc(sizeof(int) * m);
+    G->mult = calloc((size_t)m, sizeof(double));
+    G->wnode = malloc(sizeof(double) * G->nnodes);
+    double *Pfull = malloc(sizeof(double) * m * m), *F = malloc(sizeof(double) * m);
+    if (!G->slot || !G->rep || !G->mult || !G->wnode || !Pfull || !F) {
+        free(Pfull);
+        free(F);
+        ppb_rte_grid_free(G);
+        return ppb_fail(err, "rte2d: out of memory (phase matrix, %d cells)", m);
+    }
+    /* One transported cell per z-mirror pair: the pair's lower index. */
+    G->nc = 0;
+    for (int i = 0; i < m; i++) {
+        int z = pp_dirs_zmirror(&G->dirs, i);
+        if (z >= i) {
+            G->rep[G->nc] = i;
+            G->mult[G->nc] = z == i ? 1.0 : 2.0;
+            G->slot[i] = G->slot[z] = G->nc++;
+        }
+    }
+    P->ncell = G->nc;
+    G->dir4 = malloc(sizeof(double) * 4 * G->nc);
+    G->Pf = calloc((size_t)G->nc * G->nc, sizeof(double));
+    double wl[3] = {P->sin_theta_l, -P->cos_theta_l, 0.0};
+    rc = (G->dir4 && G->Pf) ? 0 : ppb_fail(err, "rte2d: out of memory");
+    if (!rc)
+        rc = pp_phase_matrix(&G->dirs, sc->g, Pfull, err);
+    if (!rc)
+        rc = pp_phase_row(&G->dirs, sc->g, wl, F, err);
+    if (!rc) {
+        for (int a = 0; a < G->nc; a++) {
+            int i = G->rep[a];
+            memcpy(G->dir4 + 4 * a, G->dirs.centre + 3 * i, 3 * sizeof(double));
+            /* Cell average of p(w.w_L): the integral over the cell of p(w'.w_L) by symmetry. */
+            G->dir4[4 * a + 3] = F[i] / G->dirs.solid;
+            for (int j = 0; j < m; j++)
+                G->Pf[(size_t)a * G->nc + G->slot[j]] += Pfull[(size_t)i * m + j];
+        }
+        /* Trapezoid weights of the bilinear interpolant. */
+        for (int j = 0; j < P->ny; j++) {
+            double wy = P->hy * ((j == 0 || j == P->ny - 1) ? 0.5 : 1.0);
+            for (int i = 0; i < P->nx; i++) {
+                double wx = 1.0;
+                if (tube) {
+                    double left = i > 0 ? (i <= P->nl ? P->hxl : P->hxr) : 0.0;
+                    double right = i < P->nx - 1 ? (i < P->nl ? P->hxl : P->hxr) : 0.0;
+                    wx = 0.5 * (left + right);
+                }
+                G->wnode[j * P->nx + i] = wx * wy;
+            }
+        }
+    }
+    free(Pfull);
+    free(F);
+    if (rc)
+        ppb_rte_grid_free(G);
+    return rc;
+}
+
+void ppb_rte_grid_free(ppb_rte_grid *G)
+{
+    pp_dirs_free(&G->dirs);
+    free(G->rep);
+    free(G->slot);
+    free(G->mult);
+    free(G->dir4);
+    free(G->Pf);
+    free(G->wnode);
+    memset(G, 0, sizeof *G);
+}
+
+void ppb_rte_scatter(const ppb_rte_grid *G, const double *rad, double *J)
+{
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, G->nc, G->nnodes, G->nc, 1.0, G->Pf,
+                G->nc, rad, G->nnodes, 0.0, J, G->nnodes);
+}
+
+int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, double *F,
+                        ppb_err *err)
+{
+    int m = 2 * G->dirs.n;
+    double *row = malloc(sizeof(double) * m);
+    if (!row)
+        return ppb_fail(err, "rte2d: out of memory");
+    memset(F, 0, sizeof(double) * (size_t)ndir * G->nc);
+    for (int d = 0; d < ndir; d++) {
+        if (pp_phase_row(&G->dirs, g, w + 3 * d, row, err)) {
+            free(row);
+            return -1;
+        }
+        for (int j = 0; j < m; j++)
+            F[(size_t)d * G->nc + G->slot[j]] += row[j];
+    }
+    free(row);
+    return 0;
+}
+
+int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, ppb_err *err)
+{
+    const ppb_rte_params *P = &G->P;
+    int m = 2 * G->dirs.n,
+        two = P->tube && (P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO);
+    pp_solution *s[2] = {NULL, NULL};
+    double tau0[2];
+    for (int c = 0; c < 1 + two; c++) {
+        double st =
+            c ? (P->step_kind == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t) : sc->sigma_t;
+        double al =
+            c ? (P->step_kind == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo) : sc->albedo;
+        tau0[c] = st * sc->height;
+        pp_params pp = {tau0[c], al, sc->g, P->cos_theta_l, G->dirs.n};
+        if (pp_solve_ex(&pp, c ? s[0] : NULL, &s[c], NULL, err)) {
+            pp_free(s[0]);
+            return -1;
+        }
+    }
+    double *field = malloc(sizeof(double) * m);
+    if (!field) {
+        pp_free(s[0]);
+        pp_free(s[1]);
+        return ppb_fail(err, "rte2d: out of memory");
+    }
+    for (int j = 0; j < P->ny; j++)
+        for (int i = 0; i < P->nx; i++) {
+            int node = j * P->nx + i, lit;
+            double x = ppb_rte_node_x(P, i), y = -j * P->hy, D;
+            ppb_rte_light(P, x, y, &D, &lit);
+            int c = two && x >= P->step_x;
+            if (lit) {
+                double tau = D * P->cos_theta_l;
+                pp_cell_field(s[c], tau < 0.0 ? 0.0 : (tau > tau0[c] ? tau0[c] : tau), field);
+            }
+            for (int a = 0; a < G->nc; a++)
+                rad[(size_t)a * G->nnodes + node] = lit ? field[G->rep[a]] : 0.0;
+        }
+    free(field);
+    pp_free(s[0]);
+    pp_free(s[1]);
+    return 0;
+}
+
+void ppb_rte_fluence(const ppb_rte_grid *G, const double *rad, double *phi)
+{
+    for (int n = 0; n < G->nnodes; n++)
+        phi[n] = 0.0;
+    for (int a = 0; a < G->nc; a++) {
+        const double *row = rad + (size_t)a * G->nnodes;
+        double w = G->mult[a] * G->dirs.solid;
+        for (int n = 0; n < G->nnodes; n++)
+            phi[n] += w * row[n];
+    }
+}
+
+void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *rad, double flux[4])
+{
+    const ppb_rte_params *P = &G->P;
+    int nn = G->nnodes;
+    for (int k = 0; k < 4; k++)
+        flux[k] = 0.0;
+    for (int a = 0; a < G->nc; a++) {
+        const double *row = rad + (size_t)a * nn;
+        double w = G->mult[a] * G->dirs.solid, ky = G->dirs.k[G->rep[a]], kx = G->dir4[4 * a];
+        for (int i = 0; i < P->nx; i++) {
+            double wx = P->nx == 1 ? 1.0 : G->wnode[i] / (0.5 * P->hy);
+            if (ky > 0.0)
+                flux[PPB_S1] += w * ky * wx * row[i];
+            else
+                flux[PPB_S2] -= w * ky * wx * row[(P->ny - 1) * P->nx + i];
+        }
+        if (P->nx == 1)
+            continue;
+        for (int j = 0; j < P->ny; j++) {
+            double wy = P->hy * ((j == 0 || j == P->ny - 1) ? 0.5 : 1.0);
+            if (kx < 0.0)
+                flux[PPB_S3] -= w * kx * wy * row[j * P->nx];
+            else if (kx > 0.0)
+                flux[PPB_S4] += w * kx * wy * row[j * P->nx + P->nx - 1];
+        }
+    }
+}
+
+double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *phi)
+{
+    const ppb_rte_params *P = &G->P;
+    double sum = 0.0;
+    if (P->nx == 1) {
+        for (int j = 0; j + 1 < P->ny; j++)
+            sum += P->hy * 0.5 * (phi[j] + phi[j + 1]);
+        return (1.0 - P->albedo) * P->sigma_t * sum;
+    }
+    for (int j = 0; j + 1 < P->ny; j++)
+        for (int i = 0; i + 1 < P->nx; i++) {
+            double xm = 0.5 * (ppb_rte_node_x(P, i) + ppb_rte_node_x(P, i + 1));
+            double st = ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right);
+            double al = ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right);
+            double area = (i < P->nl ? P->hxl : P->hxr) * P->hy;
+            const double *c = phi + j * P->nx + i;
+            sum += (1.0 - al) * st * area * 0.25 * (c[0] + c[1] + c[P->nx] + c[P->nx + 1]);
+        }
+    return sum;
+}
+
+/* Absorbed power of the beam entering at x_e, per unit power entering there. */
+static double beam_path_absorbed(const ppb_scene *sc, double xe)
+{
+    double c = ppb_scene_cos_theta_l(sc), s = ppb_scene_sin_theta_l(sc);
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return (1.0 - sc->albedo) * (1.0 - exp(-sc->sigma_t * sc->height / c));
+    double lend = sc->height / c;
+    if (s > 0.0)
+        lend = fmin(lend, (0.5 * sc->width - xe) / s);
+    double ls = lend;
+    if (s > 0.0 && xe < sc->step_x && (sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO))
+        ls = fmin(lend, (sc->step_x - xe) / s);
+    double tau = 0.0, sum = 0.0, seg[2][2] = {{0.0, ls}, {ls, lend}};
+    for (int k = 0; k < 2; k++) {
+        double len = seg[k][1] - seg[k][0];
+        if (len <= 0.0)
+            continue;
+        double xm = xe + 0.5 * (seg[k][0] + seg[k][1]) * s;
+        double st = ppb_sigma_t_at(xm, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
+        double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+        sum += (1.0 - al) * exp(-tau) * -expm1(-st * len);
+        tau += st * len;
+    }
+    return sum;
+}
+
+double ppb_rte_absorbed_beam(const ppb_scene *sc)
+{
+    double c = ppb_scene_cos_theta_l(sc);
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return c * beam_path_absorbed(sc, 0.0);
+    double a = -0.5 * sc->width, b = 0.5 * sc->width;
+    if (sc->step == PPB_STEP_SHADOW)
+        b = fmin(b, sc->step_x);
+    if (b <= a)
+        return 0.0;
+    /* Breaks where the path's end switches from S2 to S4 or it meets the step (as
+     * ppb_ballistic_fraction), Gauss-Legendre panels between them. */
+    double t = ppb_scene_tan_theta_l(sc), brk[5] = {a, b, 0, 0, 0};
+    int nb = 2;
+    double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
+    for (int k = 0; k < 3; k++)
+        if (cand[k] > a && cand[k] < b)
+            brk[nb++] = cand[k];
+    for (int i = 1; i < nb; i++) /* insertion sort of at most five breaks */
+        for (int k = i; k > 0 && brk[k] < brk[k - 1]; k--) {
+            double v = brk[k];
+            brk[k] = brk[k - 1];
+            brk[k - 1] = v;
+        }
+    double gx[5], gw[5];
+    ppb_gauss_legendre(5, gx, gw);
+    const int panels = 64;
+    double sum = 0.0;
+    for (int p = 0; p + 1 < nb; p++) {
+        double h = (brk[p + 1] - brk[p]) / panels;
+        for (int k = 0; h > 0.0 && k < panels; k++) {
+            double mid = brk[p] + (k + 0.5) * h;
+            for (int q = 4; q >= 0; q--)
+                sum += 0.5 * h * gw[q] * beam_path_absorbed(sc, mid + 0.5 * h * gx[q]);
+        }
+    }
+    return c * sum;
+}

