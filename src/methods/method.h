@@ -50,6 +50,9 @@ typedef struct ppb_method {
                          2: an exact answer methods are also checked against (ppslab) */
     const char *summary;
     ppb_method_fn run;
+    /* Refuses, before any work, a config where the method's model has no meaning (mp at albedo
+     * 1); NULL: every valid config is fine. */
+    int (*check)(const ppb_config *cfg, ppb_err *err);
 } ppb_method;
 
 #endif

@@ -11,16 +11,28 @@
 
 /* The registry: the order here is the order of outputs. */
 static const ppb_method methods[] = {
-    {"mc", "mc1", 0, 1, "photon Monte Carlo reference (mc1: its once-scattered part)",
-     ppb_method_mc},
-    {"pp", NULL, 0, 0, "plane-parallel ray marching, the paper's method", ppb_method_pp},
-    {"ss", NULL, 0, 0, "single scattering by ray marching", ppb_method_ss},
-    {"mp", NULL, 0, 0, "multipole diffusion", ppb_method_mp},
-    {"mp+ss", NULL, 0, 0, "multipole diffusion plus single scattering", ppb_method_mp_ss},
-    {"ppslab", NULL, 1, 2, "plane-parallel solution at the slab faces (slab mode only)",
-     ppb_method_ppslab},
-    {"rte2d", NULL, 0, 0, "the tube's transfer solved: the paper's refinement iterated",
-     ppb_method_rte2d},
+    {.id = "mc",
+     .also = "mc1",
+     .reference = 1,
+     .summary = "photon Monte Carlo reference (mc1: its once-scattered part)",
+     .run = ppb_method_mc},
+    {.id = "pp",
+     .summary = "plane-parallel ray marching, the paper's method",
+     .run = ppb_method_pp},
+    {.id = "ss", .summary = "single scattering by ray marching", .run = ppb_method_ss},
+    {.id = "mp", .summary = "multipole diffusion", .run = ppb_method_mp, .check = ppb_mp_check},
+    {.id = "mp+ss",
+     .summary = "multipole diffusion plus single scattering",
+     .run = ppb_method_mp_ss,
+     .check = ppb_mp_check},
+    {.id = "ppslab",
+     .slab_only = 1,
+     .reference = 2,
+     .summary = "plane-parallel solution at the slab faces (slab mode only)",
+     .run = ppb_method_ppslab},
+    {.id = "rte2d",
+     .summary = "the tube's transfer solved: the paper's refinement iterated",
+     .run = ppb_method_rte2d},
 };
 
 int ppb_method_count(void)
@@ -56,7 +68,7 @@ int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
             return ppb_config_key_fail(cfg, "experiment", "methods", err,
                                        "method '%s' runs in slab mode only", m->id);
         /* A point where the method's model has no meaning is refused here, before any work. */
-        if ((strcmp(m->id, "mp") == 0 || strcmp(m->id, "mp+ss") == 0) && ppb_mp_check(cfg, err))
+        if (m->check && m->check(cfg, err))
             return -1;
     }
     return 0;
