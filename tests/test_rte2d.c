@@ -175,7 +175,7 @@ static void test_energy_balance(void **state)
             cfg.scene.segments_top = 16;
             cfg.scene.segments_side = 6;
             cfg.samples_dir = cfg.samples_seg = 1;
-            cfg.rte2d.directions = 24;
+            cfg.rte2d.directions = 64;
             cfg.rte2d.spacing = cfg.rte2d.step = (geom ? 0.05 : 0.2) / (1 << k);
             ppb_result a;
             ppb_rte2d_stats st;
@@ -192,12 +192,94 @@ static void test_energy_balance(void **state)
     }
 }
 
+/* A reduced tube (16 x 6 segments, 4 x 4 bins) with every method's defaults but a coarser
+ * rte2d (32 cells per hemisphere, spacing 0.1). */
+static ppb_config small_tube(void)
+{
+    ppb_config cfg = base_cfg(PPB_GEOM_TUBE);
+    cfg.scene.segments_top = 16;
+    cfg.scene.segments_side = 6;
+    cfg.scene.ntheta = cfg.scene.nphi = 4;
+    cfg.samples_dir = cfg.samples_seg = 2;
+    cfg.rte2d.directions = 32;
+    cfg.rte2d.spacing = cfg.rte2d.step = 0.1;
+    return cfg;
+}
+
+/* The tube against the Monte Carlo (SPEC.md section 7's reference) within its noise: the
+ * chi-square of (rte2d - mc) / se over every bin of every surface, normal and 45 degree light,
+ * must be a plausible draw (upper tail p > 1e-4; rte2d's own discretisation error, about 0.5 %
+ * at this spacing and 64 cells, is well below the 4-15 % per-bin noise of 5e5 photons). */
+static void test_tube_matches_mc(void **state)
+{
+    (void)state;
+    double th[2] = {0.0, 45.0};
+    for (int c = 0; c < 2; c++) {
+        ppb_config cfg = small_tube();
+        cfg.scene.theta_deg = th[c];
+        cfg.mc.photons = 500000;
+        cfg.rte2d.directions = 64;
+        ppb_result a, m;
+        run(&cfg, "rte2d", &a, NULL);
+        run(&cfg, "mc", &m, NULL);
+        double chi2 = 0.0;
+        int dof = 0;
+        for (size_t i = 0; i < a.layout.ncells; i++)
+            if (m.se[i] > 0.0) {
+                double z = (a.radiance[i] - m.radiance[i]) / m.se[i];
+                chi2 += z * z;
+                dof++;
+            }
+        double p = tu_chi2_pvalue(chi2, dof);
+        printf("tube theta = %g: chi2 %.1f over %d bins, p = %.3g; R %.5f vs mc %.5f, T %.5f vs "
+               "%.5f, sides %.5f vs %.5f\n",
+               th[c], chi2, dof, p, a.totals.R, m.totals.R, a.totals.T, m.totals.T, a.totals.sides,
+               m.totals.sides);
+        assert_true(dof > 500);
+        assert_lt(1e-4, p);
+        ppb_result_free(&a);
+        ppb_result_free(&m);
+    }
+}
+
+/* refinements = K (SPEC.md section 12): Eq. 5's plain iteration from I_pp. Its error against
+ * the converged answer shrinks with K (each step multiplies it by at most the medium's
+ * albedo, 0.95, times what escapes); K = 1 is the paper's one step from I_pp. */
+static void test_refinements_approach_converged(void **state)
+{
+    (void)state;
+    ppb_config cfg = small_tube();
+    ppb_result conv;
+    run(&cfg, "rte2d", &conv, NULL);
+    int Ks[4] = {1, 2, 4, 16};
+    double prev = INFINITY;
+    for (int k = 0; k < 4; k++) {
+        cfg.rte2d.refinements = Ks[k];
+        ppb_result r;
+        run(&cfg, "rte2d", &r, NULL);
+        double num = 0.0, den = 0.0;
+        for (size_t i = 0; i < r.layout.ncells; i++) {
+            num += (r.radiance[i] - conv.radiance[i]) * (r.radiance[i] - conv.radiance[i]);
+            den += conv.radiance[i] * conv.radiance[i];
+        }
+        double rms = sqrt(num / den);
+        printf("K = %d: rms against converged %.4g\n", Ks[k], rms);
+        assert_lt(rms, prev);
+        prev = rms;
+        ppb_result_free(&r);
+    }
+    assert_lt(prev, 0.05);
+    ppb_result_free(&conv);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gmres_matches_lu),
         cmocka_unit_test(test_slab_matches_ppslab),
         cmocka_unit_test(test_energy_balance),
+        cmocka_unit_test(test_tube_matches_mc),
+        cmocka_unit_test(test_refinements_approach_converged),
     };
     return cmocka_run_group_tests(tests, open_device, close_device);
 }

@@ -3,6 +3,7 @@
 #include "drivers/perf_march.h"
 #include "drivers/perf_mc.h"
 #include "drivers/perf_pp.h"
+#include "drivers/perf_rte2d.h"
 
 int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
 {
@@ -24,6 +25,10 @@ int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
     if (rc == 0) {
         fprintf(out, "\n== Monte Carlo (OpenCL)\n");
         rc = ppb_perf_mc(ctx, out, err);
+    }
+    if (rc == 0) {
+        fprintf(out, "\n== rte2d: the refinement iterated (OpenCL marches)\n");
+        rc = ppb_perf_rte2d(ctx, out, err);
     }
     ctx->cfg = given; /* the defaults live on this stack frame only */
     return rc;

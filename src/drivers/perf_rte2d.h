@@ -1,0 +1,14 @@
+/* perf_rte2d.h: the benchmark of `rte2d` (issue 19): one converged study case (the run's
+ * config, default the uniform g = 0 tube) on the device, its time per case and per refinement
+ * (one march over the grid), and the solve's size. */
+#ifndef PPB_PERF_RTE2D_H
+#define PPB_PERF_RTE2D_H
+
+#include <stdio.h>
+
+#include "base/err.h"
+#include "methods/method.h"
+
+int ppb_perf_rte2d(ppb_run_ctx *ctx, FILE *out, ppb_err *err);
+
+#endif
