@@ -22,7 +22,7 @@ TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
 BIN   ?= ppbench
 
-.PHONY: all deps test layers unit asan bench perf format format-check clean
+.PHONY: all deps test layers docs unit asan bench perf format format-check clean
 all: $(BIN)
 
 # Dependencies first: the pkg-config flags are only asked for once the packages are there.
@@ -76,12 +76,17 @@ unit: $(BIN) $(TESTS)
 	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
 	done; exit $$fail
 
-# The layer check first: it reads includes only and fails in a second.
-test: layers unit
+# The layer check first: it reads includes only and fails in a second. Then the reference's
+# check (docs/reference.md against what a few tiny runs write, a few seconds).
+test: layers docs unit
 	@bash tests/regress.sh
 
 layers:
 	@bash scripts/check_layers.sh
+
+docs: $(BIN)
+	@mkdir -p $(BUILD)/tmp
+	@PPBENCH=$(CURDIR)/$(BIN) TMPDIR=$(CURDIR)/$(BUILD)/tmp bash scripts/check_docs.sh
 
 asan:
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \

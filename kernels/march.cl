@@ -1,4 +1,4 @@
-/* march.cl: the ray marcher of `pp` and `ss` (paper Sec. 3, Eq. 13-17; SPEC.md section 7).
+/* march.cl: the ray marcher of `pp` and `ss` (paper Sec. 3, Eq. 13-17; reference: Methods).
  *
  * One work-item owns one (segment, direction bin) cell: for every point of the segment and every
  * direction sample of the bin it marches from the exit point p into the medium along -w to the
@@ -270,7 +270,7 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
 }
 
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
- * and the bin's direction samples (SPEC.md section 4). */
+ * and the bin's direction samples (reference: Bins). */
 __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *map,
                                __global const double *tabR, __global const double *tabS,
                                __global const double *coefC, __global double *out)

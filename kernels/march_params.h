@@ -33,7 +33,7 @@ enum {
 };
 
 /* Column slabs: the medium is piecewise constant with its only jump on the vertical plane
- * x = step_x (SPEC.md section 1), so every vertical column of the tube is a homogeneous slab of
+ * x = step_x (reference: Medium), so every vertical column of the tube is a homogeneous slab of
  * optical thickness tau0 = sigma_t(x) H. The tables hold one slab solution per distinct column
  * thickness: column 0 is the left medium's (the only one without a density step), column 1 the
  * right medium's (x >= step_x) when a density step makes it differ. */
@@ -54,7 +54,7 @@ enum {
 /* Parameters of one launch, passed by value. All doubles first, then an even number of ints, so
  * host and device agree on the layout without packing attributes; the host asserts the size. */
 typedef struct ppb_march_params {
-    /* scene (SPEC.md sections 1-3) */
+    /* scene (reference: Medium to Light) */
     double width, height; /* W (tube only), H */
     double sigma_t, sigma_t_right, albedo, albedo_right, step_x;
     double tan_theta_l, cos_theta_l; /* light incidence */
@@ -87,7 +87,7 @@ typedef struct ppb_march_params {
 } ppb_march_params;
 
 /* Direction sample (a, b) of bin (itheta, iphi) on surface surf: the stratified midpoints of an
- * n x n grid in (sin^2 theta, phi), i.e. uniform in projected solid angle (SPEC.md section 4). */
+ * n x n grid in (sin^2 theta, phi), i.e. uniform in projected solid angle (reference: Bins). */
 PPB_FN void ppb_march_dir(int surf, int bin, int a, int b, int n, int ntheta, int nphi, double *wx,
                           double *wy, double *wz)
 {

@@ -1,4 +1,4 @@
-/* mc.cl: the photon Monte Carlo transport kernel (SPEC.md sections 1-4 and 7, method `mc`).
+/* mc.cl: the photon Monte Carlo transport kernel (reference: Medium to Bins, Methods; `mc`).
  *
  * A photon enters S1 uniformly over the lit part along w_L, flies free paths sampled in optical
  * depth through the piecewise-constant medium (traced exactly across the density step plane

@@ -4,7 +4,7 @@
  * Owns: the parameter struct passed by value, the kernel argument indices, the layout of the
  * integer tally buffers and their fixed-point scale. Tallies are integers so that their sums do
  * not depend on the order of accumulation: the result is bit-identical whatever the work-group
- * size, the chunking or the split into shards (SPEC.md section 10). */
+ * size, the chunking or the split into shards (reference: Corrections). */
 #ifndef PPB_MC_PARAMS_H
 #define PPB_MC_PARAMS_H
 

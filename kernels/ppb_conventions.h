@@ -1,4 +1,4 @@
-/* ppb_conventions.h: the conventions of SPEC.md sections 2-4 coded once, for host and kernels.
+/* ppb_conventions.h: the conventions (reference: Geometry to Bins), for host and kernels.
  *
  * Owns: surface ids, the surface count, and their local frames (n, b = +z, t = n x b), the
  * direction bins (equal sin^2(theta) theta bins, phi folded to [0, 180] deg) and their count,
@@ -22,7 +22,7 @@
 
 #define PPB_PI 3.14159265358979323846
 
-/* Surfaces (SPEC.md section 2). In slab mode only S1 and S2 exist. */
+/* Surfaces (reference: Geometry). In slab mode only S1 and S2 exist. */
 enum { PPB_S1 = 0, PPB_S2 = 1, PPB_S3 = 2, PPB_S4 = 3, PPB_NSURF = 4 };
 
 /* Surfaces that exist: S1..S4 in the tube, S1 and S2 in slab mode. */
@@ -31,7 +31,7 @@ PPB_FN int ppb_surface_count(int tube)
     return tube ? 4 : 2;
 }
 
-/* Step kinds (SPEC.md section 1 and 3). */
+/* Step kinds (reference: Medium, Light). */
 enum { PPB_STEP_NONE = 0, PPB_STEP_DENSITY = 1, PPB_STEP_ALBEDO = 2, PPB_STEP_SHADOW = 3 };
 
 /* Outward normal of a surface, as (x, y); the z component is 0. */
@@ -124,7 +124,7 @@ PPB_FN void ppb_bin_direction(int surf, int itheta, int iphi, double u, double v
     *wz = wb;
 }
 
-/* Segment centres (SPEC.md section 2): S1/S2 numbered along x from -W/2, S3/S4 along y from -H.
+/* Segment centres (reference: Geometry): S1/S2 numbered along x from -W/2, S3/S4 along y from -H.
  * Returns the coordinate s along the surface; (x, y) is the point. Slab mode uses s = 0. */
 PPB_FN double ppb_segment_centre(int surf, int seg, int nseg, double width, double height,
                                  double *x, double *y)
@@ -154,7 +154,7 @@ PPB_FN int ppb_segment_of(double s, double s0, double len, int nseg)
     return k < 0 ? 0 : (k >= nseg ? nseg - 1 : k);
 }
 
-/* Piecewise-constant medium (SPEC.md section 1): the right value holds for x >= step_x. */
+/* Piecewise-constant medium (reference: Medium): the right value holds for x >= step_x. */
 PPB_FN double ppb_sigma_t_at(double x, int step, double step_x, double sigma_t,
                              double sigma_t_right)
 {
@@ -166,7 +166,7 @@ PPB_FN double ppb_albedo_at(double x, int step, double step_x, double albedo, do
 }
 
 /* Henyey-Greenstein phase function of the scattering cosine, per steradian, normalised to 1
- * over the sphere (SPEC.md section 1; paper Sec. 4.1):
+ * over the sphere (reference: Medium; paper Sec. 4.1):
  *     p(cos) = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2)) = ppb_hg_norm(g) / base^(3/2),
  * base = ppb_hg_base(g, cos). The factored form is for sums of p over many cosines (the phase
  * matrix's quadratures, src/physics/phase.c), which take the constant out of the sum; it agrees

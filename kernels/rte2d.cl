@@ -1,9 +1,9 @@
-/* rte2d.cl: the marches of `rte2d` (SPEC.md section 12; paper Sec. 3.1, Eq. 5).
+/* rte2d.cl: the marches of `rte2d` (reference: Methods; paper Sec. 3.1, Eq. 5).
  *
  * One refinement of Eq. 5, I_n = K I_(n-1) + I_0, is a march from every grid node in every
  * direction cell through the piecewise-constant medium (ppb_rte_sweep); the exit radiance is the
  * same march from every segment point in every direction sample of every bin (ppb_rte_exit), as
- * `pp` averages its bins (SPEC.md section 4). Both integrate, along q = p - l w,
+ * `pp` averages its bins (reference: Bins). Both integrate, along q = p - l w,
  *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
  * where J is the grid's scattered-light source per unit scattering coefficient (bilinear in the
  * nodes, rte2d_params.h) and C E the direct beam's first scattering, exact: E = lit exp(-D) with
@@ -151,7 +151,7 @@ __kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
 }
 
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
- * and the bin's direction samples (SPEC.md section 4), as march.cl's ppb_march_kernel. */
+ * and the bin's direction samples (reference: Bins), as march.cl's ppb_march_kernel. */
 __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                            __global const double *src, __global double *out)
 {

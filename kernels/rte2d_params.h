@@ -1,11 +1,11 @@
 /* rte2d_params.h: the one definition of what the rte2d kernels (rte2d.cl) receive, shared by the
- * host (src/methods/method_rte2d.c, src/physics/rte2d_grid.c) and the kernels (SPEC.md
- * section 12).
+ * host (src/methods/method_rte2d.c, src/physics/rte2d_grid.c) and the kernels (reference:
+ * Methods).
  *
  * Owns: the launch parameters passed by value, the kernel argument indices, the source grid over
  * the cross-section (node positions, the split of the x nodes at the step, the bilinear lookup of
  * a source plane) and the exact direct beam at a point (optical depth D along the light path and
- * whether S1's lit part is seen, SPEC.md section 3), which both the grid's first-scattering
+ * whether S1's lit part is seen, reference: Light), which both the grid's first-scattering
  * source and the exit march use, so the beam's first scattering is exact (as in `ss`).
  *
  * Grid: nodes x_i, y_j = -j hy (j = 0 on S1, ny - 1 on S2). In x the nodes are uniform on
@@ -101,7 +101,7 @@ PPB_FN double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM double 
     return top + ty * (bot - top);
 }
 
-/* The exact direct beam at (x, y), y <= 0 (SPEC.md section 3): the ray toward the light meets
+/* The exact direct beam at (x, y), y <= 0 (reference: Light): the ray toward the light meets
  * S1's plane at x' = x + y tan(theta_L); the point is lit when x' lies on S1 (>= -W/2) and, with
  * a shadow step, left of step_x. D = optical depth of that path through the piecewise-constant
  * medium, continued where unlit (the caller multiplies by lit). Slab: sigma_t |y| / cos. */

@@ -1,5 +1,5 @@
-/* experiment.h: one experiment: run every method of a config, then write SPEC.md section 8's
- * outputs (CSVs, timings, provenance, images) under the output directory.
+/* experiment.h: one experiment: run every method of a config, then write the Outputs of
+ * docs/reference.md (CSVs, timings, provenance, images) under the output directory.
  *
  * Computing and writing are separate so that a sweep can take the in-memory results of each
  * grid point. The Monte Carlo (`reference` in the method registry) is what rms.csv and

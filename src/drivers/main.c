@@ -545,7 +545,7 @@ static int cmd_report(const cli *c)
 
 static const command commands[] = {
     {"run", "CONFIG...", 0,
-     "run every method of each experiment config and write\nSPEC.md section 8's outputs under "
+     "run every method of each experiment config and write\nthe outputs of docs/reference.md under "
      "[output] dir",
      "ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini",
      OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET, 1, cmd_run},
@@ -626,7 +626,10 @@ static void usage(FILE *out)
             "\n"
             "exit codes: 0 success; 1 a run failed (OpenCL, I/O, numerics); 2 bad command\n"
             "line or config (found before any work starts); 130 interrupted (what was done\n"
-            "is written, marked partial).\n");
+            "is written, marked partial).\n"
+            "\n"
+            "reference: docs/reference.md (every output file and column, config key and\n"
+            "convention).\n");
 }
 
 /* `ppbench CMD --help`: the command's synopsis, what it does, its options, one example. */

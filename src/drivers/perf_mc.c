@@ -11,7 +11,7 @@
 #define PERF_MC_PHOTONS 10000000LL
 
 /* The experiment's scene and MC settings with the given g (under `ppbench perf`, src/drivers/perf.c
- * passes the study defaults: SPEC.md section 6's uniform tube), so no default is coded twice.
+ * passes the study defaults: the uniform tube of reference: Cases), so no default is coded twice.
  * The photon range is the timed one and a target noise would cut the timing short. */
 static int perf_config(const ppb_run_ctx *ctx, double g, ppb_config *cfg, ppb_err *err)
 {

@@ -1,5 +1,5 @@
 /* perf_mc.h: the Monte Carlo throughput benchmark (issue 4): photons/s and scattering events/s
- * of kernels/mc.cl on the chosen device, for SPEC.md section 6's uniform tube at g = 0 and
+ * of kernels/mc.cl on the chosen device, for the uniform tube (reference: Cases) at g = 0 and
  * g = 0.5 (normal incidence, alpha = 0.95), printed with the device name and the 20 M events/s
  * target. */
 #ifndef PPB_PERF_MC_H

@@ -192,7 +192,7 @@ static int write_readme(const char *dir, const char *const *cases, int ncases, p
         return -1;
     FILE *f = af.f;
     fprintf(f, "%s\n%s\n\n", readme_mark, readme_mark_v1);
-    fprintf(f, "RMS error against the Monte Carlo (SPEC.md section 5) at the two segments next "
+    fprintf(f, "RMS error against the Monte Carlo (docs/reference.md) at the two segments next "
                "to x = 0 on S1 (R) and S2 (T), beside the paper's Table 2 and the Monte "
                "Carlo's own noise floor. `excess` removes the noise: sqrt(rms^2 - noise^2).\n\n");
     snprintf(path, sizeof path, "%s/table2.md", dir);

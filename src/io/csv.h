@@ -1,9 +1,9 @@
-/* csv.h: the CSV files of SPEC.md section 8, written once here for every method.
+/* csv.h: the CSV files (reference: Outputs), written once here for every method.
  *
- * radiance.csv, rms.csv, summary.csv and totals.csv keep SPEC.md's names and column order.
+ * radiance.csv, rms.csv, summary.csv and totals.csv keep their specified names and column order.
  * regions.csv (method, region, rms_rel, noise_rel, rms_excess) adds the RMS over the regions of
  * model/metrics.h (S1/S2 away from, around and near the step and the walls), which the
- * regression gate and the plots read instead of re-deriving SPEC.md 5 from radiance.csv.
+ * regression gate and the plots read instead of re-deriving the Metrics from radiance.csv.
  * Results are written in the order given; `ref` is the result every other one is measured
  * against, and `skip` (may be NULL) names a result left out of the RMS files besides the
  * reference (its companion: mc1 beside mc). Every file goes through atomic_file. */

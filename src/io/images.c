@@ -1,4 +1,4 @@
-/* images.c: the shaded tube images of an experiment (paper Fig. 6-7, SPEC.md section 8).
+/* images.c: the shaded tube images of an experiment (paper Fig. 6-7; reference: Outputs).
  *
  * Every method's picture is two views of the tube clipped along z (render_tube.h): on top the
  * view from above-left (S1 and S3), underneath the view from below-left (S2 and S3), as the

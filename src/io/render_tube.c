@@ -163,7 +163,7 @@ ppb_tube_hit ppb_tube_view_hit(const ppb_tube_view *v, double px, double py)
 size_t ppb_tube_view_cell(const ppb_tube_view *v, const ppb_layout *lo, const ppb_tube_hit *h)
 {
     int top = h->surf == PPB_S1 || h->surf == PPB_S2;
-    /* s along the surface as SPEC.md section 2 numbers segments: x from -W/2, y from -H. */
+    /* s along the surface as the reference numbers segments (Geometry): x from -W/2, y from -H. */
     double s = top ? h->p[0] : h->p[1];
     double s0 = top ? -0.5 * v->width : -v->height;
     double len = top ? v->width : v->height;

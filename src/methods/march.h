@@ -1,7 +1,7 @@
 /* march.h: the host side of the ray marcher shared by `pp` and `ss` (paper Sec. 3.4, Fig. 3's
- * rendering process; SPEC.md sections 4 and 7): uploads the light maps (maps.h) and the tables
+ * rendering process; reference: Bins, Methods): uploads the light maps (maps.h) and the tables
  * (march_tables.h), runs kernels/march.cl over every (segment, bin) cell, and turns the
- * bin-averaged radiance into the totals of SPEC.md section 4. */
+ * bin-averaged radiance into the totals (reference: Bins). */
 #ifndef PPB_MARCH_H
 #define PPB_MARCH_H
 

@@ -291,7 +291,7 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
     st->events_per_photon = E.mean;
     if (once) {
         /* mc1 holds only the once-scattered exits: what it does not hold is not "absorbed"
-         * in any tracked sense, so the writer completes it as 1 - the rest (SPEC.md 4). */
+         * in any tracked sense, so the writer completes it as 1 - the rest (reference: Bins). */
         st->mean.absorbed_tracked = 0;
         ppb_totals_complete(&st->mean);
     } else {
@@ -309,7 +309,7 @@ static void cells_to_result(const ppb_mc_tallies *t, const ppb_scene *sc, int on
     size_t tstride = (size_t)PPB_MC_NTALLY * t->ncells;
     const uint64_t *base = t->cells + (size_t)(once ? 1 : 0) * t->ncells;
     for (int s = 0; s < lo->nsurf; s++) {
-        /* Each photon carries lit x cos(theta_L) / N of the entering power (SPEC.md 4); a
+        /* Each photon carries lit x cos(theta_L) / N of the entering power (reference: Light); a
          * cell's radiance is its energy over segment length x projected solid angle. */
         double scale = power / ppb_scene_cell_measure(sc, s) / PPB_MC_FIXED_SCALE;
         for (int seg = 0; seg < lo->nseg[s]; seg++)

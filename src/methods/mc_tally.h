@@ -4,7 +4,7 @@
  * per (surface, segment, bin); totals), their binary file form, their merge (plain integer
  * addition, so shards merged in any order give the same bytes as one run with the whole
  * budget), and the conversion to radiance with standard errors from the batch means
- * (SPEC.md sections 4, 5 and 7). Layout and scale: kernels/mc_params.h. */
+ * (reference: Bins, Metrics, Methods). Layout and scale: kernels/mc_params.h. */
 #ifndef PPB_MC_TALLY_H
 #define PPB_MC_TALLY_H
 

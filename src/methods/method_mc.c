@@ -92,7 +92,7 @@ static int check_settings(const ppb_config *cfg, long long first, long long coun
         ppb_mc_scene_fingerprint(sc) != t->fingerprint)
         return ppb_fail(err, "mc: tallies were made for another scene, seed or batch count");
     if (sc->geometry == PPB_GEOM_SLAB && sc->step != PPB_STEP_NONE)
-        return ppb_fail(err, "mc: steps are not defined in slab mode (SPEC.md section 2)");
+        return ppb_fail(err, "mc: steps are not defined in slab mode (docs/reference.md)");
     if (sc->theta_deg < 0 || sc->theta_deg >= 90)
         return ppb_fail(err, "mc: theta_deg must lie in [0, 90) (got %g)", sc->theta_deg);
     if (sc->sigma_t <= 0 || (sc->step == PPB_STEP_DENSITY && sc->sigma_t_right <= 0))
@@ -248,7 +248,7 @@ static int read_tallies(mc_run *r, long long done, ppb_err *err)
     return 0;
 }
 
-/* noise_rel at the x = 0 cells of S1 and S2 (SPEC.md 5, Table 2 cells), the larger of the two,
+/* noise_rel at the x = 0 cells of S1 and S2 (reference: Metrics), the larger of the two,
  * for the tallies so far (t plus the device's, already read into tmp). */
 static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tallies *tmp,
                      double *noise, ppb_err *err)
@@ -261,7 +261,7 @@ static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tall
     if (ppb_result_init(&r, "mc", &lo, err))
         return -1;
     ppb_mc_tallies_to_results(tmp, sc, &r, NULL);
-    /* The Table 2 cells (SPEC.md 5); no signal yet counts as not reached. */
+    /* The Table 2 cells (reference: Metrics); no signal yet counts as not reached. */
     ppb_point pr[2], pt[2];
     double nr = ppb_noise_points(&r, pr, ppb_cell_points(&lo, PPB_CELL_R_X0, pr, 2));
     double nt = ppb_noise_points(&r, pt, ppb_cell_points(&lo, PPB_CELL_T_X0, pt, 2));

@@ -1,4 +1,4 @@
-/* method_mc.h: the photon Monte Carlo reference (SPEC.md section 7, `mc` and `mc1`): runs
+/* method_mc.h: the photon Monte Carlo reference (reference: Methods, `mc` and `mc1`): runs
  * kernels/mc.cl over a photon range in chunks, with progress, SIGINT and a target noise.
  *
  * ppb_method_mc is the registry entry; ppb_mc_trace is the building block that sweeps use to

@@ -1,4 +1,4 @@
-/* method_mp.c: the `mp` and `mp+ss` methods (SPEC.md section 7), the paper's multipole baseline.
+/* method_mp.c: the `mp` and `mp+ss` methods (reference: Methods), the paper's multipole baseline.
  *
  * Slab mode: the multipole's plane-integrated R and T (Donner & Jensen 2005) as a Lambertian
  * exit radiance cos(theta_L) R / pi on S1 and cos(theta_L) T / pi on S2.

@@ -1,4 +1,4 @@
-/* method_mp.h: the multipole diffusion baseline of the paper's comparison (SPEC.md section 7):
+/* method_mp.h: the multipole diffusion baseline of the paper's comparison (reference: Methods):
  * method ids `mp` (Donner & Jensen 2005 multipole for a slab of the tube's thickness, applied
  * to the tube from 3-D source-to-point distances) and `mp+ss` (mp plus the `ss` radiance). */
 #ifndef PPB_METHOD_MP_H

@@ -56,7 +56,7 @@ int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *
         return -1;
     }
     /* 3. The march along every viewing ray of every (segment, bin) cell (Sec. 3.4, Fig. 3),
-     *    then the totals of SPEC.md section 4. */
+     *    then the totals (reference: Bins). */
     ppb_march_opts opts = {
         .table = cfg->pp.table, .step = cfg->pp.step, .telescope = 1, .npts = cfg->samples_seg};
     rc = ppb_march_all(ocl, sc, &maps, tab, &opts, out->method, ctx->quiet, out->radiance,

@@ -1,4 +1,4 @@
-/* method_pp.h: the paper's method `pp` (SPEC.md section 7; paper Sec. 3, Eq. 13-17): the
+/* method_pp.h: the paper's method `pp` (reference: Methods; paper Sec. 3, Eq. 13-17): the
  * plane-parallel solution of a slab of the tube's thickness, re-integrated along every viewing
  * ray through the optical-depth and average-albedo maps with the integral tables R or S. */
 #ifndef PPB_METHOD_PP_H
@@ -6,7 +6,7 @@
 
 #include "methods/method.h"
 
-/* Fills out[0] with the bin-averaged exit radiance and the totals of SPEC.md section 4. */
+/* Fills out[0] with the bin-averaged exit radiance and the totals (reference: Bins). */
 int ppb_method_pp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
 /* The pipeline itself: maps, tables, march, totals. with_modes = 0 keeps only the attenuated

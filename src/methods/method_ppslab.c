@@ -1,5 +1,5 @@
-/* method_ppslab.c: the plane-parallel solution evaluated at the slab's faces (SPEC.md
- * section 9; paper Sec. 2.2 through src/physics/ppsolver.h). */
+/* method_ppslab.c: the plane-parallel solution evaluated at the slab's faces (reference:
+ * Methods; paper Sec. 2.2 through src/physics/ppsolver.h). */
 #include "methods/method_ppslab.h"
 
 #include <math.h>
@@ -7,8 +7,8 @@
 #include "base/progress.h"
 #include "physics/ppsolver.h"
 
-/* Bin average over samples x samples directions uniform in projected solid angle (SPEC.md
- * section 4), through ppb_bin_direction so the bins match every other method's. */
+/* Bin average over samples x samples directions uniform in projected solid angle (reference:
+ * Bins), through ppb_bin_direction so the bins match every other method's. */
 static double bin_average(const pp_solution *s, const ppb_scene *sc, int surf, int bin, int samples,
                           double tau)
 {

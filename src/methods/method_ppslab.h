@@ -1,4 +1,4 @@
-/* method_ppslab.h: the `ppslab` method (SPEC.md section 9): the plane-parallel solution itself
+/* method_ppslab.h: the `ppslab` method (reference: Methods): the plane-parallel solution itself
  * (src/physics/ppsolver.h, paper Sec. 2.2) evaluated at the faces of a slab, no ray marching. It is
  * the deterministic slab answer that mc, pp and ss are checked against in slab mode. */
 #ifndef PPB_METHOD_PPSLAB_H

@@ -1,5 +1,5 @@
 /* method_rte2d.h: `rte2d`, the tube's radiative transfer solved by iterating the paper's
- * refinement (SPEC.md section 12; paper Sec. 3.1, Eq. 5) on a grid over the cross-section.
+ * refinement (reference: Methods; paper Sec. 3.1, Eq. 5) on a grid over the cross-section.
  *
  * Pipeline: the grid and direction cells (physics/rte2d_grid.h); I_1, the once-scattered
  * radiance of every cell at every node, by one march of the exact direct beam's first

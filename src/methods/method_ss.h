@@ -1,4 +1,4 @@
-/* method_ss.h: single scattering `ss` (SPEC.md section 7; paper Eq. 5 with n = 1): the same
+/* method_ss.h: single scattering `ss` (reference: Methods; paper Eq. 5 with n = 1): the same
  * ray march as `pp` with the attenuated direct beam as the only source. */
 #ifndef PPB_METHOD_SS_H
 #define PPB_METHOD_SS_H

@@ -14,8 +14,8 @@ const ppb_method *ppb_method_find(const char *id); /* NULL when no method has th
 int ppb_method_count(void);
 const ppb_method *ppb_method_at(int i); /* NULL outside [0, ppb_method_count()) */
 
-/* Every id of cfg->methods names a method, and no slab-only method runs in tube mode (SPEC.md
- * 2); otherwise fails with "file:line: [experiment] methods: reason" (or "--set
+/* Every id of cfg->methods names a method, and no slab-only method runs in tube mode (reference:
+ * Methods); otherwise fails with "file:line: [experiment] methods: reason" (or "--set
  * experiment.methods: reason" when --set gave the list). */
 int ppb_methods_check(const ppb_config *cfg, ppb_err *err);
 

@@ -65,7 +65,7 @@ static const key_def keys[] = {
     {"experiment", "name", K_NAME, F(name), 0, 0, "", NULL,
      "experiment name; default: the config file's base name"},
     {"experiment", "geometry", K_ENUM, F(scene.geometry), 0, 0, "tube", geometry_names,
-     "the tube of SPEC.md 2, or the infinite slab of thickness `height`"},
+     "the tube (docs/reference.md: Geometry), or the infinite slab of thickness `height`"},
     {"experiment", "methods", K_METHODS, F(methods), 0, 0, "mc, pp, ss, mp, mp+ss", NULL,
      "method ids, comma-separated (`ppbench --help` lists them)"},
     {"tube", "width", K_REAL, F(scene.width), 0.01, 1000, "10", NULL, "W, mfp (ignored by slab)"},

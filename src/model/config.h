@@ -1,4 +1,4 @@
-/* config.h: an experiment's settings, read from an INI file (SPEC.md section 9 plus the
+/* config.h: an experiment's settings, read from an INI file (reference: Keys, plus the
  * method settings documented in configs/README.md).
  *
  * Owns the key table (section, key, type, default, range) and the name table of every enum

@@ -14,7 +14,7 @@ ppb_rms ppb_rms_points_w(const ppb_result *m, const ppb_result *ref, const ppb_p
     double num = 0, den = 0, noise = 0;
     for (int p = 0; p < n; p++)
         for (int k = 0; k < lo->nbins; k++) {
-            /* Equal bins (SPEC.md 4): w_k is a common factor of both sums and cancels; 1.0
+            /* Equal bins (reference: Bins): w_k is a common factor of both sums and cancels; 1.0
              * keeps the sums exactly those of the unweighted formula. */
             double wk = w ? w[k] : 1.0;
             size_t c = ppb_cell(lo, pts[p].surf, pts[p].seg, k);

@@ -1,9 +1,9 @@
-/* metrics.h: the error metrics of SPEC.md section 5.
+/* metrics.h: the error metrics (reference: Metrics).
  *
  * rms_rel of a method against a reference over a set of sample points, the reference's noise
  * floor from its standard errors, and rms_excess = sqrt(max(0, rms^2 - noise^2)). When the
  * compared method has standard errors of its own (mc against ppslab), they add to the noise
- * floor in quadrature; for a deterministic method against mc this is exactly SPEC.md's
+ * floor in quadrature; for a deterministic method against mc this is exactly the
  * noise_rel. Also the Table 2 cells (the two segments next to x = 0) and the regions of the
  * tube's top and bottom (segments away from, at, or near the medium's step and the walls) that
  * the regression gate and the plots read from regions.csv instead of re-deriving them. */
@@ -21,7 +21,7 @@ typedef struct ppb_point {
     int surf, seg;
 } ppb_point;
 
-/* SPEC.md 5 with every bin's w_k equal, as SPEC.md 4's bins are (pi / (ntheta nphi) each): the
+/* The metrics with every bin's w_k equal (pi / (ntheta nphi) each, reference: Bins): the
  * common factor cancels and is left out. */
 ppb_rms ppb_rms_points(const ppb_result *m, const ppb_result *ref, const ppb_point *pts, int n);
 
@@ -34,7 +34,7 @@ ppb_rms ppb_rms_points_w(const ppb_result *m, const ppb_result *ref, const ppb_p
  * radiance is 0 everywhere. */
 double ppb_noise_points(const ppb_result *r, const ppb_point *pts, int n);
 
-/* The summary cells of SPEC.md section 5, in output order. */
+/* The summary cells (reference: Metrics), in output order. */
 enum {
     PPB_CELL_R_X0,
     PPB_CELL_T_X0,

@@ -1,5 +1,5 @@
 /* result.h: what every method produces: radiance per (surface, segment, bin) with its standard
- * error, and the totals of SPEC.md section 4. The runner, metrics and writers only ever see
+ * error, and the totals (reference: Bins). The runner, metrics and writers only ever see
  * this struct, whatever method filled it. */
 #ifndef PPB_RESULT_H
 #define PPB_RESULT_H
@@ -9,7 +9,7 @@
 
 typedef struct ppb_totals {
     double R, T, sides, absorbed, ballistic; /* fractions of the power entering the lit S1 */
-    int absorbed_tracked; /* 0: the writer reports absorbed = 1 - the rest (SPEC.md 4) */
+    int absorbed_tracked; /* 0: the writer reports absorbed = 1 - the rest (reference: Bins) */
 } ppb_totals;
 
 typedef struct ppb_result {

@@ -19,7 +19,7 @@ ppb_layout ppb_scene_layout(const ppb_scene *sc)
     return lo;
 }
 
-/* Segments of a tube surface (SPEC.md section 2: segments_top on S1/S2, segments_side on S3/S4). */
+/* Segments of a surface (reference: Geometry; segments_top on S1/S2, segments_side on S3/S4). */
 static int tube_segments(const ppb_scene *sc, int surf)
 {
     return (surf == PPB_S1 || surf == PPB_S2) ? sc->segments_top : sc->segments_side;

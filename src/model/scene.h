@@ -1,8 +1,8 @@
-/* scene.h: what is being simulated (SPEC.md sections 1-4): geometry, medium, light, bins, and
+/* scene.h: what is being simulated (reference: Medium to Bins): geometry, medium, light, bins, and
  * the layout of every radiance array over (surface, segment, bin); the light's angle in the
  * forms the methods use (theta_L is converted from degrees here only), the power entering the
  * lit S1 and the segment length x projected solid angle that turn cell energies into average
- * radiances (SPEC.md section 4).
+ * radiances (reference: Bins).
  *
  * Conventions themselves (frames, bin edges, segment centres, the medium step) live in
  * kernels/ppb_conventions.h so host and kernels share them; this header adds the host-side
@@ -55,17 +55,17 @@ double ppb_scene_sin_theta_l(const ppb_scene *sc);
 double ppb_scene_tan_theta_l(const ppb_scene *sc);
 
 /* Width of the lit part of S1 (tube) -- the shadow step lights x < step_x only; 1 in slab mode
- * (per unit area). Used to normalise totals (SPEC.md section 4). */
+ * (per unit area). Used to normalise totals (reference: Bins). */
 double ppb_scene_lit_width(const ppb_scene *sc);
 
 /* Power entering the lit part of S1 per unit E_perp: lit width x cos(theta_L) per unit length
- * in z (tube), cos(theta_L) per unit area (slab). Totals are fractions of it (SPEC.md 4). */
+ * in z (tube), cos(theta_L) per unit area (slab). Totals are fractions of it (reference: Light). */
 double ppb_scene_power_in(const ppb_scene *sc);
 
 /* Length of one segment of surface surf (ppb_segment_length); 1 in slab mode (per unit area). */
 double ppb_scene_segment_length(const ppb_scene *sc, int surf);
 
-/* Segment length x projected solid angle of one bin (SPEC.md section 4): a cell's energy per
+/* Segment length x projected solid angle of one bin (reference: Bins): a cell's energy per
  * unit length in z (per unit area in slab mode) divided by this is its average radiance. */
 double ppb_scene_cell_measure(const ppb_scene *sc, int surf);
 

@@ -1,7 +1,7 @@
 /* directions.h: the direction cells Omega_i of the plane-parallel solver (paper Sec. 2.2.1).
  *
  * Owns the partition of the unit sphere into 2N cells, N per hemisphere, their exact solid
- * angles |Omega_i| and mean cosines k_i (SPEC.md section 10: k_i = |Omega_i|^-1 integral of
+ * angles |Omega_i| and mean cosines k_i (reference: Corrections; k_i = |Omega_i|^-1 integral of
  * mu over the cell), and quadrature nodes inside each cell.
  *
  * Partition: equal-area zonal ("EQSP"-like). Each hemisphere is a polar cap (one cell) and
@@ -24,7 +24,7 @@
  * Sector 0 of every ring is centred on phi = 0 (the beam's azimuth +x), so the partition is
  * mirror symmetric in z (phi -> -phi); cell N + i is the mirror (y -> -y) of cell i.
  *
- * Frame (SPEC.md, tube frame): y up, mu = w.y, phi measured from +x toward +z:
+ * Frame (reference: Bins, tube frame): y up, mu = w.y, phi measured from +x toward +z:
  * w = (sin(theta) cos(phi), mu, sin(theta) sin(phi)). Cells 0..N-1 are up (mu > 0). */
 #ifndef PPB_DIRECTIONS_H
 #define PPB_DIRECTIONS_H

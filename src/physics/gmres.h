@@ -1,7 +1,7 @@
 /* gmres.h: restarted GMRES (Saad and Schultz 1986; Saad, "Iterative Methods for Sparse Linear
  * Systems", 2nd ed., Alg. 6.9 with Givens rotations) for A x = b with A given as a product.
  *
- * Used by `rte2d` for (I - T S) I = I_1 (SPEC.md section 12): T the march, S the scattering.
+ * Used by `rte2d` for (I - T S) I = I_1 (reference: Methods): T the march, S the scattering.
  * Why a Krylov solve and not diffusion synthetic acceleration: it needs nothing but the operator
  * the marcher already applies (DSA needs a diffusion discretisation consistent with the
  * long-characteristic march on every grid, step and boundary, or it diverges in optically thin

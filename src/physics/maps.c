@@ -49,7 +49,7 @@ void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, do
         double f = right_fraction(x, xp, sc->step_x);
         *abar = (1.0 - f) * sc->albedo + f * sc->albedo_right;
     }
-    /* SPEC.md section 3: lit only if the path meets S1 inside its lit part; for theta_L >= 0 a
+    /* Reference: Light: lit only if the path meets S1 inside its lit part; for theta_L >= 0 a
      * path that would meet S1's plane left of -W/2 leaves through S3 first. */
     *lit = xp >= -0.5 * sc->width && xp <= 0.5 * sc->width &&
            !(sc->step == PPB_STEP_SHADOW && xp >= sc->step_x);

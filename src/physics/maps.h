@@ -1,4 +1,4 @@
-/* maps.h: the tube's light maps (paper Sec. 3.1 and 3.3; SPEC.md sections 1-3): the optical
+/* maps.h: the tube's light maps (paper Sec. 3.1 and 3.3; reference: Medium to Light): the optical
  * depth D along the light path from S1 (infinite where S1's lit part cannot be seen along -w_L)
  * and the average albedo along that path, on a light-aligned grid over the cross-section, plus
  * the exact light-path quantities they sample and the exact ballistic exit fraction.
@@ -26,7 +26,7 @@ typedef struct ppb_maps {
 
 /* Builds the maps with map_res cells per mfp (slab mode: one column). The grid's columns reach
  * left of x' = -W/2 far enough for the paths of S3's lower end, but those columns lie wholly in
- * shadow (SPEC.md section 3: a path meeting S1's plane left of -W/2 is unlit), so only the
+ * shadow (reference: Light; a path meeting S1's plane left of -W/2 is unlit), so only the
  * nearest of them is stored: the lookup clamps the others to it, where lit = 0 exactly and the
  * march adds nothing. At oblique light that is the difference between W and W + H tan(theta_L)
  * columns (22 GB at H = 100, theta_L = 80: issue 15). */
@@ -45,7 +45,7 @@ double ppb_maps_depth(const ppb_maps *m, double x, double y);
 
 /* Exact values at (x, y) inside the cross-section (y <= 0): D continued into shadow, the length
  * average of the albedo along the light path (paper Sec. 3.3), and whether the point is lit
- * (SPEC.md section 3). In slab mode x is ignored. */
+ * (reference: Light). In slab mode x is ignored. */
 void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, double *abar,
                           int *lit);
 
@@ -58,7 +58,7 @@ double ppb_segment_optical_depth(const ppb_scene *sc, double x0, double y0, doub
 double ppb_beam_depth(const ppb_scene *sc, double xe);
 
 /* Fraction of the power entering the lit part of S1 that leaves unscattered, through any
- * surface (SPEC.md section 4: ballistic): exp(-ppb_beam_depth) averaged over the lit entry
+ * surface (reference: Bins, ballistic): exp(-ppb_beam_depth) averaged over the lit entry
  * points, by Gauss-Legendre panels between the entry points where the path's end switches from
  * S2 to S4 or the path starts or ends on the step (~1e-14); exp(-tau0 / mu0) in slab mode. The
  * one ballistic fraction of every deterministic method. */

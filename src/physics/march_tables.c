@@ -36,7 +36,7 @@ typedef struct table_key {
 } table_key;
 
 /* Columns: the left medium's slab always; the right one's when a density step changes sigma_t
- * (SPEC.md section 1: the step is the vertical plane x = step_x, so each side is one column). */
+ * (reference: Medium; the step is the vertical plane x = step_x, so each side is one column). */
 static int plan_columns(const ppb_scene *sc, double sigma_t[PPB_MARCH_MAX_COLS])
 {
     sigma_t[0] = sc->sigma_t;

@@ -2,13 +2,13 @@
  * per-direction coefficient of the attenuated beam, for every direction sample of every bin.
  *
  * The marched source at a point with light-path optical depth D, tau = D cos(theta_L), average
- * albedo abar, local albedo alpha and extinction sigma_t is (SPEC.md section 7)
+ * albedo abar, local albedo alpha and extinction sigma_t is (reference: Methods)
  *     sigma_t alpha [ R(tau; w) + C(w) exp(-D) ],
  * R(tau; w) = sum_k A_k(w) e_k(tau)  (paper Eq. 15: A_k = the slab's a_k / abar, its modes'
  *             angular integral P_Vj c_j; the slab solution at abar, Sec. 3.3),
  * C(w)      = p(w.w_L) + b(w) / abar  (the direct beam's single scattering and the particular
  *             part of the diffuse field; the beam is handled analytically, not tabulated).
- * The S table (Eq. 16-17, derived afresh: SPEC.md section 10) integrates R along a step where
+ * The S table (Eq. 16-17, derived afresh, reference: Corrections) integrates R along a step where
  * tau = tau1 + r0 sigma_t l, r0 = w_y being the slab's slope:
  *     integral_0^h e^{-sigma_t l} sigma_t R(tau1 + r0 sigma_t l) dl = e^{-sigma_t h} S(tau2) -
  * S(tau1), S(tau) = sum_k A_k e_k(tau) / (lambda_k r0 - 1)  + any multiple of e^{tau / r0}, and the
@@ -19,7 +19,7 @@
  * field.
  *
  * Column slabs (paper Sec. 3.1, Eq. 13-14): I_pp at a point is the solution of the slab the
- * point sits in. The media of SPEC.md section 1 are piecewise constant with their only jump on
+ * point sits in. The media (reference: Medium) are piecewise constant with their only jump on
  * the vertical plane x = step_x, so every vertical column of the tube is a homogeneous slab of
  * optical thickness tau0(x) = sigma_t(x) H; a point at light-path optical depth D reads its
  * column's slab at tau = D cos(theta_L), clamped to [0, tau0(x)]. The tables hold one slab

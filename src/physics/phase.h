@@ -1,12 +1,12 @@
 /* phase.h: the Henyey-Greenstein phase matrix of the direction cells (paper Eq. 8, with the
- * consistent Galerkin form of SPEC.md section 10).
+ * consistent Galerkin form of reference: Corrections).
  *
  * Owns p(cos) = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2)) (normalised over 4 pi, so a row of
  * P sums to 1), the cell-pair integrals S_ij = double integral of p over Omega_i x Omega_j
  * (symmetric; P_ij = S_ij / |Omega_i|), and the cell integrals F_j(w) = integral of p(w.w')
  * over Omega_j for one continuous direction w. Derivation: with I = sum_j I_j 1_{Omega_j},
  * averaging alpha * integral p I over Omega_i gives alpha sum_j P_ij I_j with P_ij as above
- * (paper Eq. 7-8 carry a stray |Omega| factor, SPEC.md section 10).
+ * (paper Eq. 7-8 carry a stray |Omega| factor, reference: Corrections).
  *
  * Quadrature: product Gauss per cell (directions.h), the order chosen per pair from how close
  * the pair comes to the HG peak (its complex singularity lies sqrt(D / |g|) away in angle,

@@ -159,7 +159,7 @@ static int eigen_modes(const pp_solution *s, pp_work *w, ppb_err *err)
     return 0;
 }
 
-/* ---- the beam (paper Sec. 2.2 leaves it out; SPEC.md section 7) ---- */
+/* ---- the beam (paper Sec. 2.2 leaves it out; reference: Methods) ---- */
 
 /* Moves mu0 off any 1/lambda by the discrete-ordinates perturbation (ppsolver.h). */
 static void avoid_resonance(pp_solution *s, const pp_work *w)

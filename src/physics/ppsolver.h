@@ -1,8 +1,8 @@
 /* ppsolver.h: the plane-parallel solution of a homogeneous slab (paper Sec. 2.2, Eq. 8-12).
  *
  * Owns the discretised transfer equation K dI/dtau = (E - alpha P) I - alpha q exp(-tau/mu0)
- * over the direction cells of directions.h (tau = -y sigma_t grows downward, mu = w.y, SPEC.md
- * section 10's consistent Eq. 8), its eigen solution (Eq. 9-11), the boundary conditions (Eq.
+ * over the direction cells of directions.h (tau = -y sigma_t grows downward, mu = w.y, Eq. 8 as
+ * corrected (reference: Corrections)), its eigen solution (Eq. 9-11), the boundary conditions (Eq.
  * 12: no diffuse light enters either face), the collimated beam as a particular solution, and
  * the evaluation API the ray marcher and `ppslab` use.
  *

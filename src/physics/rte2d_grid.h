@@ -1,4 +1,4 @@
-/* rte2d_grid.h: the host numerics of `rte2d` (SPEC.md section 12): the source grid over the
+/* rte2d_grid.h: the host numerics of `rte2d` (reference: Methods): the source grid over the
  * cross-section, the direction cells it transports, the scattering that turns the cells' radiance
  * into the grid source, the starting field I_pp, and the energy the medium absorbs.
  *
@@ -56,7 +56,7 @@ int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, do
                         ppb_err *err);
 
 /* I_pp: at every lit node the cell field of its column's slab (sigma_t(x) H, alpha(x)) at
- * tau = D cos(theta_L) clamped to the slab (SPEC.md section 7, pp), 0 where unlit. */
+ * tau = D cos(theta_L) clamped to the slab (reference: Methods, pp), 0 where unlit. */
 int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, ppb_err *err);
 
 /* Scattered fluence at every node, phi[node] = sum over all 2N cells |Omega| I. */
