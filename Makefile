@@ -99,6 +99,14 @@ bench: $(BIN)
 perf: $(BIN)
 	@./ppbench perf
 
+# Scale-out end to end (issue 20), part of `make test`: GNU parallel, and a real one-node Slurm
+# cluster the script starts and stops (as root; otherwise that part is skipped, and says so).
+# 15 minutes at most, whatever happens.
+.PHONY: test-cluster
+test: test-cluster
+test-cluster: $(BIN)
+	@PPBENCH=$(CURDIR)/$(BIN) BUILD_DIR=$(CURDIR)/$(BUILD) timeout 900 bash tests/cluster.sh
+
 format:
 	clang-format -i src/*/*.c src/*/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
 

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Checks every dependency ppbench needs (Debian 12 packages) and installs the missing ones with
 # apt-get when run as root; otherwise prints the exact command and fails. Writes nothing else.
+# --cluster: only what tests/cluster.sh needs besides, a real Slurm cluster on this host
+# (slurm-wlm: slurmctld, slurmd, sbatch; munge: munged), never needed to build or run ppbench.
 set -euo pipefail
 
 # pkg-config module -> Debian package
@@ -16,6 +18,11 @@ declare -A FILES=(
   [/etc/OpenCL/vendors/pocl.icd]=pocl-opencl-icd
 )
 declare -A CMDS=([pkg-config]=pkg-config [gnuplot]=gnuplot-nox [parallel]=parallel [clinfo]=clinfo)
+if [ "${1:-}" = --cluster ]; then
+  declare -A PC=() FILES=()
+  declare -A CMDS=([slurmctld]=slurm-wlm [slurmd]=slurm-wlm [sbatch]=slurm-wlm [munged]=munge)
+  export PATH=$PATH:/usr/sbin:/sbin
+fi
 
 missing=()
 for c in "${!CMDS[@]}"; do command -v "$c" >/dev/null 2>&1 || missing+=("${CMDS[$c]}"); done

@@ -17,6 +17,7 @@
 #include "drivers/mc_shard.h"
 #include "drivers/perf.h"
 #include "drivers/report.h"
+#include "drivers/slurm.h"
 #include "drivers/sweep.h"
 #include "methods/registry.h"
 #include "model/config.h"
@@ -39,6 +40,12 @@ enum {
     OPT_JOBS = 1 << 4,
     OPT_YES = 1 << 5,
     OPT_QUIET = 1 << 6,
+    OPT_SHARDS = 1 << 7, /* slurm's: its job array and scripts (drivers/slurm.h) */
+    OPT_PARTITION = 1 << 8,
+    OPT_TIME = 1 << 9,
+    OPT_MEM = 1 << 10,
+    OPT_CPUS = 1 << 11,
+    OPT_SUBMIT = 1 << 12,
 };
 
 static const struct option_doc {
@@ -54,6 +61,17 @@ static const struct option_doc {
     {OPT_JOBS, "--jobs", "J", "sweep: J processes on this machine (1 to 64, default 1)"},
     {OPT_YES, "--yes", NULL, "sweep: allow a grid larger than the safety limit"},
     {OPT_QUIET, "--quiet", NULL, "no progress lines on stderr"},
+    {OPT_SHARDS, "--shards", "N",
+     "slurm: N array tasks, each one shard (1 to 1000; at most\nthe grid points or photons)"},
+    {OPT_PARTITION, "--partition", "P", "slurm: #SBATCH --partition (default: the cluster's)"},
+    {OPT_TIME, "--time", "T",
+     "slurm: #SBATCH --time per task and for the merge\n(minutes, "
+     "HH:MM:SS, D-HH:MM, ...; default: the partition's)"},
+    {OPT_MEM, "--mem", "M", "slurm: #SBATCH --mem per task (MB, or with K/M/G/T)"},
+    {OPT_CPUS, "--cpus", "C", "slurm: #SBATCH --cpus-per-task (1 to 4096)"},
+    {OPT_SUBMIT, "--submit", NULL,
+     "slurm: submit the shards neither done nor queued, and a\nmerge job after them (sbatch "
+     "--dependency=afterok)"},
 };
 enum { NOPTIONS = sizeof option_docs / sizeof option_docs[0] };
 
@@ -65,6 +83,8 @@ typedef struct cli {
     int quiet, yes;
     int shard_i, shard_n;
     int jobs;
+    int shards, cpus, submit; /* slurm's */
+    const char *partition, *time, *mem;
     const char **args;
     int nargs;
 } cli;
@@ -159,6 +179,27 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
             break;
         case OPT_YES:
             c->yes = 1;
+            break;
+        case OPT_SUBMIT:
+            c->submit = 1;
+            break;
+        case OPT_PARTITION:
+            c->partition = v;
+            break;
+        case OPT_TIME:
+            c->time = v;
+            break;
+        case OPT_MEM:
+            c->mem = v;
+            break;
+        case OPT_SHARDS:
+        case OPT_CPUS:
+            if (!parse_int(v, 1, o->bit == OPT_SHARDS ? PPB_SLURM_MAX_SHARDS : 4096,
+                           o->bit == OPT_SHARDS ? &c->shards : &c->cpus, '\0')) {
+                fprintf(stderr, "ppbench: %s %s: expected a whole number from 1 to %d\n", a, v,
+                        o->bit == OPT_SHARDS ? PPB_SLURM_MAX_SHARDS : 4096);
+                return EXIT_USAGE;
+            }
             break;
         case OPT_DEVICE:
             c->device = v;
@@ -527,6 +568,46 @@ static int cmd_mc_merge(const cli *c)
     return mc_shard_or_merge(c, 1);
 }
 
+/* `ppbench slurm`: the job array of a sweep or of one experiment's Monte Carlo
+ * (drivers/slurm.h); the config is loaded and checked here as by sweep and mc-shard. */
+static int cmd_slurm(const cli *c)
+{
+    if (c->nargs != 1 || !c->out || !c->shards) {
+        fprintf(stderr, "ppbench slurm: usage: ppbench slurm --shards N --out DIR [options] CONFIG "
+                        "(see ppbench slurm --help)\n");
+        return EXIT_USAGE;
+    }
+    ppb_grid *grid = ppb_grid_new();
+    if (!grid) {
+        fprintf(stderr, "ppbench: out of memory\n");
+        return EXIT_RUN;
+    }
+    ppb_config cfg;
+    ppb_err err = {{0}};
+    if (load_config(c, c->args[0], &cfg, grid, &err)) {
+        ppb_grid_free(grid);
+        return usage_error(&err);
+    }
+    int code = check_config_out(c, &cfg);
+    ppb_slurm_opts o = {.shards = c->shards,
+                        .partition = c->partition,
+                        .time = c->time,
+                        .mem = c->mem,
+                        .cpus = c->cpus,
+                        .device = c->device,
+                        .out = c->out,
+                        .submit = c->submit};
+    int rc = code ? 0 : ppb_slurm_run(&cfg, grid, &o, &err);
+    ppb_grid_free(grid);
+    if (code)
+        return code;
+    if (rc) {
+        fprintf(stderr, "ppbench slurm: %s\n", err.msg);
+        return rc == PPB_SLURM_BAD_CONFIG ? EXIT_USAGE : EXIT_RUN;
+    }
+    return EXIT_OK;
+}
+
 static int cmd_report(const cli *c)
 {
     if (c->nargs < 2) {
@@ -563,6 +644,14 @@ static const command commands[] = {
      "the whole budget",
      "ppbench mc-merge --out /tmp/mc configs/uniform_g0_normal.ini /tmp/p1 /tmp/p2",
      OPT_OUT | OPT_SET, 1, cmd_mc_merge},
+    {"slurm", "CONFIG", OPT_SHARDS | OPT_OUT,
+     "write a Slurm job array into --out DIR (job.sh: shard I\nof a sweep, or of one config's "
+     "Monte Carlo; merge.sh:\nits merge into DIR/result) and print the sbatch lines;\n--submit "
+     "submits the shards neither done nor queued",
+     "ppbench slurm --shards 4 --time 30 --out /scratch/sw --submit configs/sweep_example.ini",
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARDS | OPT_PARTITION | OPT_TIME | OPT_MEM | OPT_CPUS |
+         OPT_SUBMIT,
+     1, cmd_slurm},
     {"devices", NULL, 0, "list OpenCL devices (index: platform / device)",
      "PPBENCH_DEVICE=pthread ppbench devices", 0, 0, cmd_devices},
     {"keys", NULL, 0, "print every config key with its default and range", "ppbench keys", 0, 0,
