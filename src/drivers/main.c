@@ -19,6 +19,7 @@
 #include "drivers/report.h"
 #include "drivers/slurm.h"
 #include "drivers/sweep.h"
+#include "io/scene_json.h"
 #include "methods/registry.h"
 #include "model/config.h"
 #include "model/grid.h"
@@ -608,6 +609,30 @@ static int cmd_slurm(const cli *c)
     return EXIT_OK;
 }
 
+/* `ppbench scene CONFIG --out DIR`: DIR/scene.json, what an external method reads
+ * (io/scene_json.h; docs/external.md). */
+static int cmd_scene(const cli *c)
+{
+    if (c->nargs != 1) {
+        fprintf(stderr, "ppbench scene: usage: ppbench scene --out DIR CONFIG\n");
+        return EXIT_USAGE;
+    }
+    ppb_config cfg;
+    ppb_err err = {{0}};
+    if (load_config(c, c->args[0], &cfg, NULL, &err))
+        return usage_error(&err);
+    int code = check_config_out(c, &cfg);
+    if (code)
+        return code;
+    char path[PPB_PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/scene.json", cfg.out_dir);
+    if (ppb_mkdirs(cfg.out_dir, &err) || ppb_scene_json_write(&cfg, path, &err)) {
+        fprintf(stderr, "ppbench scene: %s\n", err.msg);
+        return EXIT_RUN;
+    }
+    return EXIT_OK;
+}
+
 static int cmd_report(const cli *c)
 {
     if (c->nargs < 2) {
@@ -644,6 +669,10 @@ static const command commands[] = {
      "the whole budget",
      "ppbench mc-merge --out /tmp/mc configs/uniform_g0_normal.ini /tmp/p1 /tmp/p2",
      OPT_OUT | OPT_SET, 1, cmd_mc_merge},
+    {"scene", "CONFIG", OPT_OUT,
+     "write --out DIR/scene.json: what an external method\nreads (docs/external.md)",
+     "ppbench scene --out /tmp/scene configs/uniform_g0_normal.ini", OPT_OUT | OPT_SET, 1,
+     cmd_scene},
     {"slurm", "CONFIG", OPT_SHARDS | OPT_OUT,
      "write a Slurm job array into --out DIR (job.sh: shard I\nof a sweep, or of one config's "
      "Monte Carlo; merge.sh:\nits merge into DIR/result) and print the sbatch lines;\n--submit "
