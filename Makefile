@@ -4,7 +4,7 @@
 # root, otherwise says which command to run).
 CC      ?= gcc
 BUILD   ?= build
-PKGS    := OpenCL lapacke openblas OpenEXR libpng inih libxxhash jansson
+PKGS    := OpenCL lapacke openblas OpenEXR libpng inih libxxhash
 OPT     ?= -O2 -g
 WARN    := -Wall -Wextra $(if $(WERROR),-Werror)
 SAN     ?=
@@ -73,7 +73,8 @@ $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
 unit: $(BIN) $(TESTS)
 	@mkdir -p $(BUILD)/tmp
 	@fail=0; for t in $(TESTS); do \
-	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
+	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) PPB_VERSION_FILE=$(CURDIR)/$(BUILD)/version.txt \
+	    TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
 	done; exit $$fail
 
 # The layer check first: it reads includes only and fails in a second. Then the reference's

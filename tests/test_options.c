@@ -176,10 +176,15 @@ static void test_version(void **state)
     (void)state;
     const char *bin = getenv("PPBENCH");
     char path[1200], version[256] = "", want[300];
-    snprintf(path, sizeof path, "%s", bin ? bin : "build/ppbench");
-    char *slash = strrchr(path, '/');
-    assert_non_null(slash);
-    snprintf(slash + 1, sizeof path - (size_t)(slash + 1 - path), "version.txt");
+    const char *file = getenv("PPB_VERSION_FILE"); /* make unit names it: $(BUILD)/version.txt */
+    if (file) {
+        snprintf(path, sizeof path, "%s", file);
+    } else { /* else beside the binary, as when BIN is inside the build directory */
+        snprintf(path, sizeof path, "%s", bin ? bin : "build/ppbench");
+        char *slash = strrchr(path, '/');
+        assert_non_null(slash);
+        snprintf(slash + 1, sizeof path - (size_t)(slash + 1 - path), "version.txt");
+    }
     FILE *f = fopen(path, "r");
     if (!f)
         fail_msg("cannot read %s (written by the build)", path);
