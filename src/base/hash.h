@@ -10,4 +10,12 @@
 
 uint64_t ppb_hash64(const void *data, size_t len);
 
+/* The same hash over data given in pieces (a file written or read in blocks): ppb_hash64_end
+ * returns what ppb_hash64 returns over the pieces' concatenation, and frees the state.
+ * ppb_hash64_begin returns NULL when out of memory. */
+typedef struct ppb_hasher ppb_hasher;
+ppb_hasher *ppb_hash64_begin(void);
+void ppb_hash64_update(ppb_hasher *h, const void *data, size_t len);
+uint64_t ppb_hash64_end(ppb_hasher *h);
+
 #endif

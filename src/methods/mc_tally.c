@@ -5,13 +5,17 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "base/atomic_file.h"
 #include "base/hash.h"
 
 /* Version 02: the fingerprint became base/hash.h's XXH3 (01 held FNV-1a), so a version 01 file
- * is refused as such instead of failing every merge with "different scenes". */
-static const char magic[8] = {'P', 'P', 'B', 'M', 'C', 'T', '0', '2'};
+ * is refused as such instead of failing every merge with "different scenes". Version 03: the
+ * header records the photon range the file holds (a merge refuses duplicates, overlaps and
+ * gaps) and a checksum ends the file (a flipped bit is refused). */
+static const char magic[8] = {'P', 'P', 'B', 'M', 'C', 'T', '0', '3'};
+enum { NHEAD = 8 };
 
 /* A hash (base/hash.h) of the canonical text of every setting that changes a photon's path or
  * its cell, so tallies from different scenes (or bin layouts) can never be merged by mistake. */
@@ -82,6 +86,17 @@ void ppb_mc_tallies_count_range(ppb_mc_tallies *t, uint64_t first, uint64_t coun
     }
 }
 
+int ppb_mc_tallies_range_matches(const ppb_mc_tallies *t)
+{
+    uint64_t nb = (uint64_t)t->batches;
+    for (uint64_t b = 0; b < nb; b++) {
+        uint64_t off = (b + nb - t->first % nb) % nb; /* as ppb_mc_tallies_count_range */
+        if (t->photons[b] != (off < t->count ? (t->count - off - 1) / nb + 1 : 0))
+            return 0;
+    }
+    return 1;
+}
+
 static int add_array(uint64_t *dst, const uint64_t *src, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
@@ -110,49 +125,111 @@ int ppb_mc_tallies_add(ppb_mc_tallies *dst, const ppb_mc_tallies *src, ppb_err *
     return 0;
 }
 
-/* Little-endian uint64 I/O, byte by byte, so the file is the same on every host. */
-static int put_u64s(FILE *f, const uint64_t *v, size_t n)
+/* Little-endian uint64 I/O in blocks, so the file is the same on every host; every byte
+ * written or read before the checksum goes through the hasher. */
+enum { BLOCK = 4096 };
+
+typedef struct tally_io {
+    FILE *f;
+    ppb_hasher *h;
+} tally_io;
+
+static int put_bytes(tally_io *io, const void *b, size_t n)
 {
-    unsigned char b[8];
-    for (size_t i = 0; i < n; i++) {
-        for (int k = 0; k < 8; k++)
-            b[k] = (unsigned char)(v[i] >> (8 * k));
-        if (fwrite(b, 1, 8, f) != 8)
+    ppb_hash64_update(io->h, b, n);
+    return fwrite(b, 1, n, io->f) == n ? 0 : -1;
+}
+
+static int put_u64s(tally_io *io, const uint64_t *v, size_t n)
+{
+    unsigned char b[8 * BLOCK];
+    while (n > 0) {
+        size_t k = n < BLOCK ? n : BLOCK;
+        for (size_t i = 0; i < k; i++)
+            for (int j = 0; j < 8; j++)
+                b[8 * i + (size_t)j] = (unsigned char)(v[i] >> (8 * j));
+        if (put_bytes(io, b, 8 * k))
             return -1;
+        v += k, n -= k;
     }
     return 0;
 }
 
-static int get_u64s(FILE *f, uint64_t *v, size_t n)
+static int get_u64s(tally_io *io, uint64_t *v, size_t n)
 {
-    unsigned char b[8];
-    for (size_t i = 0; i < n; i++) {
-        if (fread(b, 1, 8, f) != 8)
+    unsigned char b[8 * BLOCK];
+    while (n > 0) {
+        size_t k = n < BLOCK ? n : BLOCK;
+        if (fread(b, 1, 8 * k, io->f) != 8 * k)
             return -1;
-        uint64_t x = 0;
-        for (int k = 0; k < 8; k++)
-            x |= (uint64_t)b[k] << (8 * k);
-        v[i] = x;
+        for (size_t i = 0; i < k; i++) {
+            uint64_t x = 0;
+            for (int j = 0; j < 8; j++)
+                x |= (uint64_t)b[8 * i + (size_t)j] << (8 * j);
+            v[i] = x;
+        }
+        v += k, n -= k;
     }
     return 0;
 }
 
 int ppb_mc_tallies_save(const ppb_mc_tallies *t, const char *path, ppb_err *err)
 {
+    tally_io io = {NULL, ppb_hash64_begin()};
+    if (!io.h)
+        return ppb_fail(err, "%s: out of memory for the checksum", path);
     ppb_afile af;
-    if (ppb_afile_open(&af, path, err))
+    if (ppb_afile_open(&af, path, err)) {
+        ppb_hash64_end(io.h);
         return -1;
-    FILE *f = af.f;
-    uint64_t head[4] = {t->fingerprint, t->seed, (uint64_t)t->batches, (uint64_t)t->ncells};
+    }
+    io.f = af.f;
+    uint64_t head[NHEAD] = {t->fingerprint,
+                            t->seed,
+                            (uint64_t)t->batches,
+                            (uint64_t)t->ncells,
+                            t->budget_first,
+                            t->budget_photons,
+                            t->first,
+                            t->count};
     size_t nb = (size_t)t->batches;
-    int bad = fwrite(magic, 1, sizeof magic, f) != sizeof magic || put_u64s(f, head, 4) ||
-              put_u64s(f, t->photons, nb) || put_u64s(f, t->totals, nb * PPB_MC_NTOT) ||
-              put_u64s(f, t->cells, nb * PPB_MC_NTALLY * t->ncells);
+    int bad = put_bytes(&io, magic, sizeof magic) || put_u64s(&io, head, NHEAD) ||
+              put_u64s(&io, t->photons, nb) || put_u64s(&io, t->totals, nb * PPB_MC_NTOT) ||
+              put_u64s(&io, t->cells, nb * PPB_MC_NTALLY * t->ncells);
+    uint64_t sum = ppb_hash64_end(io.h);
+    unsigned char b[8];
+    for (int j = 0; j < 8; j++)
+        b[j] = (unsigned char)(sum >> (8 * j));
+    bad = bad || fwrite(b, 1, 8, af.f) != 8;
     if (bad) {
+        int e = errno;
         ppb_afile_abort(&af);
-        return ppb_fail(err, "%s: write failed: %s", path, strerror(errno));
+        return ppb_fail(err, "%s: write failed: %s", path, strerror(e));
     }
     return ppb_afile_commit(&af, err);
+}
+
+/* Whether the last 8 bytes of the size-byte file f are the hash of the bytes before them. */
+static int checksum_ok(FILE *f, long long size)
+{
+    ppb_hasher *h = ppb_hash64_begin();
+    if (!h)
+        return -1;
+    unsigned char b[8 * BLOCK];
+    long long left = size - 8;
+    while (left > 0) {
+        size_t k = left < (long long)sizeof b ? (size_t)left : sizeof b;
+        if (fread(b, 1, k, f) != k)
+            break;
+        ppb_hash64_update(h, b, k);
+        left -= (long long)k;
+    }
+    uint64_t sum = ppb_hash64_end(h), stored = 0;
+    if (left > 0 || fread(b, 1, 8, f) != 8)
+        return 0;
+    for (int j = 0; j < 8; j++)
+        stored |= (uint64_t)b[j] << (8 * j);
+    return stored == sum;
 }
 
 int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
@@ -161,9 +238,10 @@ int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
     FILE *f = fopen(path, "rb");
     if (!f)
         return ppb_fail(err, "%s: cannot read: %s", path, strerror(errno));
+    struct stat st;
     char m[8];
-    uint64_t head[4];
-    if (fread(m, 1, sizeof m, f) != sizeof m || memcmp(m, magic, 6) != 0 || get_u64s(f, head, 4)) {
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode) ||
+        fread(m, 1, sizeof m, f) != sizeof m || memcmp(m, magic, 6) != 0) {
         fclose(f);
         return ppb_fail(err, "%s: not a ppbench Monte Carlo tally file", path);
     }
@@ -172,6 +250,26 @@ int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
         return ppb_fail(err,
                         "%s: tally file version %.2s, this ppbench reads %.2s: run the shard again",
                         path, m + 6, magic + 6);
+    }
+    /* The checksum first, over the whole file: whatever bit is flipped (a header field
+     * included), the file is refused as corrupt, never misread. */
+    long long size = (long long)st.st_size;
+    int ok = size >= (long long)(sizeof magic + 8 * (NHEAD + 1)) && fseek(f, 0, SEEK_SET) == 0
+                 ? checksum_ok(f, size)
+                 : 0;
+    if (ok <= 0) {
+        fclose(f);
+        return ok < 0 ? ppb_fail(err, "%s: out of memory for the checksum", path)
+                      : ppb_fail(err,
+                                 "%s: corrupt or truncated tally file (its checksum does not "
+                                 "match): copy it again or run the shard again",
+                                 path);
+    }
+    tally_io io = {f, NULL};
+    uint64_t head[NHEAD];
+    if (fseek(f, (long)sizeof magic, SEEK_SET) != 0 || get_u64s(&io, head, NHEAD)) {
+        fclose(f);
+        return ppb_fail(err, "%s: cannot read the header", path);
     }
     if (head[2] < 1 || head[2] > (1u << 20) || head[3] > ((uint64_t)1 << 32)) {
         fclose(f);
@@ -182,30 +280,67 @@ int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
     t->seed = head[1];
     t->batches = (int)head[2];
     t->ncells = (size_t)head[3];
+    t->budget_first = head[4];
+    t->budget_photons = head[5];
+    t->first = head[6];
+    t->count = head[7];
+    size_t nb = (size_t)t->batches;
+    double want = 8.0 * ((double)(1 + NHEAD + 1) + (double)nb * (1 + PPB_MC_NTOT) +
+                         (double)nb * PPB_MC_NTALLY * (double)t->ncells);
+    if ((double)size != want) {
+        fclose(f);
+        return ppb_fail(err, "%s: %lld bytes, its header implies %.0f: not a tally file", path,
+                        size, want);
+    }
     if (alloc_arrays(t, err)) {
         fclose(f);
         return -1;
     }
-    size_t nb = (size_t)t->batches;
-    int bad = get_u64s(f, t->photons, nb) || get_u64s(f, t->totals, nb * PPB_MC_NTOT) ||
-              get_u64s(f, t->cells, nb * PPB_MC_NTALLY * t->ncells) || fgetc(f) != EOF;
+    int bad = get_u64s(&io, t->photons, nb) || get_u64s(&io, t->totals, nb * PPB_MC_NTOT) ||
+              get_u64s(&io, t->cells, nb * PPB_MC_NTALLY * t->ncells);
     fclose(f);
     if (bad) {
         ppb_mc_tallies_free(t);
-        return ppb_fail(err, "%s: truncated or oversized tally file", path);
+        return ppb_fail(err, "%s: truncated tally file", path);
     }
     return 0;
 }
 
-/* Mean and standard error of per-photon quantities whose batch b sums are sum(b) (in units of
- * the fixed-point scale): the mean over all photons, and the standard error from the spread of
- * the batch means (batches with no photons are skipped). */
+/* Mean and standard error of per-photon quantities whose batch b sums are value(b) (in units
+ * of the fixed-point scale): the mean over all photons, and the standard error from the spread
+ * of the batch means (batches with no photons are skipped). A series is either one tally per
+ * batch (base[b * stride]) or, with surf_mask set, the sum of the once/all-scattered cells of
+ * the surfaces in the mask, summed again on each visit: no scratch memory, so the totals cannot
+ * fail. The integers are exact, so summing again changes no bit. */
 typedef struct batch_stat {
     double mean, se;
 } batch_stat;
 
-static batch_stat batch_mean(const ppb_mc_tallies *t, const uint64_t *base, size_t stride,
-                             double scale)
+typedef struct series {
+    const uint64_t *base;
+    size_t stride;
+    const ppb_layout *lo;
+    int once, surf_mask;
+} series;
+
+static uint64_t series_at(const ppb_mc_tallies *t, const series *sr, size_t b)
+{
+    if (!sr->surf_mask)
+        return sr->base[b * sr->stride];
+    const uint64_t *c =
+        t->cells + b * (size_t)PPB_MC_NTALLY * t->ncells + (size_t)(sr->once ? 1 : 0) * t->ncells;
+    uint64_t sum = 0;
+    for (int s = 0; s < sr->lo->nsurf; s++) {
+        if (!(sr->surf_mask & (1 << s)))
+            continue;
+        size_t i0 = ppb_cell(sr->lo, s, 0, 0), i1 = i0 + (size_t)sr->lo->nseg[s] * sr->lo->nbins;
+        for (size_t i = i0; i < i1; i++)
+            sum += c[i];
+    }
+    return sum;
+}
+
+static batch_stat batch_mean_of(const ppb_mc_tallies *t, const series *sr, double scale)
 {
     batch_stat st = {0, 0};
     uint64_t n = 0;
@@ -214,7 +349,7 @@ static batch_stat batch_mean(const ppb_mc_tallies *t, const uint64_t *base, size
     for (int b = 0; b < t->batches; b++) {
         if (!t->photons[b])
             continue;
-        sum += (double)base[(size_t)b * stride];
+        sum += (double)series_at(t, sr, (size_t)b);
         n += t->photons[b];
         used++;
     }
@@ -227,11 +362,18 @@ static batch_stat batch_mean(const ppb_mc_tallies *t, const uint64_t *base, size
     for (int b = 0; b < t->batches; b++) {
         if (!t->photons[b])
             continue;
-        double mb = (double)base[(size_t)b * stride] * scale / (double)t->photons[b];
+        double mb = (double)series_at(t, sr, (size_t)b) * scale / (double)t->photons[b];
         ss += (mb - st.mean) * (mb - st.mean);
     }
     st.se = sqrt(ss / ((double)used * (double)(used - 1)));
     return st;
+}
+
+static batch_stat batch_mean(const ppb_mc_tallies *t, const uint64_t *base, size_t stride,
+                             double scale)
+{
+    series sr = {base, stride, NULL, 0, 0};
+    return batch_mean_of(t, &sr, scale);
 }
 
 void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int once,
@@ -241,26 +383,12 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
     const double unit = 1.0 / PPB_MC_FIXED_SCALE;
     ppb_layout lo = ppb_scene_layout(sc);
     size_t nb = (size_t)t->batches;
-    size_t tstride = (size_t)PPB_MC_NTALLY * t->ncells;
     /* Per-batch sums of each surface (integers, exact), then the batch statistics. */
-    uint64_t *surf = calloc(nb * PPB_NSURF, sizeof *surf);
-    uint64_t *sides = calloc(nb, sizeof *sides);
-    if (!surf || !sides) {
-        free(surf), free(sides);
-        return;
-    }
-    for (size_t b = 0; b < nb; b++) {
-        const uint64_t *c = t->cells + b * tstride + (size_t)(once ? 1 : 0) * t->ncells;
-        for (int s = 0; s < lo.nsurf; s++) {
-            size_t i0 = ppb_cell(&lo, s, 0, 0), i1 = i0 + (size_t)lo.nseg[s] * lo.nbins;
-            for (size_t i = i0; i < i1; i++)
-                surf[b * PPB_NSURF + (size_t)s] += c[i];
-        }
-        sides[b] = surf[b * PPB_NSURF + PPB_S3] + surf[b * PPB_NSURF + PPB_S4];
-    }
-    batch_stat R = batch_mean(t, surf + PPB_S1, PPB_NSURF, unit);
-    batch_stat T = batch_mean(t, surf + PPB_S2, PPB_NSURF, unit);
-    batch_stat S = batch_mean(t, sides, 1, unit);
+    series sr1 = {NULL, 0, &lo, once, 1 << PPB_S1}, sr2 = {NULL, 0, &lo, once, 1 << PPB_S2};
+    series srs = {NULL, 0, &lo, once, (1 << PPB_S3) | (1 << PPB_S4)};
+    batch_stat R = batch_mean_of(t, &sr1, unit);
+    batch_stat T = batch_mean_of(t, &sr2, unit);
+    batch_stat S = batch_mean_of(t, &srs, unit);
     batch_stat B = batch_mean(t, t->totals + PPB_MC_T_BALLISTIC, PPB_MC_NTOT, unit);
     batch_stat C = batch_mean(t, t->totals + PPB_MC_T_CAPTURE, PPB_MC_NTOT, unit);
     batch_stat E = batch_mean(t, t->totals + PPB_MC_T_EVENTS, PPB_MC_NTOT, 1.0);
@@ -299,7 +427,6 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
         st->se.absorbed = dof > 0 ? sqrt(ss_abs / dof) : 0;
         st->mean.absorbed_tracked = 1;
     }
-    free(surf), free(sides);
 }
 
 static void cells_to_result(const ppb_mc_tallies *t, const ppb_scene *sc, int once, ppb_result *r)

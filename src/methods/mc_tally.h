@@ -19,6 +19,11 @@
 typedef struct ppb_mc_tallies {
     uint64_t fingerprint; /* hash of the scene and bin settings: merges refuse a mismatch */
     uint64_t seed;
+    /* The photons these tallies hold, for a shard's file: [first, first + count) of the run's
+     * budget [budget_first, budget_first + budget_photons), photon indices as ppb_mc_trace
+     * takes them. Zero (unknown) unless the caller sets them; a merge checks that its files'
+     * ranges tile the budget (drivers/mc_shard.c). */
+    uint64_t budget_first, budget_photons, first, count;
     int batches;
     size_t ncells;
     uint64_t *photons; /* [batches]: photons traced in each batch */
@@ -40,13 +45,20 @@ uint64_t ppb_mc_tallies_photons(const ppb_mc_tallies *t);
 /* Records photons [first, first + count) as traced: adds them to their batches (i % batches). */
 void ppb_mc_tallies_count_range(ppb_mc_tallies *t, uint64_t first, uint64_t count);
 
+/* Whether the photons per batch are those of the range [first, first + count): 1 or 0. */
+int ppb_mc_tallies_range_matches(const ppb_mc_tallies *t);
+
 /* dst += src, refusing tallies of another scene, seed or batch count, and overflow. */
 int ppb_mc_tallies_add(ppb_mc_tallies *dst, const ppb_mc_tallies *src, ppb_err *err);
 
-/* Binary file: magic "PPBMCT02", then the header fields and the arrays as little-endian
- * uint64. Written atomically (base/atomic_file.h), so a kill never leaves half a file. */
+/* Binary file, every number a little-endian uint64: the magic "PPBMCT03"; the header
+ * (fingerprint, seed, batches, ncells, budget_first, budget_photons, first, count); photons
+ * [batches]; totals [batches][PPB_MC_NTOT]; cells [batches][PPB_MC_NTALLY][ncells]; last the
+ * checksum, ppb_hash64 (base/hash.h) of every byte before it. Written atomically
+ * (base/atomic_file.h), so a kill never leaves half a file. */
 int ppb_mc_tallies_save(const ppb_mc_tallies *t, const char *path, ppb_err *err);
-/* Loads into an uninitialised t (allocates). */
+/* Loads into an uninitialised t (allocates). Refuses, naming path, a file of another version,
+ * a truncated or oversized one and one whose checksum does not match (a flipped bit). */
 int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err);
 
 /* Radiance (1/sr per E_perp) and standard error per cell, and totals, of mc (all scattered
@@ -64,6 +76,8 @@ typedef struct ppb_mc_totals_stats {
     double capture, capture_se; /* implicit capture alone */
     double events_per_photon;
 } ppb_mc_totals_stats;
+/* Allocates nothing, so it cannot fail (it once returned zeroed statistics, silently, when a
+ * scratch allocation failed). */
 void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int once,
                            ppb_mc_totals_stats *st);
 
