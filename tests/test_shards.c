@@ -1,10 +1,17 @@
-/* test_shards.c: issue 14's Monte Carlo shard defects, each through the built binary
+/* test_shards.c: issue 14's sweep and Monte Carlo shard defects, each through the built binary
  * ($PPBENCH) unless it is a library function's, every one failing on the code before its fix:
+ * - sweep --jobs 2: killed with -9, its workers die too (they ran on as orphans); interrupted
+ *   (SIGINT to its process group as a Ctrl-C sends it, or to the parent alone), it exits 130
+ *   saying how many points were done (it exited 1, "1 of 2 jobs failed");
+ * - a sweep re-run into its directory with a value or an axis added gives the sweep.csv of a
+ *   fresh run of the grown grid (expected: that run's bytes; the point column was wrong and the
+ *   rows ragged);
+ * - merge refuses shards of another grid (value order, settings, keys), exit 2 naming the shard;
  * - mc-merge refuses duplicated, overlapping and missing photon ranges naming the files, a
  *   tally file with one flipped bit, and names the shard of another scene in an exact message;
  *   an interrupted mc-shard exits 130 and leaves no file;
  * - ppb_mc_tallies_totals gives the true statistics when memory is exhausted (it gave zeros).
- * Photon budgets are tiny; the slow config exists only to be interrupted. */
+ * Grids and photon budgets are tiny; the slow configs exist only to be interrupted. */
 #include "cliutil.h"
 
 #include <math.h>
@@ -57,6 +64,15 @@ static char *read_text(const char *path)
  * shows every check that fails (on the code before the fixes: all of them). */
 static int failures;
 
+static void same_bytes(const char *a, const char *b)
+{
+    if (sh("cmp -s '%s' '%s'", a, b) != 0) {
+        sh("diff '%s' '%s' | head -8 >&2", a, b);
+        print_error("FAIL: %s and %s differ\n", a, b);
+        failures++;
+    }
+}
+
 static void expect(const char *args, int code, const char *needle)
 {
     int rc = cli_run_env("", args, cli_out, sizeof cli_out);
@@ -83,11 +99,161 @@ static void end_checks(void)
         fail_msg("%d check(s) failed (above)", n);
 }
 
+/* Two points whose Monte Carlo never ends in a test's time: there only to be interrupted. */
+static const char *slow_sweep = "[experiment]\nmethods = mc\n[tube]\nsegments_top = 4\n"
+                                "segments_side = 2\n[bins]\ntheta = 2\nphi = 2\n"
+                                "[medium]\ng = 0, 0.5\n[mc]\nphotons = 2000000000\nbatches = 4\n";
+
+/* Starts `sweep --jobs 2` of the slow config (under `wrap`: "" or "setsid", which makes it a
+ * process group of its own, so a signal to the group reaches nobody else), waits for its two
+ * workers and a second more, then runs `then` (shell text seeing $pid and $kids); its exit code.
+ * The workers still alive at the end are killed, whatever happened, so a failing run leaves no
+ * orphan behind. */
+static int jobs_then(const char *d, const char *cfg, const char *name, const char *wrap,
+                     const char *then)
+{
+    return sh("%s %s sweep --quiet --jobs 2 --out %s/%s %s > %s/%s.log 2>&1 & pid=$!; i=0; "
+              "while [ $(ps -o pid= --ppid $pid | wc -l) -lt 2 ]; do i=$((i + 1)); "
+              "[ $i -gt 600 ] && { kill -9 $pid; exit 90; }; sleep 0.05; done; "
+              "kids=$(ps -o pid= --ppid $pid); sleep 1; %s; rc=$?; kill -9 $kids 2>/dev/null; "
+              "exit $rc",
+              wrap, bin(), d, name, cfg, d, name, then);
+}
+
+/* Shell text: exit 0 once no pid of $kids is alive (a zombie is dead), 1 after 20 s. */
+#define KIDS_GONE                                                                                  \
+    "i=0; while :; do alive=0; for k in $kids; do ps -o stat= -p $k | grep -qv Z && alive=1; "     \
+    "done; [ $alive = 0 ] && exit 0; i=$((i + 1)); [ $i -gt 400 ] && exit 1; sleep 0.05; done"
+
 /* Shell text: waits for $pid (a zombie has ended), its exit code; after 30 s kills it (137). */
 #define WAIT_PID                                                                                   \
     "i=0; while ps -o stat= -p $pid | grep -qv Z && [ $i -lt 600 ]; do i=$((i + 1)); "             \
     "sleep 0.05; done; "                                                                           \
     "kill -9 $pid 2>/dev/null; wait $pid"
+
+static void test_jobs_die_with_sweep(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("shards-orphans");
+    char cfg[1200];
+    snprintf(cfg, sizeof cfg, "%s/slow.ini", d);
+    write_file(cfg, slow_sweep);
+    /* kill -9 of the sweep: its workers must be gone within 20 s (before: they ran on). */
+    int rc = jobs_then(d, cfg, "k9", "", "kill -9 $pid; wait $pid; (" KIDS_GONE ")");
+    if (rc != 0)
+        fail_msg("after kill -9 of sweep --jobs 2 its workers still ran 20 s later (rc %d)", rc);
+}
+
+static void test_jobs_interrupted_exit_130(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("shards-sigint");
+    char cfg[1200];
+    snprintf(cfg, sizeof cfg, "%s/slow.ini", d);
+    write_file(cfg, slow_sweep);
+    /* A Ctrl-C: SIGINT to the whole process group. setsid makes the sweep a group leader. */
+    const char *kinds[2] = {"group", "parent"};
+    const char *sig[2] = {"kill -INT -$pid", "kill -INT $pid"};
+    for (int k = 0; k < 2; k++) {
+        char then[512], log[1300];
+        snprintf(then, sizeof then, "%s; " WAIT_PID "; code=$?; (" KIDS_GONE ") && exit $code",
+                 sig[k]);
+        char out[64];
+        snprintf(out, sizeof out, "int_%s", kinds[k]);
+        int rc = jobs_then(d, cfg, out, "setsid", then);
+        snprintf(log, sizeof log, "%s/%s.log", d, out);
+        const char *text = read_text(log);
+        if (rc != 130 || !strstr(text, "interrupted: 0 of 2 points done"))
+            fail_msg("SIGINT to the %s of sweep --jobs 2: exit %d (want 130 and 'interrupted: 0 "
+                     "of 2 points done'):\n%s",
+                     kinds[k], rc, text);
+        if (sh("test ! -e %s/%s/sweep.csv", d, out) != 0)
+            fail_msg("an interrupted sweep wrote sweep.csv");
+    }
+}
+
+/* A deterministic method only (mp), so each grid is cheap and its bytes reproducible. */
+static const char *grid_cfg(const char *g, const char *extra)
+{
+    static char text[1024];
+    snprintf(text, sizeof text,
+             "[experiment]\nname = grow\nmethods = mp\n[tube]\nsegments_top = 8\n"
+             "segments_side = 4\n[bins]\ntheta = 2\nphi = 2\n[medium]\ng = %s\n%s[mp]\npairs = 2\n",
+             g, extra);
+    return text;
+}
+
+static void test_grown_grid_reuses_points(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("shards-grow");
+    const char *b = bin();
+    struct {
+        const char *name, *g, *extra;
+    } steps[] = {
+        {"a", "0, 0.5", ""},
+        {"b", "0, 0.25, 0.5", ""},                     /* a value added between the others */
+        {"c", "0, 0.25, 0.5", "albedo = 0.95, 0.5\n"}, /* an axis (0.95: the default) */
+    };
+    for (int s = 0; s < 3; s++) {
+        char cfg[1200], grown[1300], fresh[1300];
+        snprintf(cfg, sizeof cfg, "%s/%s.ini", d, steps[s].name);
+        write_file(cfg, grid_cfg(steps[s].g, steps[s].extra));
+        /* The same directory each time (the grown grid reuses the finished points), and a fresh
+         * one: the expected bytes. */
+        assert_int_equal(sh("%s sweep --quiet --out %s/same %s", b, d, cfg), 0);
+        assert_int_equal(sh("%s sweep --quiet --out %s/fresh_%s %s", b, d, steps[s].name, cfg), 0);
+        snprintf(grown, sizeof grown, "%s/same/sweep.csv", d);
+        snprintf(fresh, sizeof fresh, "%s/fresh_%s/sweep.csv", d, steps[s].name);
+        same_bytes(grown, fresh);
+    }
+    /* The last grid: 3 x 2 points, one mp row each, every row as long as the header. */
+    expect_sh(sh("test $(wc -l < %s/same/sweep.csv) -eq 7", d) == 0, "7 lines in sweep.csv");
+    expect_sh(sh("test $(awk -F, '{print NF}' %s/same/sweep.csv | sort -u | wc -l) -eq 1", d) == 0,
+              "every row of sweep.csv has the header's fields");
+    end_checks();
+}
+
+static void test_merge_refuses_other_grids(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("shards-mergegrid");
+    const char *b = bin();
+    struct {
+        const char *name, *g, *extra;
+    } cfgs[] = {
+        {"base", "0, 0.5", ""},
+        {"order", "0.5, 0", ""},               /* the same values in another order */
+        {"other", "0, 0.5", "albedo = 0.9\n"}, /* the same grid, another setting */
+        {"keys", "0, 0.5", "albedo = 0.5, 0.9\n"},
+    };
+    for (int c = 0; c < 4; c++) {
+        char cfg[1200];
+        snprintf(cfg, sizeof cfg, "%s/%s.ini", d, cfgs[c].name);
+        write_file(cfg, grid_cfg(cfgs[c].g, cfgs[c].extra));
+        for (int s = 1; s <= 2; s++)
+            assert_int_equal(
+                sh("%s sweep --quiet --shard %d/2 --out %s/%s%d %s", b, s, d, cfgs[c].name, s, cfg),
+                0);
+    }
+    /* Shards of one grid merge (the control). */
+    char args[4096];
+    snprintf(args, sizeof args, "merge --out %s/ok %s/base1 %s/base2", d, d, d);
+    expect(args, 0, "");
+    const char *why[] = {"", "other values or another value order",
+                         "the same points hold other settings", "other swept keys"};
+    for (int c = 1; c < 4; c++) {
+        char needle[4096];
+        snprintf(args, sizeof args, "merge --out %s/bad%d %s/base1 %s/%s2", d, c, d, d,
+                 cfgs[c].name);
+        snprintf(needle, sizeof needle, "%s/%s2: its grid differs from %s/base1's (%s", d,
+                 cfgs[c].name, d, why[c]);
+        expect(args, 2, needle);
+        expect_sh(sh("test ! -e %s/bad%d/sweep.csv", d, c) == 0,
+                  "no sweep.csv from a refused merge");
+    }
+    end_checks();
+}
 
 /* A tiny Monte Carlo: the tests are about bookkeeping, not physics. */
 static const char *mc_cfg(const char *albedo)
@@ -276,8 +442,12 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_totals_without_memory),
+        cmocka_unit_test(test_grown_grid_reuses_points),
+        cmocka_unit_test(test_merge_refuses_other_grids),
         cmocka_unit_test(test_mc_merge_checks_shards),
         cmocka_unit_test(test_mc_shard_interrupted_130),
+        cmocka_unit_test(test_jobs_die_with_sweep),
+        cmocka_unit_test(test_jobs_interrupted_exit_130),
     };
     if (getenv("SHARDS_TEST")) /* one test by name (or a cmocka pattern) */
         cmocka_set_test_filter(getenv("SHARDS_TEST"));

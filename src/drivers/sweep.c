@@ -2,11 +2,14 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "base/atomic_file.h"
@@ -35,6 +38,15 @@ static uint64_t point_hash(const ppb_config *pt)
     return h;
 }
 
+/* A point's files hold only what the point's settings determine: points/<hash>.rows.csv its
+ * rows from the method on (method, RMS, noise, totals), points/<hash>.seconds its wall time.
+ * The point index and the swept values are the grid's, not the point's: they are prefixed when
+ * sweep.csv is assembled, from the grid of that run (grid.txt), so a grid grown by a value or an
+ * axis reuses its finished points under their new index and columns. (Files of the earlier
+ * form, points/<hash>.csv, carried both and are not read: such points are computed again.) */
+#define ROWS_EXT    "rows.csv"
+#define SECONDS_EXT "seconds"
+
 static void point_file(const char *dir, uint64_t h, const char *ext, char *buf, size_t n)
 {
     snprintf(buf, n, "%s/points/%016llx.%s", dir, (unsigned long long)h, ext);
@@ -60,23 +72,23 @@ static void write_header(const ppb_grid *grid, FILE *f)
     fprintf(f, ",noise_R_x0,noise_T_x0,R,T,sides,absorbed,ballistic\n");
 }
 
-/* One row per method of a point: its parameters, the RMS per summary cell against the Monte
- * Carlo (empty without one), the noise floor at x = 0 and the totals. */
-static void write_rows(const ppb_grid *grid, const ppb_config *pt, long long i,
-                       const ppb_experiment *ex, FILE *f)
+/* One row per method of a point, from the method on: the RMS per summary cell against the
+ * Monte Carlo (empty without one), the noise floor at x = 0 and the totals. */
+static int write_rows(const ppb_experiment *ex, FILE *f, ppb_err *err)
 {
     const ppb_result *ref = ppb_experiment_reference(ex);
     const ppb_layout *lo = &ex->res[0].layout;
     int cap = lo->nseg[PPB_S1] > lo->nseg[PPB_S3] ? lo->nseg[PPB_S1] : lo->nseg[PPB_S3];
-    ppb_point *pts = malloc(sizeof *pts * (size_t)(cap > 2 ? cap : 2));
+    if (cap < 2)
+        cap = 2;
+    ppb_point *pts = malloc(sizeof *pts * (size_t)cap);
+    if (!pts)
+        return ppb_fail(err, "sweep: out of memory for %d cell points", cap);
     for (int m = 0; m < ex->n; m++) {
-        fprintf(f, "%lld", i);
-        for (int a = 0; a < grid->naxes; a++)
-            fprintf(f, ",%.10g", ppb_config_key_value(pt, grid->axes[a].key));
-        fprintf(f, ",%s", ex->res[m].method);
+        fprintf(f, "%s", ex->res[m].method);
         ppb_rms x0[2] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
         for (int c = 0; c < PPB_NCELLS; c++) {
-            int np = ref ? ppb_cell_points(lo, c, pts, cap > 2 ? cap : 2) : 0;
+            int np = ref ? ppb_cell_points(lo, c, pts, cap) : 0;
             ppb_rms e = {NAN, NAN, NAN};
             if (np > 0 && &ex->res[m] != ref)
                 e = ppb_rms_points(&ex->res[m], ref, pts, np);
@@ -90,27 +102,35 @@ static void write_rows(const ppb_grid *grid, const ppb_config *pt, long long i,
                 t.R, t.T, t.sides, t.absorbed, t.ballistic);
     }
     free(pts);
+    return 0;
 }
 
-static int run_point(const ppb_config *cfg, const ppb_grid *grid, const ppb_config *pt, long long i,
-                     ppb_run_ctx *ctx, ppb_err *err)
+/* Computes one point and writes its files. An interrupted point writes nothing and is no
+ * failure: the sweep stops and a re-run computes it. */
+static int run_point(const ppb_config *cfg, const ppb_config *pt, uint64_t h, ppb_run_ctx *ctx,
+                     ppb_err *err)
 {
     ppb_experiment ex = {0};
     double t0 = ppb_now();
     int rc = ppb_experiment_compute(&ex, pt, ctx, err);
-    if (rc == 0 && !ex.partial) {
+    if (ppb_interrupted() || ex.partial) {
+        ppb_experiment_free(&ex);
+        return 0;
+    }
+    if (rc == 0) {
         char path[1300];
-        uint64_t h = point_hash(pt);
         ppb_afile af;
-        point_file(cfg->out_dir, h, "time", path, sizeof path);
+        point_file(cfg->out_dir, h, SECONDS_EXT, path, sizeof path);
         if ((rc = ppb_afile_open(&af, path, err)) == 0) {
-            fprintf(af.f, "%lld,%.4f\n", i, ppb_now() - t0);
+            fprintf(af.f, "%.4f\n", ppb_now() - t0);
             rc = ppb_afile_commit(&af, err);
         }
-        point_file(cfg->out_dir, h, "csv", path, sizeof path);
+        point_file(cfg->out_dir, h, ROWS_EXT, path, sizeof path);
         if (rc == 0 && (rc = ppb_afile_open(&af, path, err)) == 0) {
-            write_rows(grid, pt, i, &ex, af.f);
-            rc = ppb_afile_commit(&af, err);
+            if ((rc = write_rows(&ex, af.f, err)) != 0)
+                ppb_afile_abort(&af);
+            else
+                rc = ppb_afile_commit(&af, err);
         }
     }
     ppb_experiment_free(&ex);
@@ -135,8 +155,10 @@ static int check_grid(const ppb_config *cfg, const ppb_grid *grid, const ppb_swe
     return 0;
 }
 
-/* grid.txt: the header of sweep.csv, then each point's hash in grid order; merge reads it. */
-static int write_grid(const ppb_config *cfg, const ppb_grid *grid, ppb_err *err)
+/* grid.txt: the header of sweep.csv, then one record per point in grid order: its hash and
+ * its swept values as sweep.csv prints them. merge reads it, and refuses shards whose grid.txt
+ * differ (another grid, another order, other settings). hashes[n] receives the hashes. */
+static int write_grid(const ppb_config *cfg, const ppb_grid *grid, uint64_t *hashes, ppb_err *err)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/grid.txt", cfg->out_dir);
@@ -147,20 +169,26 @@ static int write_grid(const ppb_config *cfg, const ppb_grid *grid, ppb_err *err)
     ppb_config pt;
     for (long long i = 0; i < ppb_grid_npoints(grid); i++) {
         ppb_config_point(cfg, grid, i, &pt, NULL);
-        fprintf(af.f, "%016llx\n", (unsigned long long)point_hash(&pt));
+        hashes[i] = point_hash(&pt);
+        fprintf(af.f, "%016llx", (unsigned long long)hashes[i]);
+        for (int a = 0; a < grid->naxes; a++)
+            fprintf(af.f, ",%.10g", ppb_config_key_value(&pt, grid->axes[a].key));
+        fputc('\n', af.f);
     }
     return ppb_afile_commit(&af, err);
 }
 
-static int copy_into(FILE *dst, const char *path)
+/* Copies each line of path to dst behind prefix. */
+static int copy_lines(FILE *dst, const char *prefix, const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return -1;
-    char buf[8192];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
-        fwrite(buf, 1, n, dst);
+    char *line = NULL;
+    size_t cap = 0;
+    while (getline(&line, &cap, f) > 0)
+        fprintf(dst, "%s,%s", prefix, line);
+    free(line);
     fclose(f);
     return 0;
 }
@@ -177,9 +205,96 @@ static int find_point(const char *const *dirs, int ndirs, const char *hash, cons
     return -1;
 }
 
+static char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *buf = NULL;
+    size_t cap = 0, n = 0, got;
+    do {
+        if (cap - n < 65536) {
+            char *nb = realloc(buf, cap = 2 * cap + 65536);
+            if (!nb) {
+                free(buf), fclose(f);
+                return NULL;
+            }
+            buf = nb;
+        }
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+    } while (got > 0);
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return NULL;
+    }
+    *len = n;
+    return buf;
+}
+
+/* Shards of one sweep have the same grid.txt: the same swept keys in the same order (its
+ * header), the same values in the same order, the same settings at every point (the hashes).
+ * Refuses any other, saying which part differs. */
+static int same_grids(const char *const *dirs, int ndirs, ppb_err *err)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/grid.txt", dirs[0]);
+    size_t n0 = 0;
+    char *g0 = slurp(path, &n0);
+    if (!g0)
+        return ppb_fail(err, "%s: cannot read: %s (not a sweep directory?)", path, strerror(errno));
+    int rc = 0;
+    for (int d = 1; d < ndirs && rc == 0; d++) {
+        size_t n = 0;
+        snprintf(path, sizeof path, "%s/grid.txt", dirs[d]);
+        char *g = slurp(path, &n);
+        if (!g) {
+            rc = ppb_fail(err, "%s: cannot read: %s (not a sweep directory?)", path,
+                          strerror(errno));
+            break;
+        }
+        if (n != n0 || memcmp(g, g0, n) != 0) {
+            const char *e0 = memchr(g0, '\n', n0), *e = memchr(g, '\n', n);
+            size_t h0 = e0 ? (size_t)(e0 - g0) : n0, h = e ? (size_t)(e - g) : n;
+            const char *what = "the same points hold other settings (another config)";
+            if (h != h0 || memcmp(g, g0, h) != 0)
+                what = "other swept keys or another key order";
+            else {
+                /* Compare the records without their hashes: values and their order. */
+                const char *p = g0 + h0, *q = g + h;
+                const char *p1 = g0 + n0, *q1 = g + n;
+                while (p < p1 && q < q1) {
+                    const char *pe = memchr(p + 1, '\n', (size_t)(p1 - p - 1));
+                    const char *qe = memchr(q + 1, '\n', (size_t)(q1 - q - 1));
+                    pe = pe ? pe : p1, qe = qe ? qe : q1;
+                    const char *pv = memchr(p, ',', (size_t)(pe - p)),
+                               *qv = memchr(q, ',', (size_t)(qe - q));
+                    pv = pv ? pv : pe, qv = qv ? qv : qe;
+                    if (pe - pv != qe - qv || memcmp(pv, qv, (size_t)(pe - pv)) != 0) {
+                        what = "other values or another value order";
+                        break;
+                    }
+                    p = pe, q = qe;
+                }
+                if ((p < p1) != (q < q1))
+                    what = "another number of points";
+            }
+            rc =
+                ppb_fail(err, "%s: its grid differs from %s's (%s): only shards of one sweep merge",
+                         dirs[d], dirs[0], what);
+        }
+        free(g);
+    }
+    free(g0);
+    return rc;
+}
+
 /* Writes out/sweep.csv and out/timings.csv from the points found in dirs, in grid order.
  * grid.txt is read as CSV (base/csv_read.h): its header is sweep.csv's (names never need
- * quotes: write_header), its records one field each, a point's hash.
+ * quotes: write_header), its records a point's hash and swept values; each row of sweep.csv is
+ * the point's index, those values, and a row of its rows file.
  * Returns the number of points still missing (then nothing is written), or -1. */
 static long long assemble(const char *const *dirs, int ndirs, const char *out, ppb_err *err)
 {
@@ -189,6 +304,11 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
     ppb_err gerr;
     if (ppb_csv_open(&g, gpath, &gerr))
         return ppb_fail(err, "%s (not a sweep directory?)", gerr.msg);
+    int nvalues = ppb_csv_col(&g, "method") - 1;
+    if (nvalues < 1) {
+        ppb_csv_close(&g);
+        return ppb_fail(err, "%s: not a grid file (no method column)", gpath);
+    }
     ppb_afile csv, tim;
     snprintf(path, sizeof path, "%s/sweep.csv", out);
     if (ppb_afile_open(&csv, path, err)) {
@@ -205,17 +325,43 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
         fprintf(csv.f, "%s%s", c ? "," : "", g.col[c]);
     fputc('\n', csv.f);
     fprintf(tim.f, "point,seconds\n");
-    long long missing = 0;
+    long long missing = 0, i = 0;
     int rc;
+    char *prefix = NULL;
+    size_t prefix_cap = 0;
     while ((rc = ppb_csv_next(&g, err)) == 1) {
+        if (g.nfield != nvalues + 1) {
+            rc = ppb_fail(err,
+                          "%s:%ld: %d fields, the grid has %d swept keys (a grid.txt of an "
+                          "earlier ppbench: run the sweep again)",
+                          gpath, g.line, g.nfield, nvalues);
+            break;
+        }
         const char *hash = ppb_csv_get(&g, 0);
-        if (find_point(dirs, ndirs, hash, "csv", path, sizeof path) == 0)
-            copy_into(csv.f, path);
+        size_t need = 32;
+        for (int a = 1; a <= nvalues; a++)
+            need += strlen(ppb_csv_get(&g, a)) + 1;
+        if (need > prefix_cap) {
+            char *p = realloc(prefix, need);
+            if (!p) {
+                rc = ppb_fail(err, "sweep: out of memory assembling %s", out);
+                break;
+            }
+            prefix = p, prefix_cap = need;
+        }
+        size_t len = (size_t)snprintf(prefix, prefix_cap, "%lld", i);
+        for (int a = 1; a <= nvalues; a++)
+            len += (size_t)snprintf(prefix + len, prefix_cap - len, ",%s", ppb_csv_get(&g, a));
+        if (find_point(dirs, ndirs, hash, ROWS_EXT, path, sizeof path) == 0)
+            copy_lines(csv.f, prefix, path);
         else
             missing++;
-        if (find_point(dirs, ndirs, hash, "time", path, sizeof path) == 0)
-            copy_into(tim.f, path);
+        snprintf(prefix, prefix_cap, "%lld", i);
+        if (find_point(dirs, ndirs, hash, SECONDS_EXT, path, sizeof path) == 0)
+            copy_lines(tim.f, prefix, path);
+        i++;
     }
+    free(prefix);
     ppb_csv_close(&g);
     if (missing || rc < 0) {
         ppb_afile_abort(&csv);
@@ -228,8 +374,8 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
 }
 
 /* The points with index % parts == part, one device context for all of them. */
-static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o, int part,
-                     int parts, int quiet, ppb_err *err)
+static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t *hashes,
+                     const ppb_sweep_opts *o, int part, int parts, int quiet, ppb_err *err)
 {
     long long n = ppb_grid_npoints(grid);
     ppb_config pt;
@@ -244,9 +390,9 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const ppb_swee
         char path[1300];
         if ((rc = ppb_config_point(cfg, grid, i, &pt, err)) != 0)
             break;
-        point_file(cfg->out_dir, point_hash(&pt), "csv", path, sizeof path);
+        point_file(cfg->out_dir, hashes[i], ROWS_EXT, path, sizeof path);
         if (!exists(path))
-            rc = run_point(cfg, grid, &pt, i, &ctx, err);
+            rc = run_point(cfg, &pt, hashes[i], &ctx, err);
         ppb_progress_update(&pr, (double)++done * parts);
     }
     ppb_ctx_close(&ctx);
@@ -255,35 +401,93 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const ppb_swee
     return rc;
 }
 
-/* --jobs J: J processes, each its own device context, taking every J-th point of this shard;
- * the first one shows progress. A failing child's message is on its stderr. */
-static int run_jobs(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_opts *o,
-                    ppb_err *err)
+static void sleep_ms(long ms)
 {
+    struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+/* --jobs J: J processes, each its own device context, taking every J-th point of this shard;
+ * the first one shows progress. A failing child's message is on its stderr.
+ *
+ * The workers die with the sweep: each asks the kernel for SIGTERM when its parent dies
+ * (PR_SET_PDEATHSIG; the getppid() check covers a parent gone before the request), so a
+ * kill -9 of the sweep leaves no orphan computing on. Each worker has its own process group,
+ * so a Ctrl-C reaches the parent alone, which passes one SIGINT to every worker: each stops
+ * at its next check as a serial sweep does (a second Ctrl-C ends the parent at once, and the
+ * workers with it). An interrupted worker exits 130, which is no failure. */
+static int run_jobs(const ppb_config *cfg, const ppb_grid *grid, const uint64_t *hashes,
+                    const ppb_sweep_opts *o, ppb_err *err)
+{
+    enum { MAX_JOBS = 64 };
     int jobs = o->jobs > 1 ? o->jobs : 1, parts = o->shard_n * jobs;
     if (jobs == 1)
-        return run_shard(cfg, grid, o, o->shard_i - 1, o->shard_n, o->quiet, err);
+        return run_shard(cfg, grid, hashes, o, o->shard_i - 1, o->shard_n, o->quiet, err);
+    if (jobs > MAX_JOBS)
+        return ppb_fail(err, "--jobs %d: at most %d", jobs, MAX_JOBS);
     fflush(NULL);
-    pid_t pids[64];
-    for (int j = 0; j < jobs; j++) {
-        pids[j] = fork();
-        if (pids[j] < 0)
-            return ppb_fail(err, "--jobs: fork failed");
-        if (pids[j] == 0) {
+    pid_t pids[MAX_JOBS], parent = getpid();
+    int started = 0;
+    for (; started < jobs; started++) {
+        pid_t p = fork();
+        if (p < 0)
+            break;
+        if (p == 0) {
+            setpgid(0, 0);
+            if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0 || getppid() != parent)
+                _exit(1);
             ppb_err e = {{0}};
-            int rc =
-                run_shard(cfg, grid, o, o->shard_i - 1 + o->shard_n * j, parts, o->quiet || j, &e);
+            int rc = run_shard(cfg, grid, hashes, o, o->shard_i - 1 + o->shard_n * started, parts,
+                               o->quiet || started, &e);
             if (rc)
-                fprintf(stderr, "ppbench sweep (job %d): %s\n", j + 1, e.msg);
-            _exit(rc ? 1 : 0);
+                fprintf(stderr, "ppbench sweep (job %d): %s\n", started + 1, e.msg);
+            fflush(NULL);
+            _exit(rc ? 1 : ppb_interrupted() ? 130 : 0);
         }
+        pids[started] = p;
     }
-    int failed = 0;
-    for (int j = 0; j < jobs; j++) {
+    int fork_failed = started < jobs, fork_errno = errno;
+    /* Polled, not a blocking waitpid: an interrupt is seen and passed on at once, whenever it
+     * comes. */
+    int live = started, failed = 0, forwarded = 0;
+    if (fork_failed) {
+        for (int j = 0; j < started; j++)
+            kill(pids[j], SIGINT);
+        forwarded = 1;
+    }
+    while (live > 0) {
+        if (ppb_interrupted() && !forwarded) {
+            for (int j = 0; j < started; j++)
+                if (pids[j] > 0)
+                    kill(pids[j], SIGINT);
+            forwarded = 1;
+        }
         int st;
-        if (waitpid(pids[j], &st, 0) < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0)
-            failed++;
+        pid_t p = waitpid(-1, &st, WNOHANG);
+        if (p == 0) {
+            sleep_ms(20);
+            continue;
+        }
+        if (p < 0) {
+            if (errno == EINTR)
+                continue;
+            break; /* ECHILD: none left */
+        }
+        for (int j = 0; j < started; j++)
+            if (pids[j] == p) {
+                pids[j] = 0;
+                live--;
+                int ok = WIFEXITED(st) && WEXITSTATUS(st) == 0;
+                int stopped =
+                    ppb_interrupted() &&
+                    ((WIFEXITED(st) && WEXITSTATUS(st) == 130) ||
+                     (WIFSIGNALED(st) && (WTERMSIG(st) == SIGINT || WTERMSIG(st) == SIGTERM)));
+                failed += !ok && !stopped;
+            }
     }
+    if (fork_failed)
+        return ppb_fail(err, "--jobs %d: fork failed after %d: %s", jobs, started,
+                        strerror(fork_errno));
     return failed ? ppb_fail(err, "%d of %d jobs failed", failed, jobs) : 0;
 }
 
@@ -292,14 +496,35 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_o
 {
     if (check_grid(cfg, grid, o, err))
         return PPB_SWEEP_BAD_CONFIG;
+    long long n = ppb_grid_npoints(grid);
+    uint64_t *hashes = malloc(sizeof *hashes * (size_t)n);
+    if (!hashes)
+        return ppb_fail(err, "sweep: out of memory for the hashes of %lld points", n);
     char dir[1200];
     snprintf(dir, sizeof dir, "%s/points", cfg->out_dir);
-    if (ppb_mkdirs(dir, err) || write_grid(cfg, grid, err))
-        return -1;
-    if (run_jobs(cfg, grid, o, err))
-        return -1;
-    if (ppb_interrupted())
+    int rc = ppb_mkdirs(dir, err) || write_grid(cfg, grid, hashes, err) ? -1 : 0;
+    int hashed = rc == 0; /* hashes[] is filled */
+    if (rc == 0)
+        rc = run_jobs(cfg, grid, hashes, o, err);
+    if (ppb_interrupted() && hashed) {
+        /* Interrupted: no failure (the caller exits 130), the finished points are kept. */
+        long long mine = 0, done = 0;
+        for (long long i = o->shard_i - 1; i < n; i += o->shard_n) {
+            char path[1300];
+            point_file(cfg->out_dir, hashes[i], ROWS_EXT, path, sizeof path);
+            mine++;
+            done += exists(path);
+        }
+        fprintf(stderr,
+                "%s: interrupted: %lld of %lld points done, no sweep.csv written (run the same "
+                "command again to compute the other %lld)\n",
+                cfg->name, done, mine, mine - done);
+        free(hashes);
         return 0;
+    }
+    free(hashes);
+    if (rc)
+        return -1;
     const char *dirs[1] = {cfg->out_dir};
     long long missing = assemble(dirs, 1, cfg->out_dir, err);
     if (missing < 0)
@@ -316,6 +541,8 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_o
 
 int ppb_sweep_merge(const char *const *dirs, int n, const char *out_dir, ppb_err *err)
 {
+    if (same_grids(dirs, n, err))
+        return PPB_SWEEP_BAD_CONFIG;
     if (ppb_mkdirs(out_dir, err))
         return -1;
     long long missing = assemble(dirs, n, out_dir, err);
