@@ -3,13 +3,24 @@
  *   checked against kernels/ppb_conventions.h (the point count of the layout, the bin index of
  *   every averaging direction as the Monte Carlo tallies bin it, w_k summing to pi -- SPEC 4:
  *   the bins cover the projected solid angle of the hemisphere, pi);
+ * - an external method end to end: its command copies the rows of a built-in method (mp) from
+ *   an earlier run under its own name, so every output of it (summary, rms, totals, images) must
+ *   equal mp's -- mp's own rows are the expected values; without a totals.csv its R, T and sides
+ *   are the radiance integrated (SPEC 4's cell measure), which must give the Monte Carlo's own
+ *   R, T, sides when it copies the mc rows (energy per cell is what the tallies count);
+ * - each bad output (missing row, duplicate, NaN, negative, wrong columns, non-zero exit,
+ *   timeout) is refused with file:line or the reason, and none of its rows or images is written;
+ *   on timeout the command's process group is gone.
  * Expected values come from the conventions' functions (an independent path: the tallies'
- * binning of a direction, not the writer's loop), from SPEC 4's sum and from exit codes of
- * README.md. Tiny grids: bookkeeping, not physics. */
+ * binning of a direction, not the writer's loop), from SPEC 4's sum, from a built-in method's
+ * own outputs and from exit codes of README.md. Tiny grids: bookkeeping, not physics. */
 #include "cliutil.h"
 
 #include <jansson.h>
+#include <errno.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <time.h>
 
 static json_t *load_json(const char *path)
 {
@@ -87,10 +98,230 @@ static void test_scene_json(void **state)
     assert_int_equal(stat(path, &st), -1);
 }
 
+/* The tiny experiment every test below builds on (seconds on a CPU). */
+static const char tiny[] = "[tube]\nsegments_top = 8\nsegments_side = 3\n"
+                           "[bins]\ntheta = 2\nphi = 2\n[mc]\nphotons = 20000\n";
+
+static char ref_dir[1200]; /* a finished run of mc and mp, made once */
+
+static int make_ref(void **state)
+{
+    (void)state;
+    char text[2600], args[2600];
+    snprintf(ref_dir, sizeof ref_dir, "%s/ref", tu_scratch("extref"));
+    snprintf(text, sizeof text, "[experiment]\nmethods = mc, mp\n%s[output]\ndir = %s\n", tiny,
+             ref_dir);
+    snprintf(args, sizeof args, "run --quiet %s", cli_config("extref", text));
+    return cli_run_env("", args, cli_out, sizeof cli_out) != 0;
+}
+
+/* Lines of dir/file whose first field is method, with that field dropped, joined. */
+static char *rows_of(const char *dir, const char *file, const char *method)
+{
+    char path[1400];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        fail_msg("cannot open %s", path);
+    size_t cap = 1 << 20, n = 0, len = strlen(method);
+    char *out = calloc(cap, 1), line[4096];
+    assert_non_null(out);
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, method, len) && line[len] == ',' && n + strlen(line) < cap)
+            n += (size_t)sprintf(out + n, "%s", line + len + 1);
+    fclose(f);
+    return out;
+}
+
+static void assert_same_rows(const char *dir, const char *file, const char *a, const char *b)
+{
+    char *ra = rows_of(dir, file, a), *rb = rows_of(dir, file, b);
+    if (!*ra || strcmp(ra, rb) != 0)
+        fail_msg("%s/%s: rows of %s differ from those of %s:\n%s\n---\n%s", dir, file, a, b, ra,
+                 rb);
+    free(ra);
+    free(rb);
+}
+
+static int file_exists(const char *dir, const char *file)
+{
+    char path[1400];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+static int file_has(const char *dir, const char *file, const char *needle)
+{
+    char path[1400], buf[1 << 16];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return strstr(buf, needle) != NULL;
+}
+
+/* A script (its path into buf) that copies method `from`'s rows of `file` in the reference run
+ * under the name `to` into $1/file, through the shell text `filter` ("" for none; it reads the
+ * rows on stdin), then runs `after` ("" for nothing). */
+static void copy_script(char *buf, size_t cap, const char *name, const char *file, const char *from,
+                        const char *to, const char *filter, const char *after)
+{
+    char dir[64];
+    snprintf(dir, sizeof dir, "%s_sh", name);
+    snprintf(buf, cap, "%s/copy.sh", tu_scratch(dir));
+    FILE *f = fopen(buf, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "awk -F, -v OFS=, 'NR == 1 || $1 == \"%s\" { if (NR > 1) $1 = \"%s\"; print }' "
+            "%s/%s | %s > \"$1/%s\"\n%s\n",
+            from, to, ref_dir, file, *filter ? filter : "cat", file, after);
+    fclose(f);
+}
+
+static void test_external_end_to_end(void **state)
+{
+    (void)state;
+    char text[8192], rad[2400], tot[2400], args[2600], out[1200];
+    copy_script(rad, sizeof rad, "ext_e2e_r", "radiance.csv", "mp", "mine", "", "");
+    copy_script(tot, sizeof tot, "ext_e2e_t", "totals.csv", "mp", "mine", "", "");
+    snprintf(out, sizeof out, "%s/out", tu_scratch("ext_e2e"));
+    /* {scene} must be there and be this experiment's; the indented line continues the
+     * command. */
+    snprintf(text, sizeof text,
+             "[experiment]\nmethods = mc, mp, mine\n%s[output]\ndir = %s\n[method.mine]\n"
+             "command = grep -q '\"segments_top\": 8' {scene} &&\n"
+             "  sh %s {out} && sh %s {out}\ntimeout = 60\n",
+             tiny, out, rad, tot);
+    snprintf(args, sizeof args, "run --quiet %s", cli_config("ext_e2e", text));
+    cli_expect(args, 0, "");
+    assert_same_rows(out, "radiance.csv", "mine", "mp");
+    assert_same_rows(out, "summary.csv", "mine", "mp");
+    assert_same_rows(out, "rms.csv", "mine", "mp");
+    assert_same_rows(out, "totals.csv", "mine", "mp");
+    assert_true(file_exists(out, "images/mine.png"));
+    assert_true(file_exists(out, "images/mine.exr"));
+    assert_true(file_exists(out, "images/error_mine.png"));
+    /* The definition is part of the resolved config in provenance (what `score` reads). */
+    assert_true(file_has(out, "provenance.txt", "method.mine.command = grep -q"));
+    assert_true(file_has(out, "provenance.txt", "method.mine.timeout = 60\n"));
+
+    /* No totals.csv: R, T and sides integrated from the copied mc radiance are mc's own. */
+    copy_script(rad, sizeof rad, "ext_tot_r", "radiance.csv", "mc", "mine", "", "");
+    snprintf(out, sizeof out, "%s/out", tu_scratch("ext_tot"));
+    snprintf(text, sizeof text,
+             "[experiment]\nmethods = mp, mine\n%s[output]\ndir = %s\n[method.mine]\n"
+             "command = sh %s {out}\n",
+             tiny, out, rad);
+    snprintf(args, sizeof args, "run --quiet %s", cli_config("ext_tot", text));
+    cli_expect(args, 0, "");
+    char *mine = rows_of(out, "totals.csv", "mine"), *mc = rows_of(ref_dir, "totals.csv", "mc");
+    double a[5], b[5];
+    assert_int_equal(sscanf(mine, "%lf,%lf,%lf,%lf,%lf", &a[0], &a[1], &a[2], &a[3], &a[4]), 5);
+    assert_int_equal(sscanf(mc, "%lf,%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3], &b[4]), 5);
+    for (int k = 0; k < 3; k++) /* radiance.csv holds 10 significant digits */
+        assert_rel(a[k], b[k], 1e-8);
+    assert_close(a[4], 0.0, 0); /* ballistic: not radiance, not reported */
+    free(mine);
+    free(mc);
+}
+
+/* A method whose command is body (with {out}) must fail with needle in the message, and
+ * nothing of it may be written: no row in radiance.csv, no image. */
+static void expect_refused(const char *name, const char *body, const char *extra,
+                           const char *needle)
+{
+    char text[8192], args[2600], out[1200];
+    snprintf(out, sizeof out, "%s/out", tu_scratch(name));
+    snprintf(text, sizeof text,
+             "[experiment]\nmethods = mp, bad\n%s[output]\ndir = %s\n[method.bad]\n"
+             "command = %s\n%s",
+             tiny, out, body, extra);
+    snprintf(args, sizeof args, "run %s", cli_config(name, text));
+    int rc = cli_run_env("", args, cli_out, sizeof cli_out);
+    if (!strstr(cli_out, needle) || !strstr(cli_out, "bad failed"))
+        fail_msg("%s: exit %d, output lacks '%s':\n%s", name, rc, needle, cli_out);
+    char *rows = rows_of(out, "radiance.csv", "bad");
+    if (*rows)
+        fail_msg("%s: rows of the failed method written:\n%s", name, rows);
+    free(rows);
+    assert_false(file_exists(out, "images/bad.png"));
+    assert_false(file_exists(out, "images/bad.exr"));
+    assert_true(file_exists(out, "images/mp.png")); /* the others' outputs are written */
+}
+
+/* expect_refused for a copy of mp's rows through filter, then after. */
+static void expect_bad_copy(const char *name, const char *filter, const char *after,
+                            const char *needle)
+{
+    char script[1200], body[1400];
+    copy_script(script, sizeof script, name, "radiance.csv", "mp", "bad", filter, after);
+    snprintf(body, sizeof body, "sh %s {out}", script);
+    expect_refused(name, body, "", needle);
+}
+
+static void test_external_refusals(void **state)
+{
+    (void)state;
+    expect_bad_copy("ext_missing", "awk 'NR != 7'", "",
+                    "missing row: S1 segment 1 theta_bin 0 phi_bin 1");
+    expect_bad_copy("ext_dup", "awk '{ print } NR == 3'", "",
+                    "radiance.csv:4: a second row for S1 segment 0 bin (0, 1) (the first: line 3)");
+    expect_bad_copy("ext_nan", "awk -F, -v OFS=, 'NR == 5 { $7 = \"nan\" } { print }'", "",
+                    "radiance.csv:5: radiance nan");
+    expect_bad_copy("ext_neg", "awk -F, -v OFS=, 'NR == 6 { $7 = -$7 } { print }'", "",
+                    "radiance.csv:6: radiance -");
+    expect_bad_copy("ext_cols", "sed '1s/theta_bin/theta/'", "",
+                    "radiance.csv:1: the columns must begin");
+    expect_bad_copy("ext_exit", "", "exit 3", "its command exited with status 3");
+    expect_refused("ext_none", "true {out}", "", "its command wrote no");
+    char body[2600];
+
+    /* Timeout: the command and its children are killed (the whole process group). */
+    char pidfile[1200];
+    snprintf(pidfile, sizeof pidfile, "%s/sleep.pid", tu_scratch("ext_pid"));
+    snprintf(body, sizeof body, "sleep 30 & echo $! > %s; wait; echo never > {out}/radiance.csv",
+             pidfile);
+    expect_refused("ext_timeout", body, "timeout = 1\n", "ran past its timeout of 1 s: killed");
+    FILE *f = fopen(pidfile, "r");
+    assert_non_null(f);
+    int pid = 0;
+    assert_int_equal(fscanf(f, "%d", &pid), 1);
+    fclose(f);
+    int alive = 1;
+    for (int i = 0; i < 100 && alive; i++) { /* reaped by init within moments */
+        alive = kill(pid, 0) == 0;
+        if (alive)
+            nanosleep(&(struct timespec){0, 20000000L}, NULL);
+    }
+    if (alive)
+        fail_msg("the command's child %d still runs after the timeout", pid);
+
+    /* Config errors, exit 2 before any work. */
+    char text[512], args[1400];
+    snprintf(text, sizeof text, "[experiment]\nmethods = mp, x\n[method.x]\ncommand = true\n");
+    snprintf(args, sizeof args, "run %s", cli_config("ext_noout", text));
+    cli_expect(args, 2, ":4: [method.x] command: holds no {out}");
+    snprintf(text, sizeof text, "[experiment]\nmethods = mp, x\n[method.x]\ntimeout = 5\n");
+    snprintf(args, sizeof args, "run %s", cli_config("ext_nocmd", text));
+    cli_expect(args, 2, ":4: [method.x]: no command given");
+    snprintf(text, sizeof text, "[experiment]\nmethods = mp\n[method.mp]\ncommand = x {out}\n");
+    snprintf(args, sizeof args, "run %s", cli_config("ext_builtin", text));
+    cli_expect(args, 2, "[method.mp]: 'mp' is a built-in method's id");
+    snprintf(text, sizeof text, "[experiment]\nmethods = mp\n[method.y]\ncolor = 1\n");
+    snprintf(args, sizeof args, "run %s", cli_config("ext_key", text));
+    cli_expect(args, 2, ":4: [method.y] color: unknown key");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scene_json),
+        cmocka_unit_test(test_external_end_to_end),
+        cmocka_unit_test(test_external_refusals),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, make_ref, NULL);
 }

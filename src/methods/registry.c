@@ -1,8 +1,10 @@
 #include "methods/registry.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #include "methods/method_mc.h"
+#include "methods/method_external.h"
 #include "methods/method_mp.h"
 #include "methods/method_pp.h"
 #include "methods/method_ppslab.h"
@@ -35,6 +37,32 @@ static const ppb_method methods[] = {
      .run = ppb_method_rte2d},
 };
 
+/* Methods a config defines ([method.NAME], model/config.h), entered by ppb_methods_check when
+ * it accepts the config: from then on they are found by id like the built-in ones, and run by
+ * methods/method_external.c, which reads the command from the experiment's config. A process
+ * loads one config (or the points of one sweep), so entries are only ever added. */
+static struct {
+    char id[32];
+    ppb_method m;
+} external[PPB_MAX_EXTERNAL];
+static int nexternal;
+
+static int add_external(const char *id)
+{
+    for (int i = 0; i < nexternal; i++)
+        if (strcmp(external[i].id, id) == 0)
+            return 0;
+    if (nexternal == PPB_MAX_EXTERNAL)
+        return -1;
+    snprintf(external[nexternal].id, sizeof external[nexternal].id, "%s", id);
+    external[nexternal].m =
+        (ppb_method){.id = external[nexternal].id,
+                     .summary = "external method (the config's [method.NAME] command)",
+                     .run = ppb_method_external};
+    nexternal++;
+    return 0;
+}
+
 int ppb_method_count(void)
 {
     return (int)(sizeof methods / sizeof methods[0]);
@@ -50,15 +78,42 @@ const ppb_method *ppb_method_find(const char *id)
     for (int i = 0; i < ppb_method_count(); i++)
         if (strcmp(methods[i].id, id) == 0)
             return &methods[i];
+    for (int i = 0; i < nexternal; i++)
+        if (strcmp(external[i].id, id) == 0)
+            return &external[i].m;
+    return NULL;
+}
+
+static const ppb_method *builtin(const char *id)
+{
+    for (int i = 0; i < ppb_method_count(); i++)
+        if (strcmp(methods[i].id, id) == 0)
+            return &methods[i];
     return NULL;
 }
 
 int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
 {
+    /* A [method.NAME] may not take a built-in id: the config would then mean two methods. */
+    int nbuiltin = ppb_method_count();
+    for (int i = 0; i < cfg->nexternal; i++)
+        for (int j = 0; j < nbuiltin; j++)
+            if (strcmp(cfg->external[i].name, methods[j].id) == 0 ||
+                (methods[j].also && strcmp(cfg->external[i].name, methods[j].also) == 0))
+                return ppb_fail(err, "%s:%d: [method.%s]: '%s' is a built-in method's id",
+                                cfg->path, cfg->external[i].line, cfg->external[i].name,
+                                cfg->external[i].name);
+    for (int i = 0; i < cfg->nexternal; i++)
+        if (ppb_external_check(cfg, &cfg->external[i], err))
+            return -1;
+    for (int i = 0; i < cfg->nmethods; i++)
+        if (ppb_config_external(cfg, cfg->methods[i]) && add_external(cfg->methods[i]))
+            return ppb_config_key_fail(cfg, "experiment", "methods", err,
+                                       "more than %d external methods", PPB_MAX_EXTERNAL);
     /* Unknown ids first, over the whole list, then slab-only methods: the order in which the
      * config used to refuse them when it parsed the list itself. */
     for (int i = 0; i < cfg->nmethods; i++)
-        if (!ppb_method_find(cfg->methods[i]))
+        if (!builtin(cfg->methods[i]) && !ppb_config_external(cfg, cfg->methods[i]))
             return ppb_config_key_fail(cfg, "experiment", "methods", err,
                                        "unknown method '%s' (see ppbench --help)", cfg->methods[i]);
     int slab = cfg->scene.geometry == PPB_GEOM_SLAB;

@@ -536,6 +536,7 @@ typedef struct parse_state {
     const char *next, *end; /* the text not yet handed to inih */
     int line;               /* lines handed to inih: the line it is on */
     int in_key;             /* a key since the last section: an indented line continues it */
+    int cont;               /* the line handed last continues the key before it */
     int stop;               /* the line handed last holds a syntax error */
     char seen[PPB_MAX_KEYS];
     int err_line; /* line of the first error (handler or text), 0 = none */
@@ -593,6 +594,7 @@ static char *next_line(char *str, int num, void *stream)
                   num - 2);
         return NULL;
     }
+    st->cont = len > 0 && st->in_key && b > 0;
     /* inih's syntax test, in its order: a line indented under a key continues that key's value
      * (inih's multi-line values; the handler sees the key again), a section needs its ']', a
      * key line a '=' or ':'. */
@@ -611,6 +613,82 @@ static char *next_line(char *str, int num, void *stream)
     return str;
 }
 
+/* A key of a [method.NAME] section: stored as given, checked for form only (what NAME runs is
+ * the methods layer's business). Returns 1, or 0 with st->why set. */
+static int on_method_key(parse_state *st, const char *section, const char *name, const char *value)
+{
+    const char *id = section + strlen("method.");
+    ppb_config *cfg = st->cfg;
+    ppb_external_def *d = NULL;
+    for (int i = 0; i < cfg->nexternal; i++)
+        if (strcmp(cfg->external[i].name, id) == 0)
+            d = &cfg->external[i];
+    if (!d) {
+        if (!*id || strlen(id) >= sizeof d->name) {
+            snprintf(st->why, sizeof st->why, "a method name of 1 to %zu characters",
+                     sizeof d->name - 1);
+            return 0;
+        }
+        for (const char *c = id; *c; c++)
+            if (!isalnum((unsigned char)*c) && !strchr("_-.+", *c)) {
+                snprintf(st->why, sizeof st->why,
+                         "a method name may hold only letters, digits and _-.+");
+                return 0;
+            }
+        if (cfg->nexternal == PPB_MAX_EXTERNAL) {
+            snprintf(st->why, sizeof st->why, "more than %d [method.NAME] sections",
+                     PPB_MAX_EXTERNAL);
+            return 0;
+        }
+        d = &cfg->external[cfg->nexternal++];
+        snprintf(d->name, sizeof d->name, "%s", id);
+        d->line = st->line;
+    }
+    if (strcmp(name, "command") == 0) {
+        size_t have = strlen(d->command);
+        if (d->command_line && st->cont) {
+            /* An indented line continues the command (inih's multi-line value): joined by a
+             * space, so a command longer than one config line can be written. */
+            if (have + 1 + strlen(value) >= sizeof d->command) {
+                snprintf(st->why, sizeof st->why, "a command of at most %zu characters",
+                         sizeof d->command - 1);
+                return 0;
+            }
+            snprintf(d->command + have, sizeof d->command - have, " %s", value);
+            return 1;
+        }
+        if (d->command_line) {
+            snprintf(st->why, sizeof st->why, "given twice");
+            return 0;
+        }
+        if (!*value || strlen(value) >= sizeof d->command) {
+            snprintf(st->why, sizeof st->why, "a command of 1 to %zu characters",
+                     sizeof d->command - 1);
+            return 0;
+        }
+        snprintf(d->command, sizeof d->command, "%s", value);
+        d->command_line = st->line;
+        return 1;
+    }
+    if (strcmp(name, "timeout") == 0) {
+        char *end;
+        double t = strtod(value, &end);
+        if (d->timeout_line) {
+            snprintf(st->why, sizeof st->why, "given twice");
+            return 0;
+        }
+        if (end == value || *end || !(t > 0 && t <= 1e6)) {
+            snprintf(st->why, sizeof st->why, "seconds, a number in (0, 1e6]");
+            return 0;
+        }
+        d->timeout = t;
+        d->timeout_line = st->line;
+        return 1;
+    }
+    snprintf(st->why, sizeof st->why, "unknown key (a [method.NAME] holds command and timeout)");
+    return 0;
+}
+
 static int on_key(void *user, const char *section, const char *name, const char *value)
 {
     parse_state *st = user;
@@ -622,6 +700,12 @@ static int on_key(void *user, const char *section, const char *name, const char 
              shown(name, qn, sizeof qn));
     st->err_line = st->line;
     if (i < 0) {
+        if (strncmp(section, "method.", 7) == 0) {
+            if (!on_method_key(st, section, name, value))
+                return 0;
+            st->err_line = 0;
+            return 1;
+        }
         snprintf(st->why, sizeof st->why, "%s",
                  section_known(section) ? "unknown key" : "unknown section");
         return 0;
@@ -800,6 +884,10 @@ static int read_file(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err 
         return ppb_fail(err, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
     if (rc < 0)
         return ppb_fail(err, "%s: cannot read config", path);
+    for (int i = 0; i < cfg->nexternal; i++)
+        if (!cfg->external[i].command_line)
+            return ppb_fail(err, "%s:%d: [method.%s]: no command given", path,
+                            cfg->external[i].line, cfg->external[i].name);
     if (!cfg->name[0])
         base_name(path, cfg->name, sizeof cfg->name);
     if (!cfg->out_dir[0])
@@ -923,6 +1011,12 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out)
         write_value(cfg, &keys[i], out);
         fputc('\n', out);
     }
+    for (int i = 0; i < cfg->nexternal; i++) {
+        fprintf(out, "method.%s.command = %s\n", cfg->external[i].name, cfg->external[i].command);
+        if (cfg->external[i].timeout_line)
+            fprintf(out, "method.%s.timeout = %.17g\n", cfg->external[i].name,
+                    cfg->external[i].timeout);
+    }
 }
 
 void ppb_config_write_keys(FILE *out)
@@ -966,4 +1060,12 @@ int ppb_config_has_method(const ppb_config *cfg, const char *id)
         if (strcmp(cfg->methods[i], id) == 0)
             return 1;
     return 0;
+}
+
+const ppb_external_def *ppb_config_external(const ppb_config *cfg, const char *id)
+{
+    for (int i = 0; i < cfg->nexternal; i++)
+        if (strcmp(cfg->external[i].name, id) == 0)
+            return &cfg->external[i];
+    return NULL;
 }

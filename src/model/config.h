@@ -59,6 +59,20 @@ typedef struct ppb_rte2d_settings {
     int refinements; /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
 } ppb_rte2d_settings;
 
+/* A method defined by the config itself: a section [method.NAME] with `command` (a shell
+ * command holding {scene} and {out}) and an optional `timeout` in seconds. The config stores
+ * them without knowing what they run (methods/method_external.h runs them; the registry accepts
+ * NAME as a method id once it is defined here). */
+#define PPB_MAX_EXTERNAL 8
+typedef struct ppb_external_def {
+    char name[32];
+    char command[2048];
+    double timeout;   /* seconds; 0 = the default (3600) */
+    int line;         /* line of the section's first key */
+    int command_line; /* line of its command (0: none given) */
+    int timeout_line; /* line of its timeout (0: the default) */
+} ppb_external_def;
+
 /* Where a key's value came from, so that checks made after loading name the right place. */
 typedef struct ppb_key_origin {
     int line;     /* line of the key in the config file, 0 = not in the file */
@@ -80,6 +94,8 @@ typedef struct ppb_config {
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
     ppb_key_origin origin[PPB_MAX_KEYS]; /* per key of the table */
+    int nexternal;
+    ppb_external_def external[PPB_MAX_EXTERNAL]; /* the [method.NAME] sections, in file order */
 } ppb_config;
 
 /* Every key at its default (the study's settings); no file involved. */
@@ -131,5 +147,8 @@ void ppb_config_key_name(int key, char *buf, size_t cap);
 double ppb_config_key_value(const ppb_config *cfg, int key);
 
 int ppb_config_has_method(const ppb_config *cfg, const char *id);
+
+/* The [method.NAME] section of id, or NULL. */
+const ppb_external_def *ppb_config_external(const ppb_config *cfg, const char *id);
 
 #endif

@@ -1,0 +1,39 @@
+/* method_external.h: a method that is not ppbench's (SPEC 13; docs/external.md): a config's
+ * [method.NAME] command, run on the experiment's scene.json, its radiance.csv validated and
+ * turned into a result like any built-in method's.
+ *
+ * The run: scene.json (io/scene_json.h) into a fresh directory under $TMPDIR, the command run
+ * by /bin/sh -c with {scene} and {out} replaced by the (shell-quoted) paths of scene.json and of
+ * an empty output directory, in its own process group, its stdout and stderr on ppbench's
+ * stderr; a time limit (timeout, default 3600 s) and an interrupt kill the whole group. A
+ * non-zero exit, a signal, or a radiance.csv that is not exactly one finite, non-negative row
+ * per (sample point, bin) fails the method with file:line, and the directory is kept for
+ * inspection; on success it is removed. */
+#ifndef PPB_METHOD_EXTERNAL_H
+#define PPB_METHOD_EXTERNAL_H
+
+#include "methods/method.h"
+
+#define PPB_EXTERNAL_TIMEOUT 3600.0 /* seconds, when [method.NAME] gives no timeout */
+
+/* The registry's run function for every config-defined method: runs the [method.NAME] of
+ * ctx->cfg whose NAME is out[0].method. */
+int ppb_method_external(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+/* The form of a definition, checked when the config is loaded: its command holds {out}. */
+int ppb_external_check(const ppb_config *cfg, const ppb_external_def *d, ppb_err *err);
+
+/* Reads a radiance.csv (SPEC 8 columns, in order; more may follow) whose rows are those of
+ * method `id`, into r (initialised with the scene's layout): every (surface, segment, bin) once,
+ * radiance and stderr finite and >= 0, s the sample point's (within a quarter segment). Fails
+ * with "path:line: reason", or "path: missing row ..." naming the first missing one. Also used
+ * by `ppbench score`. */
+int ppb_external_read_radiance(const char *path, const char *id, const ppb_scene *sc, ppb_result *r,
+                               ppb_err *err);
+
+/* Totals of r: from totals.csv at path when it exists (the row of r's method), otherwise R, T
+ * and sides integrated from the radiance (cell energy = radiance x ppb_scene_cell_measure),
+ * ballistic 0 and absorbed the rest. */
+int ppb_external_totals(const char *path, const ppb_scene *sc, ppb_result *r, ppb_err *err);
+
+#endif
