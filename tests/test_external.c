@@ -145,7 +145,7 @@ static void assert_same_rows(const char *dir, const char *file, const char *a, c
 
 static int file_exists(const char *dir, const char *file)
 {
-    char path[1400];
+    char path[8400];
     snprintf(path, sizeof path, "%s/%s", dir, file);
     struct stat st;
     return stat(path, &st) == 0;
@@ -316,12 +316,62 @@ static void test_external_refusals(void **state)
     cli_expect(args, 2, ":4: [method.y] color: unknown key");
 }
 
+/* `score` on the run's own radiance.csv reproduces its summary, rms and regions byte for byte
+ * (the run's own files are the expected values; the reference is read back from its
+ * radiance.csv, 10 significant digits, and the metrics print 6), and its totals rows; the
+ * experiment's directory is left as it was (diff -r against a copy). */
+static void test_score(void **state)
+{
+    (void)state;
+    char dir[1024], cmd[8192], args[8192], out[1200];
+    snprintf(dir, sizeof dir, "%s", tu_scratch("ext_score"));
+    snprintf(cmd, sizeof cmd, "cp -r %s %s/before", ref_dir, dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(out, sizeof out, "%s/scored", dir);
+    snprintf(args, sizeof args, "score --ref %s --out %s %s/radiance.csv", ref_dir, out, ref_dir);
+    cli_expect(args, 0, "score: wrote");
+    static const char *const same[] = {"summary.csv", "rms.csv", "regions.csv"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(cmd, sizeof cmd, "cmp %s/%s %s/%s", ref_dir, same[i], out, same[i]);
+        if (system(cmd) != 0)
+            fail_msg("%s differs from the run's own", same[i]);
+    }
+    char *a = rows_of(out, "totals.csv", "mp"), *b = rows_of(ref_dir, "totals.csv", "mp");
+    assert_true(*a);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    char *mc = rows_of(out, "totals.csv", "mc");
+    assert_string_equal(mc, ""); /* only the scored method's rows */
+    free(mc);
+    /* Without --out: a new directory beside, never the experiment's. */
+    snprintf(args, sizeof args, "score --ref %s %s/radiance.csv", ref_dir, ref_dir);
+    cli_expect(args, 0, "-score");
+    snprintf(cmd, sizeof cmd, "%s-score", ref_dir);
+    assert_true(file_exists(cmd, "summary.csv"));
+    snprintf(args, sizeof args, "score --ref %s --out %s/ %s/radiance.csv", ref_dir, ref_dir,
+             ref_dir);
+    cli_expect(args, 2, "the experiment's own directory");
+    snprintf(cmd, sizeof cmd, "diff -r %s/before %s", dir, ref_dir);
+    if (system(cmd) != 0)
+        fail_msg("score changed %s", ref_dir);
+    /* A bad file is refused with file:line, as a method's output. */
+    snprintf(cmd, sizeof cmd,
+             "awk -F, -v OFS=, 'NR == 180 && $1 == \"mp\" { $7 = \"inf\" } { print }' "
+             "%s/radiance.csv > %s/bad.csv",
+             ref_dir, dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(args, sizeof args, "score --ref %s --out %s/bad %s/bad.csv", ref_dir, dir, dir);
+    cli_expect(args, 1, "bad.csv:180: radiance inf");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scene_json),
         cmocka_unit_test(test_external_end_to_end),
         cmocka_unit_test(test_external_refusals),
+        cmocka_unit_test(test_score),
     };
     return cmocka_run_group_tests(tests, make_ref, NULL);
 }

@@ -17,6 +17,7 @@
 #include "drivers/mc_shard.h"
 #include "drivers/perf.h"
 #include "drivers/report.h"
+#include "drivers/score.h"
 #include "drivers/slurm.h"
 #include "drivers/sweep.h"
 #include "io/scene_json.h"
@@ -41,6 +42,7 @@ enum {
     OPT_JOBS = 1 << 4,
     OPT_YES = 1 << 5,
     OPT_QUIET = 1 << 6,
+    OPT_REF = 1 << 20,
     OPT_SHARDS = 1 << 7, /* slurm's: its job array and scripts (drivers/slurm.h) */
     OPT_PARTITION = 1 << 8,
     OPT_TIME = 1 << 9,
@@ -62,6 +64,7 @@ static const struct option_doc {
     {OPT_JOBS, "--jobs", "J", "sweep: J processes on this machine (1 to 64, default 1)"},
     {OPT_YES, "--yes", NULL, "sweep: allow a grid larger than the safety limit"},
     {OPT_QUIET, "--quiet", NULL, "no progress lines on stderr"},
+    {OPT_REF, "--ref", "DIR", "score: the finished experiment to score against"},
     {OPT_SHARDS, "--shards", "N",
      "slurm: N array tasks, each one shard (1 to 1000; at most\nthe grid points or photons)"},
     {OPT_PARTITION, "--partition", "P", "slurm: #SBATCH --partition (default: the cluster's)"},
@@ -84,6 +87,7 @@ typedef struct cli {
     int quiet, yes;
     int shard_i, shard_n;
     int jobs;
+    const char *ref;
     int shards, cpus, submit; /* slurm's */
     const char *partition, *time, *mem;
     const char **args;
@@ -180,6 +184,9 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
             break;
         case OPT_YES:
             c->yes = 1;
+            break;
+        case OPT_REF:
+            c->ref = v;
             break;
         case OPT_SUBMIT:
             c->submit = 1;
@@ -633,6 +640,12 @@ static int cmd_scene(const cli *c)
     return EXIT_OK;
 }
 
+/* `ppbench score RADIANCE.csv --ref DIR [--out DIR2]` (drivers/score.h). */
+static int cmd_score(const cli *c)
+{
+    return ppb_score_main(c->nargs ? c->args[0] : NULL, c->nargs, c->ref, c->out);
+}
+
 static int cmd_report(const cli *c)
 {
     if (c->nargs < 2) {
@@ -673,6 +686,11 @@ static const command commands[] = {
      "write --out DIR/scene.json: what an external method\nreads (docs/external.md)",
      "ppbench scene --out /tmp/scene configs/uniform_g0_normal.ini", OPT_OUT | OPT_SET, 1,
      cmd_scene},
+    {"score", "RADIANCE.csv", OPT_REF,
+     "score a radiance.csv against the finished experiment\n--ref DIR: its summary, rms and "
+     "totals rows into --out\n(default DIR-score, -score-2, ...; DIR is never written)",
+     "ppbench score --ref results/uniform_g0_normal mine/radiance.csv", OPT_REF | OPT_OUT, 1,
+     cmd_score},
     {"slurm", "CONFIG", OPT_SHARDS | OPT_OUT,
      "write a Slurm job array into --out DIR (job.sh: shard I\nof a sweep, or of one config's "
      "Monte Carlo; merge.sh:\nits merge into DIR/result) and print the sbatch lines;\n--submit "

@@ -157,8 +157,8 @@ static int surface_of(const char *name, int nsurf)
     return -1;
 }
 
-int ppb_external_read_radiance(const char *path, const char *id, const ppb_scene *sc, ppb_result *r,
-                               ppb_err *err)
+int ppb_external_read_radiance(const char *path, const char *id, int others_ok, const ppb_scene *sc,
+                               ppb_result *r, ppb_err *err)
 {
     ppb_csv c;
     if (ppb_csv_open(&c, path, err))
@@ -182,6 +182,8 @@ int ppb_external_read_radiance(const char *path, const char *id, const ppb_scene
     while ((got = ppb_csv_next(&c, err)) == 1) {
         int surf, seg, it, ip;
         double s, L, se;
+        if (others_ok && strcmp(ppb_csv_get(&c, 0), id) != 0)
+            continue;
         if (strcmp(ppb_csv_get(&c, 0), id) != 0) {
             ppb_fail(err, "%s:%ld: method '%s', expected '%s'", path, c.line, ppb_csv_get(&c, 0),
                      id);
@@ -358,7 +360,7 @@ int ppb_method_external(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     if (rc == 0 && access(rad, F_OK) != 0)
         rc = ppb_fail(err, "its command wrote no %s", rad);
     if (rc == 0)
-        rc = ppb_external_read_radiance(rad, id, &cfg->scene, out, err);
+        rc = ppb_external_read_radiance(rad, id, 0, &cfg->scene, out, err);
     if (rc == 0)
         rc = ppb_external_totals(tot, &cfg->scene, out, err);
     if (rc == 0)

@@ -24,12 +24,12 @@ int ppb_method_external(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 int ppb_external_check(const ppb_config *cfg, const ppb_external_def *d, ppb_err *err);
 
 /* Reads a radiance.csv (SPEC 8 columns, in order; more may follow) whose rows are those of
- * method `id`, into r (initialised with the scene's layout): every (surface, segment, bin) once,
- * radiance and stderr finite and >= 0, s the sample point's (within a quarter segment). Fails
- * with "path:line: reason", or "path: missing row ..." naming the first missing one. Also used
- * by `ppbench score`. */
-int ppb_external_read_radiance(const char *path, const char *id, const ppb_scene *sc, ppb_result *r,
-                               ppb_err *err);
+ * method `id` (others_ok: rows of other methods are passed over; 0: refused), into r (initialised
+ * with the scene's layout): every (surface, segment, bin) once, radiance and stderr finite and >=
+ * 0, s the sample point's (within a quarter segment). Fails with "path:line: reason", or "path:
+ * missing row ..." naming the first missing one. Also used by `ppbench score`. */
+int ppb_external_read_radiance(const char *path, const char *id, int others_ok, const ppb_scene *sc,
+                               ppb_result *r, ppb_err *err);
 
 /* Totals of r: from totals.csv at path when it exists (the row of r's method), otherwise R, T
  * and sides integrated from the radiance (cell energy = radiance x ppb_scene_cell_measure),
