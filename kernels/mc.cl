@@ -4,9 +4,12 @@
  * depth through the piecewise-constant medium (traced exactly across the density step plane
  * x = step_x), scatters by Henyey-Greenstein, loses weight by implicit capture (w *= alpha) with
  * unbiased Russian roulette (applied at every event past an event cap, kernels/mc_params.h, so
- * no photon can run forever), and leaves at its first boundary crossing (n = 1). Its exit weight
- * goes into integer fixed-point tallies (kernels/mc_params.h), so sums do not depend on the
- * order of the atomic additions.
+ * no photon can run forever), and leaves at its first boundary crossing when n = 1. At n > 1
+ * (issue 18) it enters refracted with weight 1 - F(theta_L) and at every boundary hit is
+ * reflected specularly with probability F(cos theta_i) or leaves refracted into air, the exit
+ * binned by its air-side direction (ppb_mc_boundary). Its exit weight goes into integer
+ * fixed-point tallies (kernels/mc_params.h), so sums do not depend on the order of the atomic
+ * additions.
  *
  * Layout: each work-item runs PPB_MC_LANES photons side by side in OpenCL vector types (one
  * photon per lane; a lane whose photon leaves or dies takes the work-item's next photon). On a
@@ -17,8 +20,10 @@
  * Random numbers: Philox4x32-10 (Random123; Salmon et al., SC'11, the same bijection as
  * Random123's philox4x32, evaluated on a vector of counters) keyed by the seed. Photon i's
  * k-th step uses the counter (i mod 2^32, i / 2^32, k, 0): free path, HG cosine, azimuth,
- * roulette; its entry point uses (i mod 2^32, i / 2^32, 0, 1). So a photon's path depends only
- * on the seed and its index.
+ * roulette; its entry point uses (i mod 2^32, i / 2^32, 0, 1). A step that ends at a wall uses
+ * none of the last three words, so at n > 1 the reflect-or-leave choice takes the fourth (the
+ * roulette's, which only an interaction uses). So a photon's path depends only on the seed and
+ * its index.
  *
  * Precision: transport in float (positions are O(10) mfp, so float's 1e-7 relative resolution
  * is far below any bin or segment; float doubles the SIMD width over double). Binning at exit
@@ -32,6 +37,7 @@
 
 #include "mc_params.h"
 #include "ppb_conventions.h"
+#include "ppb_fresnel.h"
 
 #ifndef PPB_MC_LANES
 #define PPB_MC_LANES 8
@@ -131,7 +137,8 @@ inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong p
     }
     s->x[l] = x, s->y[l] = 0.0f;
     s->wx[l] = p->light_x, s->wy[l] = p->light_y, s->wz[l] = 0.0f;
-    s->weight[l] = 1.0f, s->capture[l] = s->rgain[l] = s->rloss[l] = 0.0f, s->tau[l] = 0.0f;
+    s->weight[l] = p->entry_weight, s->capture[l] = s->rgain[l] = s->rloss[l] = 0.0f,
+    s->tau[l] = 0.0f;
     s->nscat[l] = 0, s->need_tau[l] = -1, s->active[l] = -1, s->capped[l] = 0;
 }
 
@@ -161,6 +168,33 @@ inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_lanes *s, int l,
     sums->capped += (ulong)s->capped[l];
     sums->rgain += ppb_mc_fixed(s->rgain[l]);
     sums->rloss += ppb_mc_fixed(s->rloss[l]);
+}
+
+/* n > 1: lane l's photon has reached a wall (s->left; s->side: a side wall). With probability
+ * F(cos theta_i) (r, the step's unused fourth word) it is reflected specularly and flies on; else
+ * it leaves along the refracted air-side direction (tangential components times n, Snell), which
+ * ppb_mc_finish bins. Total internal reflection has F = 1. */
+inline void ppb_mc_boundary(const ppb_mc_params *p, ppb_mc_lanes *s, int l, uint r)
+{
+    int side = s->side[l];
+    double wn = side ? (double)s->wx[l] : (double)s->wy[l];
+    double cos_i = fabs(wn), inv_n = 1.0 / p->n_in;
+    double cos_t = ppb_refract_cos(cos_i, inv_n);
+    if (cos_t < 0.0 || (double)ppb_mc_uniform1(r) < ppb_fresnel(cos_i, inv_n)) {
+        if (side)
+            s->wx[l] = -s->wx[l];
+        else
+            s->wy[l] = -s->wy[l];
+        s->left[l] = 0, s->done[l] = 0;
+        return;
+    }
+    double n = p->n_in, ta = n * (double)s->wx[l], tb = n * (double)s->wy[l];
+    double tz = n * (double)s->wz[l], out = copysign(cos_t, wn);
+    if (side)
+        ta = out;
+    else
+        tb = out;
+    s->wx[l] = (float)ta, s->wy[l] = (float)tb, s->wz[l] = (float)tz;
 }
 
 /* One step of every lane: a flight leg to the next interaction, the step plane or a wall,
@@ -262,6 +296,13 @@ inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *me
     VSTORE(left | dead, 0, s->done);
     VSTORE(left, 0, s->left);
     VSTORE(side, 0, s->side);
+    if (p->n_in > 1.0) {
+        uint r[LANES];
+        VSTORE(c.v3, 0, r);
+        for (int l = 0; l < LANES; l++)
+            if (s->left[l])
+                ppb_mc_boundary(p, s, l, r[l]);
+    }
 }
 
 /* The global size is batches x P (the host makes it so): work-items [b P, (b + 1) P) trace the

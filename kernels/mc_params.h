@@ -69,6 +69,7 @@ typedef struct ppb_mc_params {
     ppb_u64 first;    /* photon index of work-item 0 */
     ppb_u64 count;    /* photons in this launch */
     ppb_u64 ncells;   /* cells of one tally (layout.ncells) */
+    double n_in;      /* refractive index inside; <= 1: no boundary code runs (issue 18) */
     int batches;      /* batch of photon i is i % batches */
     int tube;         /* 1 tube, 0 slab (no side walls) */
     int step;         /* PPB_STEP_* */
@@ -83,10 +84,11 @@ typedef struct ppb_mc_params {
     float albedo_right;
     float step_x;
     float g;       /* Henyey-Greenstein asymmetry */
-    float light_x; /* w_L = (light_x, light_y, 0) */
+    float light_x; /* w_L = (light_x, light_y, 0), refracted into the medium at n > 1 */
     float light_y;
     float enter_x0; /* photons enter S1 uniformly in [enter_x0, enter_x0 + enter_width) */
     float enter_width;
+    float entry_weight; /* 1 - F(cos theta_L) at n > 1 (the rest is specular), else 1 */
 } ppb_mc_params;
 
 #endif

@@ -153,12 +153,12 @@ int ppb_write_totals_csv(const char *path, const ppb_result *rs, int n, ppb_err 
     ppb_afile af;
     if (ppb_afile_open(&af, path, err))
         return -1;
-    fprintf(af.f, "method,R,T,sides,absorbed,ballistic\n");
+    fprintf(af.f, "method,R,T,sides,absorbed,ballistic,specular\n");
     for (int m = 0; m < n; m++) {
         ppb_totals t = rs[m].totals;
         ppb_totals_complete(&t);
-        fprintf(af.f, "%s,%.10g,%.10g,%.10g,%.10g,%.10g\n", rs[m].method, t.R, t.T, t.sides,
-                t.absorbed, t.ballistic);
+        fprintf(af.f, "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", rs[m].method, t.R, t.T, t.sides,
+                t.absorbed, t.ballistic, t.specular);
     }
     return ppb_afile_commit(&af, err);
 }

@@ -9,6 +9,7 @@
 
 #include "base/atomic_file.h"
 #include "base/hash.h"
+#include "kernels/ppb_fresnel.h"
 
 /* Version 02: the fingerprint became base/hash.h's XXH3 (01 held FNV-1a), so a version 01 file
  * is refused as such instead of failing every merge with "different scenes". Version 03: the
@@ -29,6 +30,9 @@ uint64_t ppb_mc_scene_fingerprint(const ppb_scene *sc)
                      sc->segments_top, sc->segments_side, sc->sigma_t, sc->albedo, sc->g, sc->step,
                      sc->step_x, sc->sigma_t_right, sc->albedo_right, sc->theta_deg, sc->ntheta,
                      sc->nphi);
+    /* n joins the text only where it acts (issue 18), so n = 1 fingerprints are those of before. */
+    if (sc->n > 1.0 && n > 0 && n < (int)sizeof buf)
+        n += snprintf(buf + n, sizeof buf - (size_t)n, " n=%.17g", sc->n);
     return ppb_hash64(buf, n < (int)sizeof buf ? (size_t)n : sizeof buf - 1);
 }
 
@@ -417,6 +421,8 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
     st->capture = C.mean, st->capture_se = C.se;
     st->roulette = net, st->roulette_se = dof > 0 ? sqrt(ss_net / dof) : 0;
     st->events_per_photon = E.mean;
+    /* The beam's specular reflection at entry is exact, not tallied (issue 18). */
+    st->mean.specular = sc->n > 1.0 ? ppb_fresnel(ppb_scene_cos_theta_l(sc), sc->n) : 0.0;
     if (once) {
         /* mc1 holds only the once-scattered exits: what it does not hold is not "absorbed"
          * in any tracked sense, so the writer completes it as 1 - the rest (reference: Bins). */

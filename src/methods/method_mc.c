@@ -5,12 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "kernels/ppb_fresnel.h"
 #include "model/metrics.h"
 #include "base/memory.h"
 #include "base/progress.h"
 
 /* Host and kernel must agree on the parameter block passed by value (kernels/mc_params.h). */
-_Static_assert(sizeof(ppb_mc_params) == 136, "ppb_mc_params layout changed: check mc.cl");
+_Static_assert(sizeof(ppb_mc_params) == 144, "ppb_mc_params layout changed: check mc.cl");
 
 /* Everything one trace holds on the device, released by one NULL-safe cleanup. */
 typedef struct mc_device {
@@ -54,9 +55,19 @@ static ppb_mc_params make_params(const ppb_config *cfg)
     ppb_layout lo = ppb_scene_layout(sc);
     double wl[3];
     ppb_scene_light_dir(sc, wl);
+    float entry_weight = 1.0f;
+    if (sc->n > 1.0) {
+        /* The beam enters refracted (Snell) with 1 - F; F is the specular total (issue 18). At
+         * n = 1 nothing here runs, so the photons are those of before bit for bit. */
+        double cos_l = ppb_scene_cos_theta_l(sc);
+        wl[0] = wl[0] / sc->n;
+        wl[1] = -ppb_refract_cos(cos_l, sc->n);
+        entry_weight = (float)(1.0 - ppb_fresnel(cos_l, sc->n));
+    }
     ppb_mc_params p = {
         .seed = (ppb_u64)cfg->mc.seed,
         .ncells = (ppb_u64)lo.ncells,
+        .n_in = sc->n,
         .batches = cfg->mc.batches,
         .tube = sc->geometry == PPB_GEOM_TUBE,
         .step = sc->step,
@@ -74,6 +85,7 @@ static ppb_mc_params make_params(const ppb_config *cfg)
         .light_y = (float)wl[1],
         .enter_x0 = (float)(-0.5 * sc->width),
         .enter_width = (float)ppb_scene_lit_width(sc),
+        .entry_weight = entry_weight,
     };
     for (int s = 0; s < PPB_NSURF; s++) {
         p.nseg[s] = lo.nseg[s];

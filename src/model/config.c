@@ -80,6 +80,8 @@ static const key_def keys[] = {
     {"medium", "albedo", K_REAL, F(scene.albedo), 0, 1, "0.95", NULL,
      "single-scattering albedo (left of the step)"},
     {"medium", "g", K_REAL, F(scene.g), -0.95, 0.95, "0", NULL, "Henyey-Greenstein asymmetry"},
+    {"medium", "n", K_REAL, F(scene.n), 1, 2.5, "1", NULL,
+     "refractive index inside (outside is 1): smooth Fresnel boundaries"},
     {"medium", "step", K_ENUM, F(scene.step), 0, 0, "none", step_names,
      "what changes at x = step_x (tube only)"},
     {"medium", "step_x", K_REAL, F(scene.step_x), -500, 500, "0", NULL,
@@ -829,6 +831,16 @@ static int validate(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "step_x", err,
             "the step must lie inside the tube (|step_x| < width / 2 = %g, width from %s)",
             0.5 * sc->width, origin_of(cfg, "tube", "width", where, sizeof where));
+    /* Refractive boundaries (issue 18) are built method by method; until a method has them it
+     * is refused at n > 1 rather than run as if n were 1. */
+    if (sc->n > 1.0)
+        for (int i = 0; i < cfg->nmethods; i++)
+            if (strcmp(cfg->methods[i], "mc") != 0)
+                return ppb_config_key_fail(
+                    cfg, "medium", "n", err,
+                    "n > 1 is implemented by mc only so far (issue 18); method %s (methods from "
+                    "%s) would ignore it",
+                    cfg->methods[i], origin_of(cfg, "experiment", "methods", where, sizeof where));
     return 0;
 }
 

@@ -28,5 +28,5 @@ void ppb_result_free(ppb_result *r)
 void ppb_totals_complete(ppb_totals *t)
 {
     if (!t->absorbed_tracked)
-        t->absorbed = 1.0 - (t->R + t->T + t->sides + t->ballistic);
+        t->absorbed = 1.0 - (t->R + t->T + t->sides + t->ballistic + t->specular);
 }

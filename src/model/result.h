@@ -8,7 +8,8 @@
 #include "model/scene.h"
 
 typedef struct ppb_totals {
-    double R, T, sides, absorbed, ballistic; /* fractions of the power entering the lit S1 */
+    double R, T, sides, absorbed, ballistic; /* fractions of the power incident on the lit S1 */
+    double specular;      /* reflected by S1 at entry (n > 1), never in radiance; 0 at n = 1 */
     int absorbed_tracked; /* 0: the writer reports absorbed = 1 - the rest (reference: Bins) */
 } ppb_totals;
 
@@ -25,7 +26,8 @@ typedef struct ppb_result {
 int ppb_result_init(ppb_result *r, const char *method, const ppb_layout *lo, ppb_err *err);
 void ppb_result_free(ppb_result *r);
 
-/* Sets absorbed = 1 - (R + T + sides + ballistic) when the method does not track it. */
+/* Sets absorbed = 1 - (R + T + sides + ballistic + specular) when the method does not track
+ * it. */
 void ppb_totals_complete(ppb_totals *t);
 
 #endif

@@ -1,0 +1,38 @@
+/* ppb_fresnel.h: the smooth dielectric boundary at n > 1 (issue 18; reference: Keys), coded
+ * once for host and kernels.
+ *
+ * Owns: the exact unpolarized Fresnel reflectance from the s- and p-amplitude coefficients
+ * (Born & Wolf Sec. 1.5.2; not Schlick's approximation), with total internal reflection, and
+ * the refraction of a cosine (Snell's law). The relative index n_rel = n_t / n_i: light entering
+ * the medium from air sees n_rel = n, light leaving it sees n_rel = 1 / n. Plain C that is also
+ * OpenCL C (double precision, as ppb_conventions.h). */
+#ifndef PPB_FRESNEL_H
+#define PPB_FRESNEL_H
+
+#include "ppb_conventions.h"
+
+/* Cosine of the refracted direction for incidence cosine cos_i in [0, 1] (Snell: sin_t =
+ * sin_i / n_rel); -1 where the incidence is beyond the critical angle (total internal
+ * reflection). */
+PPB_FN double ppb_refract_cos(double cos_i, double n_rel)
+{
+    double sin2_t = (1.0 - cos_i * cos_i) / (n_rel * n_rel);
+    return sin2_t >= 1.0 ? -1.0 : sqrt(1.0 - sin2_t);
+}
+
+/* Unpolarized reflectance F = (r_s^2 + r_p^2) / 2 with
+ *     r_s = (cos_i - n_rel cos_t) / (cos_i + n_rel cos_t),
+ *     r_p = (n_rel cos_i - cos_t) / (n_rel cos_i + cos_t);
+ * 1 under total internal reflection; F(cos_i = 0) = 1 (grazing). At n_rel = 1 it is 0 up to
+ * round-off; callers skip the boundary entirely at n = 1. */
+PPB_FN double ppb_fresnel(double cos_i, double n_rel)
+{
+    double cos_t = ppb_refract_cos(cos_i, n_rel);
+    if (cos_t < 0.0)
+        return 1.0;
+    double rs = (cos_i - n_rel * cos_t) / (cos_i + n_rel * cos_t);
+    double rp = (n_rel * cos_i - cos_t) / (n_rel * cos_i + cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+#endif
