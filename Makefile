@@ -56,6 +56,12 @@ $(BUILD)/version.txt: FORCE
 $(BUILD)/obj/drivers/experiment.o $(BUILD)/obj/drivers/main.o: $(BUILD)/version.txt
 $(BUILD)/obj/drivers/experiment.o $(BUILD)/obj/drivers/main.o: CPPFLAGS += -DPPB_VERSION='"$(PPB_VERSION)"'
 FORCE:
+# provenance.txt's ppbench.commit (the full hash of HEAD) and lib.inih (inih has no version
+# call: the version built against, from pkg-config). Rebuilt with the version, as above.
+PPB_COMMIT := $(shell git rev-parse HEAD 2>/dev/null || echo unknown)
+$(BUILD)/obj/drivers/provenance.o: $(BUILD)/version.txt
+$(BUILD)/obj/drivers/provenance.o: CPPFLAGS += -DPPB_COMMIT='"$(PPB_COMMIT)"' \
+  -DPPB_INIH_VERSION='"$(shell pkg-config --modversion inih 2>/dev/null || echo unknown)"'
 
 $(LIB): $(OBJ)
 	@rm -f $@

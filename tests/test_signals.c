@@ -150,17 +150,19 @@ static const char *out_file(const char *dir, const char *file)
     return path;
 }
 
-/* How many completion lines `label` printed: progress lines start with \r (ppb_progress), the
- * last one reads "label: N unit in T s". */
+/* How many completion lines `label` printed: progress lines start a line (after \r on a
+ * terminal, ppb_progress), the last one reads "label: N unit in T s". */
 static int count_done(const char *text, const char *label)
 {
     char pre[64];
-    snprintf(pre, sizeof pre, "\r%s: ", label);
+    snprintf(pre, sizeof pre, "%s: ", label);
     int n = 0;
     for (const char *p = strstr(text, pre); p; p = strstr(p + 1, pre)) {
+        if (p > text && p[-1] != '\r' && p[-1] != '\n')
+            continue;
         char line[256];
-        size_t span = strcspn(p + 1, "\r\n");
-        snprintf(line, sizeof line, "%.*s", (int)(span < 255 ? span : 255), p + 1);
+        size_t span = strcspn(p, "\r\n");
+        snprintf(line, sizeof line, "%.*s", (int)(span < 255 ? span : 255), p);
         n += strstr(line, " in ") != NULL && strchr(line, '%') == NULL;
     }
     return n;

@@ -2,6 +2,7 @@
 
 #include <signal.h>
 #include <stdio.h>
+#include <string.h>
 #include <unistd.h>
 
 static volatile sig_atomic_t interrupted;
@@ -54,26 +55,37 @@ void ppb_progress_begin(ppb_progress *p, const char *label, const char *unit, do
     p->total = total;
     p->t0 = p->last = ppb_now();
     p->quiet = quiet;
+    p->tty = isatty(STDERR_FILENO);
 }
 
-static void print_line(const ppb_progress *p, double done, double now, const char *end)
+/* The unit as the count needs it: "1 point", "2 points" (units are given in the plural). */
+static int singular(const char *unit, double n)
+{
+    size_t len = strlen(unit);
+    return n == 1 && len > 1 && unit[len - 1] == 's';
+}
+
+static void print_line(const ppb_progress *p, double done, double now)
 {
     double dt = now - p->t0;
     double rate = dt > 0 ? done / dt : 0;
     double pct = p->total > 0 ? 100.0 * done / p->total : 100.0;
     double eta = rate > 0 ? (p->total - done) / rate : 0;
-    fprintf(stderr, "\r%s: %5.1f%%  %.3g %s/s  ETA %.0f s%s", p->label, pct, rate, p->unit, eta,
-            end);
+    if (p->tty)
+        fprintf(stderr, "\r%s: %5.1f%%  %.3g %s/s  ETA %.0f s   ", p->label, pct, rate, p->unit,
+                eta);
+    else
+        fprintf(stderr, "%s: %.1f%%  %.3g %s/s  ETA %.0f s\n", p->label, pct, rate, p->unit, eta);
     fflush(stderr);
 }
 
 void ppb_progress_update(ppb_progress *p, double done)
 {
     double now = ppb_now();
-    if (p->quiet || now - p->last < 0.5)
+    if (p->quiet || now - p->last < (p->tty ? 0.5 : PPB_PROGRESS_LOG_SECONDS))
         return;
     p->last = now;
-    print_line(p, done, now, "   ");
+    print_line(p, done, now);
 }
 
 void ppb_progress_end(ppb_progress *p, double done)
@@ -81,6 +93,10 @@ void ppb_progress_end(ppb_progress *p, double done)
     if (p->quiet)
         return;
     double now = ppb_now();
-    fprintf(stderr, "\r%s: %.3g %s in %.2f s%s\n", p->label, done, p->unit, now - p->t0,
-            ppb_interrupted() ? " (interrupted)" : "                ");
+    int one = singular(p->unit, done);
+    fprintf(stderr, "%s%s: %.3g %.*s in %.2f s%s\n", p->tty ? "\r" : "", p->label, done,
+            (int)strlen(p->unit) - one, p->unit, now - p->t0,
+            ppb_interrupted() ? " (interrupted)"
+            : p->tty          ? "                "
+                              : "");
 }

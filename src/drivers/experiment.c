@@ -99,8 +99,10 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
             fprintf(stderr, "%s: %s skipped: interrupted before it started\n", cfg->name,
                     cfg->methods[i]);
     }
-    if (ctx->ocl_open)
+    if (ctx->ocl_open) {
         snprintf(ex->device, sizeof ex->device, "%s", ctx->ocl.name);
+        ppb_ocl_versions_get(&ctx->ocl, &ex->ocl_versions);
+    }
     if (ex->n == 0 && ex->nfailed > 0)
         return ppb_fail(err, "%s", ex->failed_why[0]);
     return 0;
@@ -188,6 +190,7 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *
             when);
     fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
             ex->partial);
+    ppb_provenance_write_build(af.f, ex->device[0] ? &ex->ocl_versions : NULL);
     for (int i = 0; i < ex->n; i++)
         if (ex->res[i].photons)
             fprintf(af.f, "%s.photons_traced = %lld\n", ex->res[i].method, ex->res[i].photons);
@@ -198,7 +201,20 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *
     for (int i = 0; i < ex->nincomplete; i++)
         fprintf(af.f, "%s.incomplete = interrupted before it finished: no rows written\n",
                 ex->incomplete[i]);
-    ppb_config_write_resolved(ex->cfg, af.f);
+    ppb_config_write_readable(ex->cfg, af.f);
+    return ppb_afile_commit(&af, err);
+}
+
+/* config.ini: the resolved config as an INI file, which `ppbench run` takes (issue 16: a run
+ * can be repeated from its own output set; docs/reference.md: Outputs). */
+static int write_config_ini(const ppb_experiment *ex, const char *dir, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 256];
+    out_path(dir, "config.ini", path, sizeof path);
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    ppb_config_write_ini(ex->cfg, af.f);
     return ppb_afile_commit(&af, err);
 }
 
@@ -290,7 +306,7 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
     if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err) ||
-        write_provenance(ex, dir, err))
+        write_provenance(ex, dir, err) || write_config_ini(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
     return ppb_images_write(dir, &ex->cfg->scene, ex->res, ex->n, ref ? (int)(ref - ex->res) : -1,

@@ -12,6 +12,7 @@
 #include "model/config.h"
 #include "methods/method.h"
 #include "model/result.h"
+#include "drivers/provenance.h"
 
 #define PPB_MAX_RESULTS (2 * PPB_MAX_METHODS)
 
@@ -21,6 +22,7 @@ typedef struct ppb_experiment {
     ppb_result res[PPB_MAX_RESULTS];
     double seconds[PPB_MAX_RESULTS]; /* wall time of the method run that produced it */
     char device[512];                /* "" when no method used OpenCL */
+    ppb_ocl_versions ocl_versions;   /* the device's versions (when device is not "") */
     int partial;                     /* interrupted: results are incomplete */
     /* Methods that failed at this point (issue 15): no results of theirs, their reasons kept,
      * the other methods run on. */

@@ -432,9 +432,9 @@ static int cmd_run(const cli *c)
             fprintf(stderr, "ppbench: %s: %s\n", cfg->path, err.msg);
             code = EXIT_RUN;
         } else {
-            if (!c->quiet)
-                fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
-                        partial ? " (partial: interrupted)" : "");
+            /* Said under --quiet too (issue 16): where the results went is its one line. */
+            fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
+                    partial ? " (partial: interrupted)" : "");
             if (partial)
                 code = EXIT_INTERRUPTED;
         }

@@ -1047,6 +1047,55 @@ void ppb_config_write_keys(FILE *out)
     }
 }
 
+/* A real in the shortest of %.15g, %.16g, %.17g that strtod reads back as the same double
+ * (0.95, not 0.94999999999999996; %.17g always round-trips an IEEE 754 binary64). */
+static void write_real_short(double v, FILE *out)
+{
+    char buf[40];
+    for (int prec = 15; prec <= 17; prec++) {
+        snprintf(buf, sizeof buf, "%.*g", prec, v);
+        if (strtod(buf, NULL) == v)
+            break;
+    }
+    fputs(buf, out);
+}
+
+static void write_value_short(const ppb_config *cfg, const key_def *k, FILE *out)
+{
+    if (k->type == K_REAL)
+        write_real_short(*(const double *)((const char *)cfg + k->offset), out);
+    else
+        write_value(cfg, k, out);
+}
+
+void ppb_config_write_readable(const ppb_config *cfg, FILE *out)
+{
+    for (int i = 0; i < NKEYS; i++) {
+        fprintf(out, "%s.%s = ", keys[i].section, keys[i].key);
+        write_value_short(cfg, &keys[i], out);
+        fputc('\n', out);
+    }
+}
+
+void ppb_config_write_ini(const ppb_config *cfg, FILE *out)
+{
+    fprintf(out, "; the resolved config of the run beside it (ppbench run THIS_FILE repeats it)\n");
+    for (int i = 0; i < NKEYS; i++) {
+        int seen = 0;
+        for (int j = 0; j < i && !seen; j++)
+            seen = strcmp(keys[j].section, keys[i].section) == 0;
+        if (seen)
+            continue;
+        fprintf(out, "\n[%s]\n", keys[i].section);
+        for (int j = i; j < NKEYS; j++)
+            if (strcmp(keys[j].section, keys[i].section) == 0) {
+                fprintf(out, "%s = ", keys[j].key);
+                write_value_short(cfg, &keys[j], out);
+                fputc('\n', out);
+            }
+    }
+}
+
 void ppb_config_key_name(int key, char *buf, size_t cap)
 {
     if (key < 0 || key >= NKEYS)

@@ -139,6 +139,15 @@ int ppb_config_axis_fail(const ppb_config *cfg, const ppb_grid *grid, int a, ppb
  * resume and recorded in provenance. */
 void ppb_config_write_resolved(const ppb_config *cfg, FILE *out);
 
+/* The same lines with every real in the shortest form that reads back as the same double
+ * (0.95): provenance.txt's, for people (the hash keeps ppb_config_write_resolved's form). */
+void ppb_config_write_readable(const ppb_config *cfg, FILE *out);
+
+/* Every resolved key as an INI file ([section] then key = value, reals as in
+ * ppb_config_write_readable): config.ini, which ppb_config_load reads back into the same
+ * settings, so `ppbench run config.ini` repeats the run. */
+void ppb_config_write_ini(const ppb_config *cfg, FILE *out);
+
 /* The key table as a Markdown table (configs/README.md is generated from it). */
 void ppb_config_write_keys(FILE *out);
 

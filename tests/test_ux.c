@@ -1,0 +1,272 @@
+/* test_ux.c: issue 16's CLI and provenance items, through the built binary ($PPBENCH) where a
+ * user sees them and through the library where the property is a function's:
+ * - provenance.txt records the commit, compiler, OpenCL and library versions, and prints reals
+ *   in their shortest round-trip form (0.95; expected from IEEE 754: %.17g of 0.95 is
+ *   0.94999999999999996, which the old provenance printed);
+ * - config.ini beside it repeats the run: `ppbench run DIR/config.ini` gives byte-identical
+ *   result files (the Monte Carlo is seeded (Philox), so the same settings give the same bytes);
+ *   ppb_config_write_ini reads back into the same doubles, even one that needs 17 digits;
+ * - progress lines when stderr is not a terminal: no \r, at most one line per
+ *   PPB_PROGRESS_LOG_SECONDS; on a terminal (a pty) the line is still rewritten with \r;
+ *   a count of one takes the singular ("1 point");
+ * - run --quiet prints one line, where the results went.
+ * Photon budgets and grids are tiny. */
+#define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
+#include "cliutil.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "base/progress.h"
+#include "model/config.h"
+
+static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int sh(const char *fmt, ...)
+{
+    char cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        fail_msg("cannot open %s", path);
+    static char buf[1 << 20];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    if (len)
+        *len = n;
+    return buf;
+}
+
+static const char tiny[] = "[experiment]\nmethods = mc, ss\n[tube]\nsegments_top = 16\n"
+                           "segments_side = 4\n[medium]\nstep = density\n[mc]\nphotons = 20000\n"
+                           "batches = 4\n[bins]\ntheta = 4\nphi = 4\n";
+
+static void test_provenance_versions_and_short_reals(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxprov", tiny);
+    char dir[1300], args[3000], path[1400];
+    snprintf(dir, sizeof dir, "%s/out", tu_scratch("uxprov_out"));
+    snprintf(args, sizeof args, "run %s --out %s", cfg, dir);
+    cli_expect(args, 0, "wrote");
+    snprintf(path, sizeof path, "%s/provenance.txt", dir);
+    const char *p = slurp(path, NULL);
+    const char *want[] = {"\nppbench.commit = ",
+                          "\ncompiler = ",
+                          "\nopencl.platform_version = ",
+                          "\nopencl.device_version = ",
+                          "\nopencl.driver_version = ",
+                          "\nlib.openblas = OpenBLAS",
+                          "\nlib.lapack = ",
+                          "\nlib.openexr = ",
+                          "\nlib.libpng = ",
+                          "\nlib.xxhash = ",
+                          "\nlib.inih = ",
+                          "\nmedium.albedo = 0.95\n",
+                          "\nmedium.sigma_t_right = 0.5\n"};
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+        if (!strstr(p, want[i]))
+            fail_msg("provenance.txt lacks '%s':\n%s", want[i] + 1, p);
+    if (strstr(p, "0.94999999999999996"))
+        fail_msg("provenance.txt prints 0.95 in 17 digits:\n%s", p);
+}
+
+/* The files of a set that a repeated run must reproduce byte for byte (timings.csv and
+ * provenance.txt hold times and paths, docs/reference.md: Outputs). */
+static const char *const result_files[] = {
+    "radiance.csv", "totals.csv",      "angular.csv",   "rms.csv",       "summary.csv",
+    "regions.csv",  "summary_mc1.csv", "images/mc.exr", "images/ss.exr", "config.ini"};
+
+static void test_config_ini_repeats_run(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxrep", tiny);
+    char a[1300], b[1300], args[3000];
+    snprintf(a, sizeof a, "%s/a", tu_scratch("uxrep_a"));
+    snprintf(b, sizeof b, "%s/b", tu_scratch("uxrep_b"));
+    /* A --set real that needs all 17 digits, to show config.ini keeps the exact double. */
+    snprintf(args, sizeof args, "run %s --set medium.step_x=0.30000000000000004 --out %s", cfg, a);
+    cli_expect(args, 0, "wrote");
+    snprintf(args, sizeof args, "run %s/config.ini --out %s", a, b);
+    cli_expect(args, 0, "wrote");
+    for (size_t i = 0; i < sizeof result_files / sizeof result_files[0]; i++) {
+        /* config.ini names its output directory: the repeat's holds --out's, the rest is equal. */
+        if (!strcmp(result_files[i], "config.ini"))
+            assert_int_equal(sh("grep -v '^dir = ' '%s/config.ini' > '%s.ini' && grep -v '^dir = ' "
+                                "'%s/config.ini' > '%s.ini' && cmp -s '%s.ini' '%s.ini'",
+                                a, a, b, b, a, b),
+                             0);
+        else if (sh("cmp -s '%s/%s' '%s/%s'", a, result_files[i], b, result_files[i]))
+            fail_msg("%s differs between a run and its repeat from config.ini", result_files[i]);
+    }
+    char path[1400];
+    snprintf(path, sizeof path, "%s/config.ini", a);
+    if (!strstr(slurp(path, NULL), "\nstep_x = 0.30000000000000004\n"))
+        fail_msg("config.ini lacks step_x = 0.30000000000000004:\n%s", slurp(path, NULL));
+}
+
+/* ppb_config_write_ini -> ppb_config_load gives the same settings: the canonical lines
+ * (ppb_config_write_resolved, %.17g) of both are equal, with reals that need 15, 16 and 17
+ * digits (0.95, 0.1 + 0.2, 1/3). */
+static void test_ini_round_trip_exact(void **state)
+{
+    (void)state;
+    ppb_config c, d;
+    ppb_err err = {{0}};
+    const char *cfg = cli_config("uxini", tiny);
+    assert_int_equal(ppb_config_load(&c, cfg, &err), 0);
+    c.scene.step_x = 0.1 + 0.2;
+    c.scene.g = 1.0 / 3.0;
+    char path[1300];
+    snprintf(path, sizeof path, "%s/config.ini", tu_scratch("uxini2"));
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    ppb_config_write_ini(&c, f);
+    fclose(f);
+    if (ppb_config_load(&d, path, &err))
+        fail_msg("config.ini does not load: %s", err.msg);
+    char *t1 = NULL, *t2 = NULL;
+    size_t n1 = 0, n2 = 0;
+    FILE *f1 = open_memstream(&t1, &n1), *f2 = open_memstream(&t2, &n2);
+    ppb_config_write_resolved(&c, f1);
+    ppb_config_write_resolved(&d, f2);
+    fclose(f1);
+    fclose(f2);
+    if (n1 != n2 || memcmp(t1, t2, n1))
+        fail_msg("settings differ after the INI round trip:\n%s\n---\n%s", t1, t2);
+    assert_non_null(strstr(t1, "medium.step_x = 0.30000000000000004\n"));
+    free(t1);
+    free(t2);
+    /* The readable form: the shortest that round-trips (0.95; 1/3 needs 16 digits). */
+    f1 = open_memstream(&t1, &n1);
+    ppb_config_write_readable(&c, f1);
+    fclose(f1);
+    assert_non_null(strstr(t1, "medium.albedo = 0.95\n"));
+    assert_non_null(strstr(t1, "medium.g = 0.3333333333333333\n"));
+    free(t1);
+}
+
+/* Progress lines of p written to fd 2 pointing at `to` for `seconds`, updated every ms; the
+ * bytes come back in out. */
+static size_t progress_into(int to, int from, double seconds, const char *unit, double end,
+                            char *out, size_t cap)
+{
+    fflush(stderr);
+    int saved = dup(2);
+    assert_true(saved >= 0);
+    assert_true(dup2(to, 2) == 2);
+    ppb_progress p;
+    ppb_progress_begin(&p, "ux", unit, 100, 0);
+    double t0 = ppb_now();
+    while (ppb_now() - t0 < seconds) {
+        ppb_progress_update(&p, 50);
+        usleep(1000);
+    }
+    ppb_progress_end(&p, end);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    size_t n = 0;
+    ssize_t r;
+    lseek(from, 0, SEEK_SET);
+    while (n + 1 < cap && (r = read(from, out + n, cap - 1 - n)) > 0)
+        n += (size_t)r;
+    out[n] = '\0';
+    return n;
+}
+
+static int count_lines(const char *s)
+{
+    int n = 0;
+    for (; *s; s++)
+        n += *s == '\n';
+    return n;
+}
+
+static void test_progress_plain_lines_off_terminal(void **state)
+{
+    (void)state;
+    char path[1300], out[8192];
+    snprintf(path, sizeof path, "%s/stderr", tu_scratch("uxprog"));
+    int fd = open(path, O_RDWR | O_CREAT | O_TRUNC, 0600);
+    assert_true(fd >= 0);
+    /* 1.3 gaps of PPB_PROGRESS_LOG_SECONDS: one update line (at the gap) and the end line. */
+    progress_into(fd, fd, 1.3 * PPB_PROGRESS_LOG_SECONDS, "points", 1, out, sizeof out);
+    close(fd);
+    if (strchr(out, '\r') || count_lines(out) != 2 || !strstr(out, "ux: 50.0%") ||
+        !strstr(out, "ux: 1 point in "))
+        fail_msg("off a terminal: want one plain update line and 'ux: 1 point in', no \\r:\n%s",
+                 out);
+}
+
+static void test_progress_rewrites_on_terminal(void **state)
+{
+    (void)state;
+    int m = posix_openpt(O_RDWR | O_NOCTTY);
+    if (m < 0 || grantpt(m) || unlockpt(m))
+        skip();
+    int s = open(ptsname(m), O_RDWR | O_NOCTTY);
+    assert_true(s >= 0);
+    char out[8192];
+    fcntl(m, F_SETFL, O_NONBLOCK);
+    progress_into(s, m, 1.2, "points", 3, out, sizeof out);
+    close(s);
+    close(m);
+    if (!strchr(out, '\r') || !strstr(out, "ux: 3 points in "))
+        fail_msg("on a terminal: want \\r updates and 'ux: 3 points in':\n%s", out);
+}
+
+/* A whole run with stderr in a file: no \r in it, and progress lines bounded by the time. */
+static void test_run_log_has_no_cr(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxlog", tiny);
+    char dir[1300], args[3000];
+    snprintf(dir, sizeof dir, "%s/out", tu_scratch("uxlog_out"));
+    snprintf(args, sizeof args, "run %s --out %s", cfg, dir);
+    double t0 = ppb_now();
+    cli_expect(args, 0, "wrote");
+    double dt = ppb_now() - t0;
+    int eta = 0;
+    for (const char *s = cli_out; (s = strstr(s, "ETA")); s++)
+        eta++;
+    if (strchr(cli_out, '\r') || eta > 2 * (1 + (int)(dt / PPB_PROGRESS_LOG_SECONDS)))
+        fail_msg("a run's log (%.1f s) holds \\r or %d progress lines:\n%s", dt, eta, cli_out);
+}
+
+/* --quiet: the run says where its results went, in one line and nothing else. */
+static void test_quiet_says_where(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxquiet", tiny);
+    char dir[1300], args[3000], want[1400];
+    snprintf(dir, sizeof dir, "%s/out", tu_scratch("uxquiet_out"));
+    snprintf(args, sizeof args, "run --quiet --set experiment.name=q %s --out %s", cfg, dir);
+    snprintf(want, sizeof want, "q: wrote %s\n", dir);
+    int rc = cli_run_env("", args, cli_out, sizeof cli_out);
+    if (rc != 0 || strcmp(cli_out, want))
+        fail_msg("run --quiet: exit %d, want exactly '%s', got:\n%s", rc, want, cli_out);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_provenance_versions_and_short_reals),
+        cmocka_unit_test(test_config_ini_repeats_run),
+        cmocka_unit_test(test_ini_round_trip_exact),
+        cmocka_unit_test(test_progress_plain_lines_off_terminal),
+        cmocka_unit_test(test_progress_rewrites_on_terminal),
+        cmocka_unit_test(test_run_log_has_no_cr),
+        cmocka_unit_test(test_quiet_says_where),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
