@@ -5,8 +5,6 @@
 
 #include "testutil.h"
 
-#include <sys/wait.h>
-
 /* Runs `env ppbench args` (env: "" or "VAR=value ..."), stdout+stderr into out; the exit code,
  * or 128 + the signal for a killed process. */
 static inline int cli_run_env(const char *env, const char *args, char *out, size_t cap)
@@ -43,16 +41,7 @@ static inline void cli_expect(const char *args, int code, const char *needle)
     cli_expect_env("", args, code, needle);
 }
 
-/* Writes text to <scratch dir of name>/<name>.ini; returns its path (a static buffer). */
-static inline const char *cli_config(const char *name, const char *text)
-{
-    static char path[1200];
-    snprintf(path, sizeof path, "%s/%s.ini", tu_scratch(name), name);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-    return path;
-}
+/* cli_config: the scratch config of testutil.h. */
+#define cli_config tu_config
 
 #endif

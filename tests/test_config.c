@@ -9,23 +9,12 @@
 #include "model/config.h"
 #include "model/grid.h"
 
-static const char *write_cfg(const char *name, const char *text)
-{
-    static char path[1200];
-    snprintf(path, sizeof path, "%s/%s.ini", tu_scratch(name), name);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-    return path;
-}
-
 static ppb_config cfg;
 
 static void test_spec_example(void **state)
 {
     (void)state;
-    const char *p = write_cfg("spec", "[experiment]\nname = uniform_g0_normal\ngeometry = tube\n"
+    const char *p = tu_config("spec", "[experiment]\nname = uniform_g0_normal\ngeometry = tube\n"
                                       "methods = mc, pp, ss, mp, mp+ss\n"
                                       "[tube]\nwidth = 10\nheight = 3\nsegments_top = 128\n"
                                       "segments_side = 36\n"
@@ -60,7 +49,7 @@ static void test_spec_example(void **state)
 static void test_defaults(void **state)
 {
     (void)state;
-    const char *p = write_cfg("defaults", "[experiment]\n");
+    const char *p = tu_config("defaults", "[experiment]\n");
     ppb_err err = {{0}};
     assert_int_equal(ppb_config_load(&cfg, p, &err), 0);
     /* Defaults are SPEC.md section 6's study values. */
@@ -74,7 +63,7 @@ static void test_defaults(void **state)
 /* Each error class names file, line and key. */
 static void expect_error(const char *name, const char *text, const char *needle)
 {
-    const char *p = write_cfg(name, text);
+    const char *p = tu_config(name, text);
     ppb_err err = {{0}};
     if (ppb_config_load(&cfg, p, &err) != -1)
         fail_msg("config '%s' was accepted", name);
@@ -113,7 +102,7 @@ static void test_errors(void **state)
  * mode, naming where the list was set, in the words the config used to refuse them in. */
 static void expect_method_error(const char *name, const char *text, const char *why)
 {
-    const char *p = write_cfg(name, text);
+    const char *p = tu_config(name, text);
     ppb_err err = {{0}};
     assert_int_equal(ppb_config_load(&cfg, p, &err), 0);
     assert_int_equal(ppb_methods_check(&cfg, &err), -1);
@@ -133,7 +122,7 @@ static void test_method_checks(void **state)
     expect_method_error("both", "[experiment]\nmethods = ppslab, xx\n",
                         "2: [experiment] methods: unknown method 'xx' (see ppbench --help)");
     ppb_err err = {{0}};
-    const char *p = write_cfg("methodsok", "[experiment]\ngeometry = slab\nmethods = ppslab, mc\n");
+    const char *p = tu_config("methodsok", "[experiment]\ngeometry = slab\nmethods = ppslab, mc\n");
     assert_int_equal(ppb_config_load(&cfg, p, &err), 0);
     assert_int_equal(ppb_methods_check(&cfg, &err), 0);
     /* The study's default list is every tube method. */
@@ -203,7 +192,7 @@ static void test_missing_file(void **state)
 static void test_lists_and_points(void **state)
 {
     (void)state;
-    const char *p = write_cfg("sweep", "[medium]\ng = 0, 0.5\nalbedo = 0.5:0.9:0.2\n");
+    const char *p = tu_config("sweep", "[medium]\ng = 0, 0.5\nalbedo = 0.5:0.9:0.2\n");
     ppb_err err = {{0}};
     ppb_grid *grid = ppb_grid_new();
     assert_non_null(grid);
@@ -233,7 +222,7 @@ static void test_lists_and_points(void **state)
     assert_int_equal(grid->naxes, 1);
     assert_int_equal(ppb_grid_npoints(grid), 3);
     /* Loading again starts from an empty grid. */
-    p = write_cfg("plain", "[medium]\ng = 0.5\n");
+    p = tu_config("plain", "[medium]\ng = 0.5\n");
     assert_int_equal(ppb_config_load_grid(&cfg, grid, p, &err), 0);
     assert_int_equal(grid->naxes, 0);
     assert_int_equal(ppb_grid_npoints(grid), 1);
@@ -244,7 +233,7 @@ static void test_lists_and_points(void **state)
 static void test_set_override(void **state)
 {
     (void)state;
-    const char *p = write_cfg("set", "[mc]\nphotons = 1e6\n");
+    const char *p = tu_config("set", "[mc]\nphotons = 1e6\n");
     ppb_err err = {{0}};
     assert_int_equal(ppb_config_load(&cfg, p, &err), 0);
     assert_int_equal(ppb_config_set(&cfg, "mc", "photons", "2e3", &err), 0);

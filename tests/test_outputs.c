@@ -17,18 +17,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int sh(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 static int exists(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static int exists(const char *fmt, ...)
 {
@@ -108,7 +96,7 @@ static void test_rerun_with_fewer_methods_leaves_nothing_stale(void **state)
     for (size_t i = 0; i < sizeof stale / sizeof stale[0]; i++)
         assert_absent("%s/%s", d, stale[i]);
     /* radiance.csv holds mp's rows only (its first column is the method). */
-    if (sh("awk -F, 'NR > 1 && $1 != \"mp\" {exit 1}' %s/radiance.csv", d) != 0)
+    if (tu_sh("awk -F, 'NR > 1 && $1 != \"mp\" {exit 1}' %s/radiance.csv", d) != 0)
         fail_msg("%s/radiance.csv holds rows of a method that did not run", d);
 }
 
@@ -122,7 +110,7 @@ static void test_foreign_directory_is_refused_before_work(void **state)
     const char *s = tu_scratch("outputs-foreign");
     char d[1100], args[4000];
     snprintf(d, sizeof d, "%s/mine", s);
-    assert_int_equal(sh("mkdir -p %s && echo keep > %s/notes.txt", d, d), 0);
+    assert_int_equal(tu_sh("mkdir -p %s && echo keep > %s/notes.txt", d, d), 0);
     /* Not --quiet: a method that started would say "tiny: mc ...". */
     snprintf(args, sizeof args, "run --out %s %s", d, cfg);
     const char *why[] = {d, "ppbench did not write", "notes.txt", NULL};
@@ -130,14 +118,14 @@ static void test_foreign_directory_is_refused_before_work(void **state)
     if (strstr(cli_out, "tiny: mc ..."))
         fail_msg("the run started before refusing:\n%s", cli_out);
     assert_int_equal(
-        sh("test \"$(cat %s/notes.txt)\" = keep && test \"$(ls %s)\" = notes.txt", d, d), 0);
-    assert_int_equal(sh("test -z \"$(ls %s | grep -v '^mine$')\"", s), 0); /* no staging left */
+        tu_sh("test \"$(cat %s/notes.txt)\" = keep && test \"$(ls %s)\" = notes.txt", d, d), 0);
+    assert_int_equal(tu_sh("test -z \"$(ls %s | grep -v '^mine$')\"", s), 0); /* no staging left */
     /* mc-merge writes an output set too: refused before it reads a shard. */
     snprintf(args, sizeof args, "mc-merge --out %s %s %s/no-such-shard", d, cfg, s);
     expect_all("", args, 2, why);
     /* An empty directory is taken. */
     snprintf(d, sizeof d, "%s/empty", s);
-    assert_int_equal(sh("mkdir -p %s", d), 0);
+    assert_int_equal(tu_sh("mkdir -p %s", d), 0);
     snprintf(args, sizeof args, "run --quiet --set experiment.methods=mp --out %s %s", d, cfg);
     cli_expect(args, 0, "");
     assert_exists("%s/radiance.csv", d);
@@ -156,24 +144,24 @@ static void test_failed_write_keeps_previous_set(void **state)
     snprintf(d, sizeof d, "%s/o", s);
     snprintf(args, sizeof args, "run --quiet --out %s %s", d, cfg);
     cli_expect(args, 0, "");
-    assert_int_equal(sh("cp -r %s %s/saved", d, s), 0);
+    assert_int_equal(tu_sh("cp -r %s %s/saved", d, s), 0);
     /* The second run is mp alone: its radiance.csv differs from the first's (no mc rows). */
     snprintf(args, sizeof args, "run --quiet --set experiment.methods=mp --out %s %s", d, cfg);
     /* 10 blocks of 512 bytes: the CSVs fit (mp's radiance.csv is about 3.4 KB), the images do
      * not. SIGXFSZ ignored: the write fails with EFBIG instead of killing the process. */
     snprintf(env, sizeof env, "sh -c 'trap \"\" XFSZ; ulimit -f 10; exec \"$0\" \"$@\"'");
     cli_expect_env(env, args, 1, "");
-    if (sh("diff -r %s %s/saved >&2", d, s) != 0)
+    if (tu_sh("diff -r %s %s/saved >&2", d, s) != 0)
         fail_msg("the previous output set changed:\n%s", cli_out);
-    assert_int_equal(sh("test \"$(ls %s)\" = \"$(printf 'o\\nsaved')\"", s), 0);
+    assert_int_equal(tu_sh("test \"$(ls %s)\" = \"$(printf 'o\\nsaved')\"", s), 0);
     /* 4 blocks: radiance.csv, the first file, fails; the message says where and why. */
     snprintf(env, sizeof env, "sh -c 'trap \"\" XFSZ; ulimit -f 4; exec \"$0\" \"$@\"'");
     char reason[300];
     snprintf(reason, sizeof reason, "radiance.csv: write failed: %s", strerror(EFBIG));
     cli_expect_env(env, args, 1, reason);
-    if (sh("diff -r %s %s/saved >&2", d, s) != 0)
+    if (tu_sh("diff -r %s %s/saved >&2", d, s) != 0)
         fail_msg("the previous output set changed:\n%s", cli_out);
-    assert_int_equal(sh("test \"$(ls %s)\" = \"$(printf 'o\\nsaved')\"", s), 0);
+    assert_int_equal(tu_sh("test \"$(ls %s)\" = \"$(printf 'o\\nsaved')\"", s), 0);
 }
 
 /* Before: a killed run left radiance.csv.tmp.<pid> (and now would leave staging directories)
@@ -189,10 +177,11 @@ static void test_stale_temporaries_of_dead_processes_removed(void **state)
     snprintf(args, sizeof args, "run --quiet --set experiment.methods=mp --out %s %s", d, cfg);
     cli_expect(args, 0, "");
     long dead = dead_pid();
-    assert_int_equal(sh("touch %s/radiance.csv.tmp.%ld %s/images/mp.png.tmp.%ld && "
-                        "mkdir %s.tmp.%ld %s.old.%ld %s/new.tmp.%ld && touch %s.tmp.%ld/totals.csv",
-                        d, dead, d, dead, d, dead, d, dead, s, dead, d, dead),
-                     0);
+    assert_int_equal(
+        tu_sh("touch %s/radiance.csv.tmp.%ld %s/images/mp.png.tmp.%ld && "
+              "mkdir %s.tmp.%ld %s.old.%ld %s/new.tmp.%ld && touch %s.tmp.%ld/totals.csv",
+              d, dead, d, dead, d, dead, d, dead, s, dead, d, dead),
+        0);
     /* Removed at start, not with the previous directory when the new set is swapped in: this
      * run fails at its first file (a 2 KB file size limit), so no swap happens. */
     cli_expect_env("sh -c 'trap \"\" XFSZ; ulimit -f 4; exec \"$0\" \"$@\"'", args, 1,
@@ -208,7 +197,8 @@ static void test_stale_temporaries_of_dead_processes_removed(void **state)
     assert_absent("%s/new.tmp.%ld", s, dead);
     /* This test's own process is alive: its staging directory is left alone, the run refused. */
     long live = (long)getpid();
-    assert_int_equal(sh("mkdir %s.tmp.%ld && touch %s.tmp.%ld/radiance.csv", d, live, d, live), 0);
+    assert_int_equal(tu_sh("mkdir %s.tmp.%ld && touch %s.tmp.%ld/radiance.csv", d, live, d, live),
+                     0);
     char pid[32];
     snprintf(pid, sizeof pid, "process %ld", live);
     snprintf(args, sizeof args, "run --quiet --set experiment.methods=mp --out %s %s", d, cfg);
@@ -216,7 +206,7 @@ static void test_stale_temporaries_of_dead_processes_removed(void **state)
     expect_all("", args, 2, why);
     assert_exists("%s.tmp.%ld/radiance.csv", d, live);
     assert_exists("%s/radiance.csv", d);
-    assert_int_equal(sh("rm -r %s.tmp.%ld", d, live), 0);
+    assert_int_equal(tu_sh("rm -r %s.tmp.%ld", d, live), 0);
 }
 
 /* Before: `ppbench report . CASE` overwrote the repository's README.md, silently. Now a file
@@ -230,7 +220,7 @@ static void test_report_replaces_only_its_own_files(void **state)
     char args[3000];
     snprintf(args, sizeof args, "run --quiet --out %s/case1 %s", s, cfg);
     cli_expect(args, 0, "");
-    assert_int_equal(sh("echo '# my project' > %s/README.md", s), 0);
+    assert_int_equal(tu_sh("echo '# my project' > %s/README.md", s), 0);
     snprintf(args, sizeof args, "report %s case1", s);
     char readme[1200], csv[1200], md[1200];
     snprintf(readme, sizeof readme, "%s/README.md", s);
@@ -238,15 +228,15 @@ static void test_report_replaces_only_its_own_files(void **state)
     snprintf(md, sizeof md, "%s/table2.md", s);
     const char *refused_readme[] = {readme, "not written by ppbench report", NULL};
     expect_all("", args, 2, refused_readme);
-    assert_int_equal(sh("test \"$(cat %s)\" = '# my project'", readme), 0);
+    assert_int_equal(tu_sh("test \"$(cat %s)\" = '# my project'", readme), 0);
     assert_absent("%s", csv);
     assert_absent("%s", md);
     /* A table of someone else's is refused as well. */
-    assert_int_equal(sh("rm %s && printf 'a,b\\n1,2\\n' > %s", readme, csv), 0);
+    assert_int_equal(tu_sh("rm %s && printf 'a,b\\n1,2\\n' > %s", readme, csv), 0);
     const char *refused_csv[] = {csv, "not written by ppbench report", NULL};
     expect_all("", args, 2, refused_csv);
-    assert_int_equal(sh("test \"$(cat %s)\" = \"$(printf 'a,b\\n1,2')\"", csv), 0);
-    assert_int_equal(sh("rm %s", csv), 0);
+    assert_int_equal(tu_sh("test \"$(cat %s)\" = \"$(printf 'a,b\\n1,2')\"", csv), 0);
+    assert_int_equal(tu_sh("rm %s", csv), 0);
     /* Its own files it writes, names, and replaces on the next report. */
     char w1[1300], w2[1300], w3[1300];
     snprintf(w1, sizeof w1, "wrote %s\n", csv);
@@ -257,9 +247,9 @@ static void test_report_replaces_only_its_own_files(void **state)
     expect_all("", args, 0, wrote);
     /* A README.md an earlier report wrote (its title line first) is its own too. */
     assert_int_equal(
-        sh("printf '# The accuracy study (written by `make bench`)\\nold\\n' > %s", readme), 0);
+        tu_sh("printf '# The accuracy study (written by `make bench`)\\nold\\n' > %s", readme), 0);
     expect_all("", args, 0, wrote);
-    assert_int_equal(sh("grep -q 'RMS error against the Monte Carlo' %s", readme), 0);
+    assert_int_equal(tu_sh("grep -q 'RMS error against the Monte Carlo' %s", readme), 0);
 }
 
 /* Before: an interrupted pp wrote the rows it never marched as 0 radiance, like data. Now an
@@ -275,20 +265,20 @@ static void test_interrupted_pp_writes_no_rows(void **state)
                                                    "[pp]\ndirections = 16\nstep = 0.005\n");
     const char *s = tu_scratch("outputs-pp");
     const char *b = getenv("PPBENCH") ? getenv("PPBENCH") : "./ppbench";
-    int rc = sh("%s run --out %s/o %s 2> %s/err & pid=$!; i=0; "
-                "until grep -q 'pp: .*rows/s' %s/err || [ $i -ge 1200 ]; do sleep 0.1; "
-                "i=$((i + 1)); done; kill -INT $pid; wait $pid",
-                b, s, cfg, s, s);
+    int rc = tu_sh("%s run --out %s/o %s 2> %s/err & pid=$!; i=0; "
+                   "until grep -q 'pp: .*rows/s' %s/err || [ $i -ge 1200 ]; do sleep 0.1; "
+                   "i=$((i + 1)); done; kill -INT $pid; wait $pid",
+                   b, s, cfg, s, s);
     if (rc != 130)
-        sh("tr '\\r' '\\n' < %s/err >&2", s);
+        tu_sh("tr '\\r' '\\n' < %s/err >&2", s);
     assert_int_equal(rc, 130);
-    assert_int_equal(sh("grep -q 'pp: .*rows/s' %s/err", s), 0); /* interrupted while marching */
-    if (sh("awk -F, '$1 == \"pp\" {exit 1}' %s/o/radiance.csv", s) != 0)
+    assert_int_equal(tu_sh("grep -q 'pp: .*rows/s' %s/err", s), 0); /* interrupted while marching */
+    if (tu_sh("awk -F, '$1 == \"pp\" {exit 1}' %s/o/radiance.csv", s) != 0)
         fail_msg("%s/o/radiance.csv holds rows of the interrupted pp", s);
-    assert_int_equal(sh("grep -q '^mp,' %s/o/radiance.csv", s), 0);
-    assert_int_equal(sh("awk -F, '$1 == \"pp\" {exit 1}' %s/o/totals.csv", s), 0);
-    assert_int_equal(sh("grep -q '^partial = 1$' %s/o/provenance.txt", s), 0);
-    assert_int_equal(sh("grep -q '^pp.incomplete = ' %s/o/provenance.txt", s), 0);
+    assert_int_equal(tu_sh("grep -q '^mp,' %s/o/radiance.csv", s), 0);
+    assert_int_equal(tu_sh("awk -F, '$1 == \"pp\" {exit 1}' %s/o/totals.csv", s), 0);
+    assert_int_equal(tu_sh("grep -q '^partial = 1$' %s/o/provenance.txt", s), 0);
+    assert_int_equal(tu_sh("grep -q '^pp.incomplete = ' %s/o/provenance.txt", s), 0);
 }
 
 int main(void)

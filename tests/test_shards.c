@@ -21,53 +21,14 @@
 
 #include "methods/mc_tally.h"
 
-static const char *bin(void)
-{
-    const char *b = getenv("PPBENCH");
-    return b ? b : "./ppbench";
-}
-
-static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int sh(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static char *read_text(const char *path)
-{
-    static char buf[1 << 16];
-    FILE *f = fopen(path, "r");
-    buf[0] = '\0';
-    if (f) {
-        size_t n = fread(buf, 1, sizeof buf - 1, f);
-        buf[n] = '\0';
-        fclose(f);
-    }
-    return buf;
-}
-
 /* Soft checks: each failure is printed and counted, and the test fails at its end, so one run
  * shows every check that fails (on the code before the fixes: all of them). */
 static int failures;
 
 static void same_bytes(const char *a, const char *b)
 {
-    if (sh("cmp -s '%s' '%s'", a, b) != 0) {
-        sh("diff '%s' '%s' | head -8 >&2", a, b);
+    if (tu_sh("cmp -s '%s' '%s'", a, b) != 0) {
+        tu_sh("diff '%s' '%s' | head -8 >&2", a, b);
         print_error("FAIL: %s and %s differ\n", a, b);
         failures++;
     }
@@ -112,12 +73,12 @@ static const char *slow_sweep = "[experiment]\nmethods = mc\n[tube]\nsegments_to
 static int jobs_then(const char *d, const char *cfg, const char *name, const char *wrap,
                      const char *then)
 {
-    return sh("%s %s sweep --quiet --jobs 2 --out %s/%s %s > %s/%s.log 2>&1 & pid=$!; i=0; "
-              "while [ $(ps -o pid= --ppid $pid | wc -l) -lt 2 ]; do i=$((i + 1)); "
-              "[ $i -gt 600 ] && { kill -9 $pid; exit 90; }; sleep 0.05; done; "
-              "kids=$(ps -o pid= --ppid $pid); sleep 1; %s; rc=$?; kill -9 $kids 2>/dev/null; "
-              "exit $rc",
-              wrap, bin(), d, name, cfg, d, name, then);
+    return tu_sh("%s %s sweep --quiet --jobs 2 --out %s/%s %s > %s/%s.log 2>&1 & pid=$!; i=0; "
+                 "while [ $(ps -o pid= --ppid $pid | wc -l) -lt 2 ]; do i=$((i + 1)); "
+                 "[ $i -gt 600 ] && { kill -9 $pid; exit 90; }; sleep 0.05; done; "
+                 "kids=$(ps -o pid= --ppid $pid); sleep 1; %s; rc=$?; kill -9 $kids 2>/dev/null; "
+                 "exit $rc",
+                 wrap, tu_bin(), d, name, cfg, d, name, then);
 }
 
 /* Shell text: exit 0 once no pid of $kids is alive (a zombie is dead), 1 after 20 s. */
@@ -137,7 +98,7 @@ static void test_jobs_die_with_sweep(void **state)
     const char *d = tu_scratch("shards-orphans");
     char cfg[1200];
     snprintf(cfg, sizeof cfg, "%s/slow.ini", d);
-    write_file(cfg, slow_sweep);
+    tu_write_file(cfg, slow_sweep);
     /* kill -9 of the sweep: its workers must be gone within 20 s (before: they ran on). */
     int rc = jobs_then(d, cfg, "k9", "", "kill -9 $pid; wait $pid; (" KIDS_GONE ")");
     if (rc != 0)
@@ -150,7 +111,7 @@ static void test_jobs_interrupted_exit_130(void **state)
     const char *d = tu_scratch("shards-sigint");
     char cfg[1200];
     snprintf(cfg, sizeof cfg, "%s/slow.ini", d);
-    write_file(cfg, slow_sweep);
+    tu_write_file(cfg, slow_sweep);
     /* A Ctrl-C: SIGINT to the whole process group. setsid makes the sweep a group leader. */
     const char *kinds[2] = {"group", "parent"};
     const char *sig[2] = {"kill -INT -$pid", "kill -INT $pid"};
@@ -162,12 +123,12 @@ static void test_jobs_interrupted_exit_130(void **state)
         snprintf(out, sizeof out, "int_%s", kinds[k]);
         int rc = jobs_then(d, cfg, out, "setsid", then);
         snprintf(log, sizeof log, "%s/%s.log", d, out);
-        const char *text = read_text(log);
+        const char *text = tu_read_text(log);
         if (rc != 130 || !strstr(text, "interrupted: 0 of 2 points done"))
             fail_msg("SIGINT to the %s of sweep --jobs 2: exit %d (want 130 and 'interrupted: 0 "
                      "of 2 points done'):\n%s",
                      kinds[k], rc, text);
-        if (sh("test ! -e %s/%s/sweep.csv", d, out) != 0)
+        if (tu_sh("test ! -e %s/%s/sweep.csv", d, out) != 0)
             fail_msg("an interrupted sweep wrote sweep.csv");
     }
 }
@@ -187,7 +148,7 @@ static void test_grown_grid_reuses_points(void **state)
 {
     (void)state;
     const char *d = tu_scratch("shards-grow");
-    const char *b = bin();
+    const char *b = tu_bin();
     struct {
         const char *name, *g, *extra;
     } steps[] = {
@@ -198,18 +159,20 @@ static void test_grown_grid_reuses_points(void **state)
     for (int s = 0; s < 3; s++) {
         char cfg[1200], grown[1300], fresh[1300];
         snprintf(cfg, sizeof cfg, "%s/%s.ini", d, steps[s].name);
-        write_file(cfg, grid_cfg(steps[s].g, steps[s].extra));
+        tu_write_file(cfg, grid_cfg(steps[s].g, steps[s].extra));
         /* The same directory each time (the grown grid reuses the finished points), and a fresh
          * one: the expected bytes. */
-        assert_int_equal(sh("%s sweep --quiet --out %s/same %s", b, d, cfg), 0);
-        assert_int_equal(sh("%s sweep --quiet --out %s/fresh_%s %s", b, d, steps[s].name, cfg), 0);
+        assert_int_equal(tu_sh("%s sweep --quiet --out %s/same %s", b, d, cfg), 0);
+        assert_int_equal(tu_sh("%s sweep --quiet --out %s/fresh_%s %s", b, d, steps[s].name, cfg),
+                         0);
         snprintf(grown, sizeof grown, "%s/same/sweep.csv", d);
         snprintf(fresh, sizeof fresh, "%s/fresh_%s/sweep.csv", d, steps[s].name);
         same_bytes(grown, fresh);
     }
     /* The last grid: 3 x 2 points, one mp row each, every row as long as the header. */
-    expect_sh(sh("test $(wc -l < %s/same/sweep.csv) -eq 7", d) == 0, "7 lines in sweep.csv");
-    expect_sh(sh("test $(awk -F, '{print NF}' %s/same/sweep.csv | sort -u | wc -l) -eq 1", d) == 0,
+    expect_sh(tu_sh("test $(wc -l < %s/same/sweep.csv) -eq 7", d) == 0, "7 lines in sweep.csv");
+    expect_sh(tu_sh("test $(awk -F, '{print NF}' %s/same/sweep.csv | sort -u | wc -l) -eq 1", d) ==
+                  0,
               "every row of sweep.csv has the header's fields");
     end_checks();
 }
@@ -218,7 +181,7 @@ static void test_merge_refuses_other_grids(void **state)
 {
     (void)state;
     const char *d = tu_scratch("shards-mergegrid");
-    const char *b = bin();
+    const char *b = tu_bin();
     struct {
         const char *name, *g, *extra;
     } cfgs[] = {
@@ -230,11 +193,11 @@ static void test_merge_refuses_other_grids(void **state)
     for (int c = 0; c < 4; c++) {
         char cfg[1200];
         snprintf(cfg, sizeof cfg, "%s/%s.ini", d, cfgs[c].name);
-        write_file(cfg, grid_cfg(cfgs[c].g, cfgs[c].extra));
+        tu_write_file(cfg, grid_cfg(cfgs[c].g, cfgs[c].extra));
         for (int s = 1; s <= 2; s++)
-            assert_int_equal(
-                sh("%s sweep --quiet --shard %d/2 --out %s/%s%d %s", b, s, d, cfgs[c].name, s, cfg),
-                0);
+            assert_int_equal(tu_sh("%s sweep --quiet --shard %d/2 --out %s/%s%d %s", b, s, d,
+                                   cfgs[c].name, s, cfg),
+                             0);
     }
     /* Shards of one grid merge (the control). */
     char args[4096];
@@ -249,7 +212,7 @@ static void test_merge_refuses_other_grids(void **state)
         snprintf(needle, sizeof needle, "%s/%s2: its grid differs from %s/base1's (%s", d,
                  cfgs[c].name, d, why[c]);
         expect(args, 2, needle);
-        expect_sh(sh("test ! -e %s/bad%d/sweep.csv", d, c) == 0,
+        expect_sh(tu_sh("test ! -e %s/bad%d/sweep.csv", d, c) == 0,
                   "no sweep.csv from a refused merge");
     }
     end_checks();
@@ -269,8 +232,8 @@ static const char *mc_cfg(const char *albedo)
 
 static void shard(const char *d, const char *cfg, const char *part, const char *dir)
 {
-    assert_int_equal(sh("%s mc-shard --quiet --shard %s --out %s/%s %s", bin(), part, d, dir, cfg),
-                     0);
+    assert_int_equal(
+        tu_sh("%s mc-shard --quiet --shard %s --out %s/%s %s", tu_bin(), part, d, dir, cfg), 0);
 }
 
 static void flip_bit(const char *path, long at)
@@ -292,8 +255,8 @@ static void test_mc_merge_checks_shards(void **state)
     char cfg[1200], other[1200], args[8192], needle[8192];
     snprintf(cfg, sizeof cfg, "%s/one.ini", d);
     snprintf(other, sizeof other, "%s/other.ini", d);
-    write_file(cfg, mc_cfg("0.95"));
-    write_file(other, mc_cfg("0.5"));
+    tu_write_file(cfg, mc_cfg("0.95"));
+    tu_write_file(other, mc_cfg("0.5"));
     const char *parts[][2] = {{"1/3", "p1"}, {"2/3", "p2"}, {"3/3", "p3"}, {"1/2", "h1"},
                               {"2/4", "q2"}, {"4/4", "q4"}, {"1/4", "q1"}};
     for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++)
@@ -337,7 +300,7 @@ static void test_mc_merge_checks_shards(void **state)
     snprintf(needle, sizeof needle, "%s: corrupt or truncated tally file", p2);
     expect(args, 1, needle);
     for (const char *o = "dup\0ovl\0gap\0scene\0flip\0"; *o; o += strlen(o) + 1)
-        expect_sh(sh("test ! -e %s/%s/radiance.csv", d, o) == 0,
+        expect_sh(tu_sh("test ! -e %s/%s/radiance.csv", d, o) == 0,
                   "no radiance.csv from a refused merge");
     end_checks();
 }
@@ -348,22 +311,22 @@ static void test_mc_shard_interrupted_130(void **state)
     const char *d = tu_scratch("shards-mcint");
     char cfg[1200];
     snprintf(cfg, sizeof cfg, "%s/slow.ini", d);
-    write_file(cfg, "[experiment]\nmethods = mc\n[tube]\nsegments_top = 4\nsegments_side = 2\n"
-                    "[bins]\ntheta = 2\nphi = 2\n[mc]\nphotons = 2000000000\nbatches = 4\n");
+    tu_write_file(cfg, "[experiment]\nmethods = mc\n[tube]\nsegments_top = 4\nsegments_side = 2\n"
+                       "[bins]\ntheta = 2\nphi = 2\n[mc]\nphotons = 2000000000\nbatches = 4\n");
     /* Interrupted once it has started tracing (its progress line says so). */
-    int rc = sh("%s mc-shard --shard 1/2 --out %s/part %s > %s/log 2>&1 & pid=$!; i=0; "
-                "while ! grep -qs photons %s/log; do i=$((i + 1)); "
-                "[ $i -gt 600 ] && { kill -9 $pid; exit 90; }; sleep 0.05; done; "
-                "kill -INT $pid; " WAIT_PID,
-                bin(), d, cfg, d, d);
+    int rc = tu_sh("%s mc-shard --shard 1/2 --out %s/part %s > %s/log 2>&1 & pid=$!; i=0; "
+                   "while ! grep -qs photons %s/log; do i=$((i + 1)); "
+                   "[ $i -gt 600 ] && { kill -9 $pid; exit 90; }; sleep 0.05; done; "
+                   "kill -INT $pid; " WAIT_PID,
+                   tu_bin(), d, cfg, d, d);
     char log[1300];
     snprintf(log, sizeof log, "%s/log", d);
-    const char *text = read_text(log);
+    const char *text = tu_read_text(log);
     if (rc != 130 || !strstr(text, "shard 1/2 interrupted after"))
         fail_msg("interrupted mc-shard: exit %d (want 130, 'shard 1/2 interrupted after'):\n%s", rc,
                  text);
     /* Nothing half-written: no tally file, no temporary. */
-    assert_int_equal(sh("test -z \"$(ls -A %s/part 2>/dev/null)\"", d), 0);
+    assert_int_equal(tu_sh("test -z \"$(ls -A %s/part 2>/dev/null)\"", d), 0);
 }
 
 /* ppb_mc_tallies_totals under memory exhaustion: a forked child caps its address space, takes

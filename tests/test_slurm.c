@@ -30,18 +30,6 @@ static void assert_lacks(const char *text, const char *needle)
         fail_msg("text holds '%s':\n%s", needle, text);
 }
 
-static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int sh(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 static void write_text(const char *path, const char *text, int exec)
 {
     FILE *f = fopen(path, "w");
@@ -50,19 +38,6 @@ static void write_text(const char *path, const char *text, int exec)
     fclose(f);
     if (exec)
         chmod(path, 0755);
-}
-
-static char *read_text(const char *path)
-{
-    static char buf[1 << 16];
-    buf[0] = '\0';
-    FILE *f = fopen(path, "r");
-    if (f) {
-        size_t n = fread(buf, 1, sizeof buf - 1, f);
-        buf[n] = '\0';
-        fclose(f);
-    }
-    return buf;
 }
 
 static ppb_slurm_job sweep_job(const char *dir)
@@ -138,7 +113,7 @@ static void test_scripts_run(void **state)
     job.shards = 2;
     snprintf(job.stamp, sizeof job.stamp, "sweep shards=2 config=1 build=2");
     ppb_slurm_opts o = {.shards = 2};
-    assert_int_equal(sh("mkdir -p '%s/done' '%s/shards' '%s/logs'", d, d, d), 0);
+    assert_int_equal(tu_sh("mkdir -p '%s/done' '%s/shards' '%s/logs'", d, d, d), 0);
     snprintf(log, sizeof log, "%s/calls.log", d);
     char fake[2000];
     snprintf(fake, sizeof fake, "#!/bin/sh\necho \"$*\" >> '%s'\nexit ${FAKE_RC:-0}\n", log);
@@ -153,30 +128,31 @@ static void test_scripts_run(void **state)
     free(m);
 
     /* A failing task: no marker. */
-    assert_int_not_equal(sh("FAKE_RC=1 SLURM_ARRAY_TASK_ID=2 bash '%s/job.sh' 2>/dev/null", d), 0);
+    assert_int_not_equal(tu_sh("FAKE_RC=1 SLURM_ARRAY_TASK_ID=2 bash '%s/job.sh' 2>/dev/null", d),
+                         0);
     snprintf(path, sizeof path, "%s/done/2", d);
     assert_int_not_equal(access(path, F_OK), 0);
     /* The merge refuses while shard 1 and 2 have no marker, and calls no ppbench merge. */
-    assert_int_not_equal(sh("bash '%s/merge.sh' 2>'%s/merge.err'", d, d), 0);
+    assert_int_not_equal(tu_sh("bash '%s/merge.sh' 2>'%s/merge.err'", d, d), 0);
     snprintf(path, sizeof path, "%s/merge.err", d);
-    assert_has(read_text(path), "shard 1 of 2 is not done by this job (done/1: none)");
+    assert_has(tu_read_text(path), "shard 1 of 2 is not done by this job (done/1: none)");
     /* Both tasks succeed: markers holding the stamp. */
-    assert_int_equal(sh("SLURM_ARRAY_TASK_ID=1 bash '%s/job.sh'", d), 0);
-    assert_int_equal(sh("SLURM_ARRAY_TASK_ID=2 bash '%s/job.sh'", d), 0);
+    assert_int_equal(tu_sh("SLURM_ARRAY_TASK_ID=1 bash '%s/job.sh'", d), 0);
+    assert_int_equal(tu_sh("SLURM_ARRAY_TASK_ID=2 bash '%s/job.sh'", d), 0);
     snprintf(path, sizeof path, "%s/done/2", d);
-    assert_string_equal(read_text(path), "sweep shards=2 config=1 build=2\n");
+    assert_string_equal(tu_read_text(path), "sweep shards=2 config=1 build=2\n");
     /* A marker of another job (another build) is refused. */
     snprintf(path, sizeof path, "%s/done/1", d);
     write_text(path, "sweep shards=2 config=1 build=3\n", 0);
-    assert_int_not_equal(sh("bash '%s/merge.sh' 2>'%s/merge.err'", d, d), 0);
+    assert_int_not_equal(tu_sh("bash '%s/merge.sh' 2>'%s/merge.err'", d, d), 0);
     snprintf(path, sizeof path, "%s/merge.err", d);
-    assert_has(read_text(path), "shard 1 of 2 is not done by this job (done/1: sweep shards=2 "
-                                "config=1 build=3)");
+    assert_has(tu_read_text(path), "shard 1 of 2 is not done by this job (done/1: sweep shards=2 "
+                                   "config=1 build=3)");
     snprintf(path, sizeof path, "%s/done/1", d);
     write_text(path, "sweep shards=2 config=1 build=2\n", 0);
-    assert_int_equal(sh("bash '%s/merge.sh'", d), 0);
+    assert_int_equal(tu_sh("bash '%s/merge.sh'", d), 0);
     snprintf(path, sizeof path, "%s/done/merge", d);
-    assert_string_equal(read_text(path), "sweep shards=2 config=1 build=2\n");
+    assert_string_equal(tu_read_text(path), "sweep shards=2 config=1 build=2\n");
     char want[16000];
     snprintf(want, sizeof want,
              "sweep --quiet --shard 2/2 --out %s/shards/2 %s/config.ini\n"
@@ -184,7 +160,7 @@ static void test_scripts_run(void **state)
              "sweep --quiet --shard 2/2 --out %s/shards/2 %s/config.ini\n"
              "merge --out %s/result %s/shards/1 %s/shards/2\n",
              d, d, d, d, d, d, d, d, d);
-    assert_string_equal(read_text(log), want);
+    assert_string_equal(tu_read_text(log), want);
 }
 
 static void test_config_copy(void **state)
@@ -323,7 +299,7 @@ static const char *stamp_of(const char *dir)
     char path[1300];
     static char stamp[256];
     snprintf(path, sizeof path, "%s/job.txt", dir);
-    const char *t = read_text(path);
+    const char *t = tu_read_text(path);
     const char *p = strstr(t, "ppbench slurm job: ");
     assert_non_null(p);
     snprintf(stamp, sizeof stamp, "%.*s", (int)strcspn(p + 19, "\n"), p + 19);
@@ -340,8 +316,8 @@ static void test_submit_with_stand_ins(void **state)
     char d[1100], env[2600], args[4000], path[1300];
     snprintf(d, sizeof d, "%s", tu_scratch("slurm-submit"));
     /* sbatch logs its arguments and prints the next id from 101; squeue prints queue.txt. */
-    assert_int_equal(sh("mkdir -p '%s/bin' && echo 100 > '%s/next' && : > '%s/queue.txt'", d, d, d),
-                     0);
+    assert_int_equal(
+        tu_sh("mkdir -p '%s/bin' && echo 100 > '%s/next' && : > '%s/queue.txt'", d, d, d), 0);
     char text[8000];
     snprintf(text, sizeof text,
              "#!/bin/sh\necho \"sbatch $*\" >> '%s/calls.log'\nn=$(($(cat '%s/next') + 1))\n"
@@ -375,7 +351,7 @@ static void test_submit_with_stand_ins(void **state)
     /* The job name is the module's (ppb-cli-<hash of the directory>): read it from job.txt. */
     char jobtxt[1300];
     snprintf(jobtxt, sizeof jobtxt, "%s/job/job.txt", d);
-    const char *jt = read_text(jobtxt);
+    const char *jt = tu_read_text(jobtxt);
     const char *nm = strstr(jt, "Slurm job name ");
     assert_non_null(nm);
     char name[160];
@@ -386,7 +362,7 @@ static void test_submit_with_stand_ins(void **state)
              "sbatch --parsable --array=1-3 %s/job/job.sh\n"
              "sbatch --parsable --dependency=afterok:101 %s/job/merge.sh\n",
              name, name, d, d);
-    assert_string_equal(read_text(path), want);
+    assert_string_equal(tu_read_text(path), want);
 
     /* Shard 1 done, shard 2 still running, shard 3 failed (neither done nor queued); the merge
      * waits on the array for ever: re-run submits shard 3 alone, cancels the merge, and the new
@@ -400,7 +376,7 @@ static void test_submit_with_stand_ins(void **state)
     snprintf(text, sizeof text, "101_2|%s|RUNNING\n102|%s-merge|PENDING\n", name, name);
     snprintf(mark, sizeof mark, "%s/queue.txt", d);
     write_text(mark, text, 0);
-    assert_int_equal(sh(": > '%s'", path), 0);
+    assert_int_equal(tu_sh(": > '%s'", path), 0);
     cli_expect_env(env, args, 0, "submitted: merge job 104, after afterok:103:101_2");
     assert_has(cli_out, "shards done: 1 of 3");
     assert_has(cli_out, "cancelled: merge job 102");
@@ -410,7 +386,7 @@ static void test_submit_with_stand_ins(void **state)
              "sbatch --parsable --array=3 %s/job/job.sh\n"
              "sbatch --parsable --dependency=afterok:103:101_2 %s/job/merge.sh\n",
              d, d);
-    const char *calls = read_text(path);
+    const char *calls = tu_read_text(path);
     assert_non_null(strstr(calls, want));
 
     /* All done and merged, nothing queued: nothing submitted. */
@@ -422,9 +398,9 @@ static void test_submit_with_stand_ins(void **state)
     write_text(mark, line, 0);
     snprintf(mark, sizeof mark, "%s/queue.txt", d);
     write_text(mark, "", 0);
-    assert_int_equal(sh(": > '%s'", path), 0);
+    assert_int_equal(tu_sh(": > '%s'", path), 0);
     cli_expect_env(env, args, 0, "nothing to submit: every shard is done and merged");
-    assert_lacks(read_text(path), "sbatch");
+    assert_lacks(tu_read_text(path), "sbatch");
 
     /* Another seed into the same directory: refused, exit 2, nothing written or submitted. */
     snprintf(args, sizeof args, "slurm --shards 3 --set mc.seed=7 --out %s/job --submit %s", d,
@@ -434,7 +410,7 @@ static void test_submit_with_stand_ins(void **state)
     cli_expect_env(env, args, 2, "holds the job of another --shards");
     /* A directory that is not a job directory. */
     snprintf(mark, sizeof mark, "%s/foreign/x", d);
-    assert_int_equal(sh("mkdir -p '%s/foreign' && : > '%s'", d, mark), 0);
+    assert_int_equal(tu_sh("mkdir -p '%s/foreign' && : > '%s'", d, mark), 0);
     snprintf(args, sizeof args, "slurm --shards 2 --out %s/foreign %s", d, cfg);
     cli_expect_env(env, args, 2, "not empty and not a ppbench slurm job directory");
     /* A config with neither a list nor mc. */

@@ -11,40 +11,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-static const char *bin(void)
-{
-    const char *b = getenv("PPBENCH");
-    return b ? b : "./ppbench";
-}
-
-static int sh(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 /* Cheap methods and a small photon budget: the test is about bookkeeping, not physics. */
 static const char *sweep_cfg =
     "[experiment]\nname = sw\nmethods = mc, mp\n[tube]\nsegments_top = 16\nsegments_side = 6\n"
     "[bins]\ntheta = 4\nphi = 4\n[medium]\ng = 0, 0.5\nalbedo = 0.5:0.9:0.2\n"
     "[light]\ntheta_deg = 0, 30\n[mc]\nphotons = 20000\nbatches = 4\n[mp]\npairs = 2\n";
 
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 static void same_bytes(const char *a, const char *b)
 {
-    if (sh("cmp -s '%s' '%s'", a, b) != 0)
+    if (tu_sh("cmp -s '%s' '%s'", a, b) != 0)
         fail_msg("%s and %s differ", a, b);
 }
 
@@ -54,37 +29,37 @@ static void test_sweep_whole_shards_resume(void **state)
     const char *d = tu_scratch("sweep");
     char cfg[1200];
     snprintf(cfg, sizeof cfg, "%s/sw.ini", d);
-    write_file(cfg, sweep_cfg);
-    const char *b = bin();
-    assert_int_equal(sh("%s sweep --quiet --out %s/whole %s", b, d, cfg), 0);
+    tu_write_file(cfg, sweep_cfg);
+    const char *b = tu_bin();
+    assert_int_equal(tu_sh("%s sweep --quiet --out %s/whole %s", b, d, cfg), 0);
     /* Three shards under GNU parallel, each in its own directory, then merged. */
-    assert_int_equal(sh("parallel --will-cite -j 3 '%s sweep --quiet --shard {}/3 --out %s/s{} "
-                        "%s' ::: 1 2 3",
-                        b, d, cfg),
+    assert_int_equal(tu_sh("parallel --will-cite -j 3 '%s sweep --quiet --shard {}/3 --out %s/s{} "
+                           "%s' ::: 1 2 3",
+                           b, d, cfg),
                      0);
-    assert_int_equal(sh("%s merge --out %s/merged %s/s1 %s/s2 %s/s3", b, d, d, d, d), 0);
+    assert_int_equal(tu_sh("%s merge --out %s/merged %s/s1 %s/s2 %s/s3", b, d, d, d, d), 0);
     char w[1300], m[1300];
     snprintf(w, sizeof w, "%s/whole/sweep.csv", d);
     snprintf(m, sizeof m, "%s/merged/sweep.csv", d);
     same_bytes(w, m);
     /* Two processes on this machine (--jobs 2). */
-    assert_int_equal(sh("%s sweep --quiet --jobs 2 --out %s/jobs %s", b, d, cfg), 0);
+    assert_int_equal(tu_sh("%s sweep --quiet --jobs 2 --out %s/jobs %s", b, d, cfg), 0);
     snprintf(m, sizeof m, "%s/jobs/sweep.csv", d);
     same_bytes(w, m);
     /* Killed once its first point is written, then resumed. */
     /* The wait gives up after 60 s, so a sweep that fails to start fails the test, not hangs it. */
-    assert_int_equal(sh("%s sweep --quiet --out %s/resumed %s & pid=$!; i=0; "
-                        "while ! ls %s/resumed/points/*.csv >/dev/null 2>&1; do "
-                        "i=$((i + 1)); [ $i -gt 1200 ] && exit 1; sleep 0.05; done; "
-                        "kill -9 $pid; wait $pid; true",
-                        b, d, cfg, d),
+    assert_int_equal(tu_sh("%s sweep --quiet --out %s/resumed %s & pid=$!; i=0; "
+                           "while ! ls %s/resumed/points/*.csv >/dev/null 2>&1; do "
+                           "i=$((i + 1)); [ $i -gt 1200 ] && exit 1; sleep 0.05; done; "
+                           "kill -9 $pid; wait $pid; true",
+                           b, d, cfg, d),
                      0);
-    assert_int_equal(sh("test ! -e %s/resumed/sweep.csv", d), 0);
-    assert_int_equal(sh("%s sweep --quiet --out %s/resumed %s", b, d, cfg), 0);
+    assert_int_equal(tu_sh("test ! -e %s/resumed/sweep.csv", d), 0);
+    assert_int_equal(tu_sh("%s sweep --quiet --out %s/resumed %s", b, d, cfg), 0);
     snprintf(m, sizeof m, "%s/resumed/sweep.csv", d);
     same_bytes(w, m);
     /* 12 grid points x 3 results (mc, its companion mc1, mp) + the header. */
-    assert_int_equal(sh("test $(wc -l < %s) -eq 37", w), 0);
+    assert_int_equal(tu_sh("test $(wc -l < %s) -eq 37", w), 0);
 }
 
 static void test_mc_shards_merge(void **state)
@@ -93,15 +68,15 @@ static void test_mc_shards_merge(void **state)
     const char *d = tu_scratch("mcshard");
     char cfg[1200];
     snprintf(cfg, sizeof cfg, "%s/one.ini", d);
-    write_file(cfg, "[experiment]\nmethods = mc\n[tube]\nsegments_top = 16\nsegments_side = 6\n"
-                    "[mc]\nphotons = 40001\nbatches = 8\nseed = 3\n");
-    const char *b = bin();
-    assert_int_equal(sh("%s run --quiet --out %s/single %s", b, d, cfg), 0);
+    tu_write_file(cfg, "[experiment]\nmethods = mc\n[tube]\nsegments_top = 16\nsegments_side = 6\n"
+                       "[mc]\nphotons = 40001\nbatches = 8\nseed = 3\n");
+    const char *b = tu_bin();
+    assert_int_equal(tu_sh("%s run --quiet --out %s/single %s", b, d, cfg), 0);
     for (int i = 1; i <= 4; i++)
-        assert_int_equal(sh("%s mc-shard --quiet --shard %d/4 --out %s/p%d %s", b, i, d, i, cfg),
+        assert_int_equal(tu_sh("%s mc-shard --quiet --shard %d/4 --out %s/p%d %s", b, i, d, i, cfg),
                          0);
     assert_int_equal(
-        sh("%s mc-merge --out %s/merged %s %s/p1 %s/p2 %s/p3 %s/p4", b, d, cfg, d, d, d, d), 0);
+        tu_sh("%s mc-merge --out %s/merged %s %s/p1 %s/p2 %s/p3 %s/p4", b, d, cfg, d, d, d, d), 0);
     const char *files[] = {"radiance.csv", "totals.csv"};
     for (int i = 0; i < 2; i++) {
         char a[1300], c[1300];
@@ -111,7 +86,7 @@ static void test_mc_shards_merge(void **state)
     }
     /* A missing shard is refused: 3 of 4 parts do not make the budget. */
     assert_int_not_equal(
-        sh("%s mc-merge --out %s/bad %s %s/p1 %s/p2 %s/p3 2>/dev/null", b, d, cfg, d, d, d), 0);
+        tu_sh("%s mc-merge --out %s/bad %s %s/p1 %s/p2 %s/p3 2>/dev/null", b, d, cfg, d, d, d), 0);
 }
 
 static void test_bad_sweeps(void **state)
@@ -119,7 +94,7 @@ static void test_bad_sweeps(void **state)
     (void)state;
     const char *d = tu_scratch("badsweep");
     char cfg[1200];
-    const char *b = bin();
+    const char *b = tu_bin();
     struct {
         const char *text, *needle;
     } cases[] = {
@@ -133,12 +108,12 @@ static void test_bad_sweeps(void **state)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         snprintf(cfg, sizeof cfg, "%s/bad%zu.ini", d, i);
-        write_file(cfg, cases[i].text);
-        if (sh("%s sweep --quiet --out %s/o%zu %s 2>%s/err%zu.txt", b, d, i, cfg, d, i) != 2 ||
-            sh("grep -q -- '%s' %s/err%zu.txt", cases[i].needle, d, i) != 0)
+        tu_write_file(cfg, cases[i].text);
+        if (tu_sh("%s sweep --quiet --out %s/o%zu %s 2>%s/err%zu.txt", b, d, i, cfg, d, i) != 2 ||
+            tu_sh("grep -q -- '%s' %s/err%zu.txt", cases[i].needle, d, i) != 0)
             fail_msg("sweep config %zu: expected exit 2 and '%s'", i, cases[i].needle);
         /* Refused before any work: no output directory was made. */
-        assert_int_equal(sh("test ! -e %s/o%zu", d, i), 0);
+        assert_int_equal(tu_sh("test ! -e %s/o%zu", d, i), 0);
     }
 }
 

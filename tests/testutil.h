@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <math.h>
@@ -127,6 +128,58 @@ static inline const char *tu_scratch(const char *name)
     if (system(cmd) != 0)
         fail_msg("cannot make %s", dir);
     return dir;
+}
+
+/* The binary under test: $PPBENCH (make sets it), else ./ppbench. */
+static inline const char *tu_bin(void)
+{
+    const char *b = getenv("PPBENCH");
+    return b ? b : "./ppbench";
+}
+
+/* A shell command built like printf; its exit code, -1 when it did not exit. */
+static inline int tu_sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static inline int tu_sh(const char *fmt, ...)
+{
+    char cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static inline void tu_write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        fail_msg("cannot write %s", path);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* The first 64 KiB of a file ("" when it cannot be read); a static buffer. */
+static inline char *tu_read_text(const char *path)
+{
+    static char buf[1 << 16];
+    buf[0] = '\0';
+    FILE *f = fopen(path, "r");
+    if (f) {
+        size_t n = fread(buf, 1, sizeof buf - 1, f);
+        buf[n] = '\0';
+        fclose(f);
+    }
+    return buf;
+}
+
+/* Writes text to <scratch dir of name>/<name>.ini; returns its path (a static buffer). */
+static inline const char *tu_config(const char *name, const char *text)
+{
+    static char path[1200];
+    snprintf(path, sizeof path, "%s/%s.ini", tu_scratch(name), name);
+    tu_write_file(path, text);
+    return path;
 }
 
 /* SPEC.md section 6's defaults: W = 10, H = 3, sigma_t = 1, alpha = 0.95, g = 0, normal light. */
