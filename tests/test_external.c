@@ -18,6 +18,7 @@
 
 #include <jansson.h>
 #include <errno.h>
+#include <limits.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -208,6 +209,13 @@ static void test_external_end_to_end(void **state)
     /* The definition is part of the resolved config in provenance (what `score` reads). */
     assert_true(file_has(out, "provenance.txt", "method.mine.command = grep -q"));
     assert_true(file_has(out, "provenance.txt", "method.mine.timeout = 60\n"));
+    /* config.ini holds the section too, cut into continuation lines, and runs again alike. */
+    assert_true(file_has(out, "config.ini", "[method.mine]\ncommand = grep -q"));
+    char out2[1300];
+    snprintf(out2, sizeof out2, "%s2", out);
+    snprintf(args, sizeof args, "run --quiet --out %s %s/config.ini", out2, out);
+    cli_expect(args, 0, "");
+    assert_same_rows(out2, "summary.csv", "mine", "mp");
 
     /* No totals.csv: R, T and sides integrated from the copied mc radiance are mc's own. */
     copy_script(rad, sizeof rad, "ext_tot_r", "radiance.csv", "mc", "mine", "", "");
@@ -365,6 +373,75 @@ static void test_score(void **state)
     cli_expect(args, 1, "bad.csv:180: radiance inf");
 }
 
+/* The Python path (python/ppbench): the example dipole through [method.dipole_py] against the C
+ * mp at one pair (mp.pairs = 0: no pairs beyond the first) in slab mode -- both are the same
+ * model, so they must agree within the example's stated quadrature error (1e-9) plus the
+ * 10-digit print of radiance.csv and totals.csv: 1e-8 relative; and ppbench.metrics() on
+ * load(dir) recomputes summary.csv (printed to 6 digits: 1e-5 relative). */
+static void test_python(void **state)
+{
+    (void)state;
+    if (system("python3 -c 'import sys; sys.exit(sys.version_info < (3, 8))'") != 0)
+        fail_msg("python3 >= 3.8 is needed for the Python path");
+    char root[PATH_MAX], text[8192], args[8192], out[1200];
+    assert_non_null(realpath("python", root));
+    snprintf(out, sizeof out, "%s/out", tu_scratch("ext_py"));
+    snprintf(text, sizeof text,
+             "[experiment]\ngeometry = slab\nmethods = mc, mp, dipole_py\n[tube]\nheight = 3\n"
+             "[bins]\ntheta = 2\nphi = 2\n[mc]\nphotons = 20000\n[mp]\npairs = 0\n"
+             "[output]\ndir = %s\n[method.dipole_py]\n"
+             "command = PYTHONPATH=%s python3 -m ppbench.dipole {scene} {out}\n",
+             out, root);
+    snprintf(args, sizeof args, "run --quiet %s", cli_config("ext_py", text));
+    cli_expect(args, 0, "");
+    char *py = rows_of(out, "radiance.csv", "dipole_py"), *mp = rows_of(out, "radiance.csv", "mp");
+    int n = 0;
+    for (char *a = py, *b = mp; *a && *b; n++) {
+        char sa[8], sb[8];
+        int ga, gb, ta, tb, pa, pb, ka, kb;
+        double xa, xb, La, Lb;
+        assert_int_equal(sscanf(a, "%7[^,],%d,%lf,%d,%d,%lf%n", sa, &ga, &xa, &ta, &pa, &La, &ka),
+                         6);
+        assert_int_equal(sscanf(b, "%7[^,],%d,%lf,%d,%d,%lf%n", sb, &gb, &xb, &tb, &pb, &Lb, &kb),
+                         6);
+        assert_string_equal(sa, sb);
+        assert_int_equal(ta * 2 + pa, tb * 2 + pb);
+        assert_rel(La, Lb, 1e-8);
+        a = strchr(a, '\n') + 1;
+        b = strchr(b, '\n') + 1;
+    }
+    assert_int_equal(n, 2 * 4); /* S1 and S2, one point each, 4 bins */
+    free(py);
+    free(mp);
+    char *tp = rows_of(out, "totals.csv", "dipole_py"), *tm = rows_of(out, "totals.csv", "mp");
+    double a[5], b[5];
+    assert_int_equal(sscanf(tp, "%lf,%lf,%lf,%lf,%lf", &a[0], &a[1], &a[2], &a[3], &a[4]), 5);
+    assert_int_equal(sscanf(tm, "%lf,%lf,%lf,%lf,%lf", &b[0], &b[1], &b[2], &b[3], &b[4]), 5);
+    assert_rel(a[0], b[0], 1e-8); /* R */
+    assert_rel(a[1], b[1], 1e-8); /* T */
+    assert_rel(a[4], b[4], 1e-8); /* ballistic, exp(-tau): both exact */
+    free(tp);
+    free(tm);
+    /* metrics() from load(): every summary.csv row, recomputed. */
+    snprintf(args, sizeof args,
+             "PYTHONPATH=%s python3 -c '\n"
+             "import ppbench, sys\n"
+             "run = ppbench.load(\"%s\")\n"
+             "rows = run[\"summary\"]\n"
+             "rows = rows.to_dict(\"records\") if hasattr(rows, \"to_dict\") else rows\n"
+             "bad = 0\n"
+             "for r in rows:\n"
+             "    m = ppbench.metrics(run[\"radiance\"], r[\"method\"], cell=r[\"cell\"])\n"
+             "    for k in (\"rms_rel\", \"noise_rel\", \"rms_excess\"):\n"
+             "        if abs(m[k] - r[k]) > 1e-5 * abs(r[k]) + 1e-12:\n"
+             "            print(r, k, m[k]); bad = 1\n"
+             "print(len(rows), \"rows\")\n"
+             "sys.exit(bad or len(rows) < 6)'",
+             root, out);
+    int rc = system(args);
+    assert_int_equal(rc, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -372,6 +449,7 @@ int main(void)
         cmocka_unit_test(test_external_end_to_end),
         cmocka_unit_test(test_external_refusals),
         cmocka_unit_test(test_score),
+        cmocka_unit_test(test_python),
     };
     return cmocka_run_group_tests(tests, make_ref, NULL);
 }

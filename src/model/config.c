@@ -1068,6 +1068,34 @@ static void write_value_short(const ppb_config *cfg, const key_def *k, FILE *out
         write_value(cfg, k, out);
 }
 
+/* The [method.NAME] definitions: as "method.NAME.key = value" lines (ini 0) or as sections
+ * (ini 1), a long command cut at single spaces into indented continuation lines, which the
+ * parser joins back with one space. */
+static void write_externals(const ppb_config *cfg, int ini, FILE *out)
+{
+    for (int i = 0; i < cfg->nexternal; i++) {
+        const ppb_external_def *d = &cfg->external[i];
+        if (!ini) {
+            fprintf(out, "method.%s.command = %s\n", d->name, d->command);
+        } else {
+            fprintf(out, "\n[method.%s]\ncommand =", d->name);
+            const char *s = d->command;
+            for (int first = 1; *s; first = 0) {
+                size_t n = strlen(s), cut = n;
+                for (size_t j = 1; n > 150 && j < n - 1 && j < 150; j++)
+                    if (s[j] == ' ' && s[j - 1] != ' ' && s[j + 1] != ' ')
+                        cut = j;
+                fprintf(out, "%s%.*s\n", first ? " " : "  ", (int)cut, s);
+                s += cut < n ? cut + 1 : cut;
+            }
+        }
+        if (d->timeout_line && ini)
+            fprintf(out, "timeout = %.17g\n", d->timeout);
+        else if (d->timeout_line)
+            fprintf(out, "method.%s.timeout = %.17g\n", d->name, d->timeout);
+    }
+}
+
 void ppb_config_write_readable(const ppb_config *cfg, FILE *out)
 {
     for (int i = 0; i < NKEYS; i++) {
@@ -1075,6 +1103,7 @@ void ppb_config_write_readable(const ppb_config *cfg, FILE *out)
         write_value_short(cfg, &keys[i], out);
         fputc('\n', out);
     }
+    write_externals(cfg, 0, out);
 }
 
 void ppb_config_write_ini(const ppb_config *cfg, FILE *out)
@@ -1094,6 +1123,7 @@ void ppb_config_write_ini(const ppb_config *cfg, FILE *out)
                 fputc('\n', out);
             }
     }
+    write_externals(cfg, 1, out);
 }
 
 void ppb_config_key_name(int key, char *buf, size_t cap)
