@@ -278,25 +278,15 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
     int nbins = ppb_bin_count(P.ntheta, P.nphi);
     int gid = (int)get_global_id(0);
     int row = P.row0 + gid / nbins, bin = gid % nbins;
-    int surf = -1;
-    for (int s = 0; s < PPB_NSURF; s++)
-        if (P.nseg[s] > 0 && row >= P.offset[s] && row < P.offset[s] + P.nseg[s])
-            surf = s;
+    int seg, surf = ppb_row_surface(row, P.offset, P.nseg, &seg);
     if (surf < 0)
         return;
-    int seg = row - P.offset[surf];
     int ndir = ppb_march_ndir(ppb_surface_count(P.tube), nbins, P.nsamp);
-    double cx = 0.0, cy = surf == PPB_S1 ? 0.0 : -P.height, seglen = 0.0;
-    int along_x = surf == PPB_S1 || surf == PPB_S2;
-    if (P.tube) {
-        ppb_segment_centre(surf, seg, P.nseg[surf], P.width, P.height, &cx, &cy);
-        seglen = ppb_segment_length(surf, P.nseg[surf], P.width, P.height);
-    }
     int npts = P.tube ? P.npts : 1;
     double sum = 0.0;
     for (int ip = 0; ip < npts; ip++) {
-        double o = ((ip + 0.5) / npts - 0.5) * seglen;
-        double px = cx + (along_x ? o : 0.0), py = cy + (along_x ? 0.0 : o);
+        double px, py;
+        ppb_segment_sample(P.tube, surf, seg, P.nseg[surf], P.width, P.height, ip, npts, &px, &py);
         for (int a = 0; a < P.nsamp; a++)
             for (int b = 0; b < P.nsamp; b++) {
                 double wx, wy, wz;

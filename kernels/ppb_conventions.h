@@ -147,6 +147,34 @@ PPB_FN double ppb_segment_length(int surf, int nseg, double width, double height
     return (surf == PPB_S1 || surf == PPB_S2 ? width : height) / nseg;
 }
 
+/* The surface and segment of layout row `row`: surface s holds the rows [offset[s], offset[s] +
+ * nseg[s]). Returns the surface, -1 for a row outside every surface. */
+PPB_FN int ppb_row_surface(int row, const int *offset, const int *nseg, int *seg)
+{
+    int surf = -1;
+    for (int s = 0; s < PPB_NSURF; s++)
+        if (nseg[s] > 0 && row >= offset[s] && row < offset[s] + nseg[s])
+            surf = s;
+    *seg = surf < 0 ? 0 : row - offset[surf];
+    return surf;
+}
+
+/* Point ip of npts spread evenly along segment seg, where a deterministic method averages the
+ * segment (reference: Bins); slab mode: the one point of the face, at x = 0. */
+PPB_FN void ppb_segment_sample(int tube, int surf, int seg, int nseg, double width, double height,
+                               int ip, int npts, double *px, double *py)
+{
+    double cx = 0.0, cy = surf == PPB_S1 ? 0.0 : -height, seglen = 0.0;
+    int along_x = surf == PPB_S1 || surf == PPB_S2;
+    if (tube) {
+        ppb_segment_centre(surf, seg, nseg, width, height, &cx, &cy);
+        seglen = ppb_segment_length(surf, nseg, width, height);
+    }
+    double o = ((ip + 0.5) / npts - 0.5) * seglen;
+    *px = cx + (along_x ? o : 0.0);
+    *py = cy + (along_x ? 0.0 : o);
+}
+
 /* Segment holding coordinate s along a surface of length len starting at s0. */
 PPB_FN int ppb_segment_of(double s, double s0, double len, int nseg)
 {

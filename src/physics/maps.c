@@ -150,13 +150,12 @@ double ppb_beam_depth(const ppb_scene *sc, double xe)
     return ppb_segment_optical_depth(sc, xe, 0.0, xb, yb);
 }
 
-double ppb_ballistic_fraction(const ppb_scene *sc)
+double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *width)
 {
-    if (sc->geometry == PPB_GEOM_SLAB)
-        return exp(-ppb_beam_depth(sc, 0.0)); /* Beer-Lambert: exp(-tau0 / mu0) */
     double a = -0.5 * sc->width, b = 0.5 * sc->width;
     if (sc->step == PPB_STEP_SHADOW)
         b = fmin(b, sc->step_x);
+    *width = b > a ? b - a : 0.0;
     if (b <= a)
         return 0.0;
     /* The integrand is smooth between the entry points where the path's end switches from S2 to
@@ -178,8 +177,22 @@ double ppb_ballistic_fraction(const ppb_scene *sc)
         for (int k = 0; hstep > 0.0 && k < panels; k++) {
             double mid = brk[p] + (k + 0.5) * hstep;
             for (int q = 4; q >= 0; q--)
-                sum += 0.5 * hstep * gw[q] * exp(-ppb_beam_depth(sc, mid + 0.5 * hstep * gx[q]));
+                sum += 0.5 * hstep * gw[q] * f(sc, mid + 0.5 * hstep * gx[q], arg);
         }
     }
-    return sum / (b - a);
+    return sum;
+}
+
+static double unscattered(const ppb_scene *sc, double x_entry, void *arg)
+{
+    (void)arg;
+    return exp(-ppb_beam_depth(sc, x_entry));
+}
+
+double ppb_ballistic_fraction(const ppb_scene *sc)
+{
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return exp(-ppb_beam_depth(sc, 0.0)); /* Beer-Lambert: exp(-tau0 / mu0) */
+    double width, sum = ppb_lit_integral(sc, unscattered, NULL, &width);
+    return width > 0.0 ? sum / width : 0.0;
 }

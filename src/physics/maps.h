@@ -64,4 +64,11 @@ double ppb_beam_depth(const ppb_scene *sc, double xe);
  * one ballistic fraction of every deterministic method. */
 double ppb_ballistic_fraction(const ppb_scene *sc);
 
+/* The integral over the lit part of S1 (tube mode) of f(x_e) dx_e, x_e the beam's entry point,
+ * by Gauss-Legendre panels between the entry points where f may jump or kink (the beam's path
+ * switching its exit from S2 to S4, the step); *width is the lit width. The ballistic fraction
+ * and rte2d's absorbed beam are its two integrands. */
+typedef double (*ppb_entry_fn)(const ppb_scene *sc, double x_entry, void *arg);
+double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *width);
+
 #endif

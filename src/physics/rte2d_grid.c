@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "base/quadrature.h"
+#include "physics/maps.h"
 #include "physics/phase.h"
 #include "physics/ppsolver.h"
 
@@ -322,41 +322,18 @@ static double beam_path_absorbed(const ppb_scene *sc, double xe)
     return sum;
 }
 
+static double path_absorbed(const ppb_scene *sc, double x_entry, void *arg)
+{
+    (void)arg;
+    return beam_path_absorbed(sc, x_entry);
+}
+
 double ppb_rte_absorbed_beam(const ppb_scene *sc)
 {
     double c = ppb_scene_cos_theta_l(sc);
     if (sc->geometry == PPB_GEOM_SLAB)
         return c * beam_path_absorbed(sc, 0.0);
-    double a = -0.5 * sc->width, b = 0.5 * sc->width;
-    if (sc->step == PPB_STEP_SHADOW)
-        b = fmin(b, sc->step_x);
-    if (b <= a)
-        return 0.0;
-    /* Breaks where the path's end switches from S2 to S4 or it meets the step (as
-     * ppb_ballistic_fraction), Gauss-Legendre panels between them. */
-    double t = ppb_scene_tan_theta_l(sc), brk[5] = {a, b, 0, 0, 0};
-    int nb = 2;
-    double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
-    for (int k = 0; k < 3; k++)
-        if (cand[k] > a && cand[k] < b)
-            brk[nb++] = cand[k];
-    for (int i = 1; i < nb; i++) /* insertion sort of at most five breaks */
-        for (int k = i; k > 0 && brk[k] < brk[k - 1]; k--) {
-            double v = brk[k];
-            brk[k] = brk[k - 1];
-            brk[k - 1] = v;
-        }
-    double gx[5], gw[5];
-    ppb_gauss_legendre(5, gx, gw);
-    const int panels = 64;
-    double sum = 0.0;
-    for (int p = 0; p + 1 < nb; p++) {
-        double h = (brk[p + 1] - brk[p]) / panels;
-        for (int k = 0; h > 0.0 && k < panels; k++) {
-            double mid = brk[p] + (k + 0.5) * h;
-            for (int q = 4; q >= 0; q--)
-                sum += 0.5 * h * gw[q] * beam_path_absorbed(sc, mid + 0.5 * h * gx[q]);
-        }
-    }
-    return c * sum;
+    /* Over the lit strip as ppb_ballistic_fraction integrates its own beam (maps.h). */
+    double width;
+    return c * ppb_lit_integral(sc, path_absorbed, NULL, &width);
 }
