@@ -11,7 +11,7 @@ SAN     ?=
 CFLAGS  += -std=c11 $(OPT) $(WARN) $(SAN) -fno-strict-aliasing
 # Includes name their layer (#include "physics/maps.h", "kernels/ppb_conventions.h").
 CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc -I. \
-            -DPPB_KERNEL_DIR='"$(CURDIR)/kernels"'
+            -DPPB_KERNEL_DIR='"$(CURDIR)/kernels"' -DPPB_SCRIPT_DIR='"$(CURDIR)/scripts"'
 LDFLAGS += $(SAN)
 
 # src/<layer>/<module>.c; the layers and their order are in README.md (Layout) and checked by

@@ -1,89 +1,230 @@
 #!/usr/bin/env bash
-# plots.sh CASE_DIR THETA_DEG: the case's plots as PNG with gnuplot, from its CSVs.
-#   plots/rms_vs_x.png    RMS against the Monte Carlo at each sample point of S1 and S2, every
-#                         method, with the Monte Carlo's noise floor (paper Fig. 8)
-#   plots/angular_x0.png  in-plane exit radiance at x = 0 on S1 and S2 against the signed
-#                         theta-bin centre, phi bin 0 (+, along t) and the last phi bin (-), with
-#                         the light direction marked (paper Fig. 5)
+# plots.sh CASE_DIR [THETA_DEG]: a case's figures with gnuplot, from its CSVs and images, each
+# as PNG (pngcairo) and PDF (pdfcairo) (reference: Outputs). `ppbench run` calls it on the
+# staged output directory; it plots what exists (no Monte Carlo: no RMS plot, no error images)
+# and fails only when gnuplot does. The scene (light angle, step, sigma_t) is read from
+# provenance.txt; THETA_DEG, when given, overrides the light angle. Colours, markers and
+# palettes: scripts/plot_style.gp (one colour per method in every plot). PPB_PLOTS_KEEP=DIR
+# keeps each figure's gnuplot script body in DIR (the tests read them).
+#   plots/rms_vs_x.{png,pdf}     (tube) RMS against the Monte Carlo per sample point of S1, S2,
+#                                S3, S4, every method, with the Monte Carlo's noise floor; S1, S2 on
+#                                one y range, S3 and S4 on one; dashed lines at step_x and at
+#                                step_x +- 2 mfp (paper Fig. 8; the claim is about that band)
+#   plots/angular_x0.{png,pdf}   in-plane exit radiance at x = 0 on S1 and S2 against the signed
+#                                theta-bin centre (phi bin 0: +, along t; the last phi bin: -),
+#                                each half its own line, Monte Carlo +- 1 standard error
+#   plots/angular_x0_polar.{png,pdf}  the same as a polar plot (paper Fig. 5)
+#   images/all.{png,pdf}         every method's picture side by side, titled with its id (paper
+#                                Fig. 6-7); the light arrow is in the pictures (src/io/images.c)
+#   images/error_<m>.{png,pdf}   errmap_<m>.png titled "<m> vs mc", with a colour bar numbered
+#                                -50% .. +50%
 set -euo pipefail
 dir=$1
-theta_l=${2:-0}
-mkdir -p "$dir/plots"
+here=$(cd "$(dirname "$0")" && pwd)
+style=$here/plot_style.gp
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-mapfile -t methods < <(awk -F, 'NR > 1 {print $1}' "$dir/rms.csv" | awk '!seen[$0]++')
-for m in "${methods[@]}"; do
-  for s in S1 S2; do
-    awk -F, -v m="$m" -v s="$s" '$1 == m && $2 == s {print $4, $5, $6}' "$dir/rms.csv" \
-      > "$tmp/rms_${m//+/_}_$s.dat"
-  done
-done
+prov() { awk -F' = ' -v k="$1" '$1 == k {print $2; exit}' "$dir/provenance.txt" 2> /dev/null; }
+name=$(prov experiment.name)
+name=${name:-$(basename "$dir")}
+theta_l=${2:-$(prov light.theta_deg)}
+theta_l=${theta_l:-0}
+step=$(prov medium.step)
+step_x=$(prov medium.step_x)
+sigma_t=$(prov medium.sigma_t)
+ref=mc
 
-plot_rms() {
-  local s=$1 cmd="" m
+# render BASENAME: $tmp/body.gp drawn to BASENAME.png and BASENAME.pdf, each atomically.
+# $1: output path without extension; $2, $3: PNG size in pixels (the PDF is the same at 100 dpi).
+render() {
+  local out=$1 w=$2 h=$3
+  mkdir -p "$(dirname "$out")"
+  { echo "set terminal pngcairo size $w,$h font ',10' noenhanced"
+    echo "set output '$out.png.tmp'"
+    echo "load '$style'"
+    cat "$tmp/body.gp"; } > "$tmp/png.gp"
+  { echo "set terminal pdfcairo size $(awk -v w="$w" 'BEGIN {print w / 100}')in,$(awk -v h="$h" 'BEGIN {print h / 100}')in font ',7' noenhanced"
+    echo "set output '$out.pdf.tmp'"
+    echo "load '$style'"
+    cat "$tmp/body.gp"; } > "$tmp/pdf.gp"
+  # from a file, not a pipe: gnuplot then stops at the first error with a non-zero status
+  if ! gnuplot "$tmp/png.gp" || ! gnuplot "$tmp/pdf.gp"; then
+    rm -f "$out.png.tmp" "$out.pdf.tmp"
+    echo "plots.sh: gnuplot failed drawing $out" >&2
+    exit 1
+  fi
+  mv "$out.png.tmp" "$out.png"
+  mv "$out.pdf.tmp" "$out.pdf"
+  # PPB_PLOTS_KEEP=DIR keeps each figure's gnuplot body as DIR/<figure>.gp (tests/test_plots.c)
+  if [ -n "${PPB_PLOTS_KEEP:-}" ]; then cp "$tmp/body.gp" "$PPB_PLOTS_KEEP/$(basename "$out").gp"; fi
+}
+
+# ---- rms_vs_x: four panels, one key beside them ----
+if [ -s "$dir/rms.csv" ] && [ "$(prov experiment.geometry)" != slab ]; then
+  mapfile -t methods < <(awk -F, 'NR > 1 {print $1}' "$dir/rms.csv" | awk '!seen[$0]++')
   for m in "${methods[@]}"; do
-    cmd+="'$tmp/rms_${m//+/_}_$s.dat' using 1:(100*\$2) with linespoints pt 7 ps 0.4 title '$m', "
+    for s in S1 S2 S3 S4; do
+      awk -F, -v m="$m" -v s="$s" '$1 == m && $2 == s {print $4, $5, $6}' "$dir/rms.csv" \
+        > "$tmp/rms_${m//+/_}_$s.dat"
+    done
   done
-  local m0=${methods[0]}
-  cmd+="'$tmp/rms_${m0//+/_}_$s.dat' using 1:(100*\$3) with lines dt 2 lc rgb 'black' title 'MC noise floor'"
-  echo "$cmd"
-}
+  # y ranges (%, log): S1 and S2 together, S3 and S4 together, over every curve and the floor
+  yr() { awk -F, -v a="$1" -v b="$2" 'NR > 1 && ($2 == a || $2 == b) {
+           for (i = 5; i <= 6; i++) if ($i > 0) { v = 100 * $i; if (!n++ || v < lo) lo = v;
+                                                  if (v > hi) hi = v } }
+           END {if (!n) {lo = 0.1; hi = 100}
+                a = log(lo) / log(10); f = int(a); if (f > a) f--
+                b = log(hi) / log(10); c = int(b); if (c < b) c++
+                printf "[%g:%g]", 10 ^ f, 10 ^ c}' \
+           "$dir/rms.csv"; }
+  yr12=$(yr S1 S2)
+  yr34=$(yr S3 S4)
+  {
+    echo "set multiplot title '$name: RMS error against Monte Carlo per sample point'"
+    echo "set logscale y; set grid; set ylabel 'RMS (%)'"
+    if [ -n "$step" ] && [ "$step" != none ] && [ -n "$step_x" ]; then
+      mfp=$(awk -v s="${sigma_t:-1}" 'BEGIN {print 1 / s}')
+      echo "set arrow 1 from $step_x, graph 0 to $step_x, graph 1 nohead dt 2 lw 1.5 lc rgb '#444444'"
+      for d in -2 2; do
+        echo "set arrow $((d < 0 ? 2 : 3)) from ($step_x + $d * $mfp), graph 0 to ($step_x + $d * $mfp), graph 1 nohead dt 3 lc rgb '#888888'"
+      done
+      markers="dashed: step_x = $step_x; dotted: step_x +- 2 mfp (mfp = 1/sigma_t = $mfp)"
+    else
+      markers="no step"
+    fi
+    echo "set label 1 '$markers' at screen 0.01, 0.015 left font ',8'"
+    # the surfaces that have sample points (a slab has S1 and S2 only)
+    mapfile -t surfs < <(awk -F, 'NR > 1 {print $2}' "$dir/rms.csv" | awk '!seen[$0]++')
+    i=0
+    for s in "${surfs[@]}"; do
+      case $s in
+        S1) t='S1 (top, reflectance)'; xl='x (mfp)'; r=$yr12 ;;
+        S2) t='S2 (bottom, transmittance)'; xl='x (mfp)'; r=$yr12 ;;
+        S3) t='S3 (left side)'; xl='y (mfp; S1 at 0)'; r=$yr34 ;;
+        S4) t='S4 (right side)'; xl='y (mfp; S1 at 0)'; r=$yr34 ;;
+      esac
+      col=$((i % 2)); row=$((i / 2))
+      echo "set lmargin at screen $(awk -v c=$col 'BEGIN {print 0.07 + c * 0.41}')"
+      echo "set rmargin at screen $(awk -v c=$col 'BEGIN {print 0.42 + c * 0.41}')"
+      echo "set tmargin at screen $(awk -v r=$row 'BEGIN {print 0.90 - r * 0.45}')"
+      echo "set bmargin at screen $(awk -v r=$row 'BEGIN {print 0.56 - r * 0.45}')"
+      echo "set title '$t'; set xlabel '$xl'; set yrange $r"
+      if [ $i -eq 2 ]; then echo "unset arrow"; fi
+      if [ $i -eq 0 ]; then
+        echo "set key at screen 0.99, 0.90 right top vertical box opaque title 'method'"
+      else
+        echo "unset key"
+      fi
+      cmd=""
+      for m in "${methods[@]}"; do
+        cmd+="'$tmp/rms_${m//+/_}_$s.dat' using 1:(100*\$2) with linespoints pt mpoint('$m') ps 0.4 lc rgb mcolor('$m') title '$m', "
+      done
+      cmd+="'$tmp/rms_${methods[0]//+/_}_$s.dat' using 1:(100*\$3) with lines dt 2 lc rgb 'black' title 'MC noise floor'"
+      echo "plot $cmd"
+      i=$((i + 1))
+    done
+    echo "unset multiplot"
+  } > "$tmp/body.gp"
+  render "$dir/plots/rms_vs_x" 1200 820
+fi
 
-gnuplot <<GP
-set terminal pngcairo size 1100,420 font ',10' noenhanced
-set output '$dir/plots/rms_vs_x.png.tmp'
-set multiplot layout 1,2 title '$(basename "$dir"): RMS error against Monte Carlo per sample point'
-set logscale y
-set grid
-set xlabel 'x (mfp)'
-set ylabel 'RMS (%)'
-set key top left
-set title 'S1 (top, reflectance)'
-plot $(plot_rms S1)
-set title 'S2 (bottom, transmittance)'
-plot $(plot_rms S2)
-unset multiplot
-GP
-mv "$dir/plots/rms_vs_x.png.tmp" "$dir/plots/rms_vs_x.png"
-
-# In-plane cut at x = 0 from angular.csv (ppbench writes the Table 2 cells' radiance per bin
-# with the bin centres): phi bin 0 (+theta, along t) and the last phi bin (-theta).
-mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/angular.csv" | awk '!seen[$0]++')
-for m in "${all_methods[@]}"; do
-  for s in S1 S2; do
-    awk -F, -v m="$m" -v s="$s" '
-      NR == 1 {for (i = 1; i <= NF; i++) c[$i] = i; next}
-      {rows[NR] = $0; if ($c["phi_bin"] + 0 > np) np = $c["phi_bin"] + 0}
-      END {for (r in rows) { split(rows[r], f, ",");
-             if (f[c["method"]] != m || f[c["surface"]] != s) continue;
-             if (f[c["phi_bin"]] == 0) print f[c["theta_deg"]], f[c["radiance"]];
-             else if (f[c["phi_bin"]] == np) print -f[c["theta_deg"]], f[c["radiance"]] }}' \
-      "$dir/angular.csv" | sort -g > "$tmp/ang_${m//+/_}_$s.dat"
-  done
-done
-plot_ang() {
-  local s=$1 cmd="" m
+# ---- angular_x0: the in-plane cut at x = 0 from angular.csv ----
+if [ -s "$dir/angular.csv" ]; then
+  mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/angular.csv" | awk '!seen[$0]++')
   for m in "${all_methods[@]}"; do
-    cmd+="'$tmp/ang_${m//+/_}_$s.dat' using 1:2 with linespoints pt 7 ps 0.5 title '$m', "
+    for s in S1 S2; do
+      # columns: signed theta, radiance, se; the + half (phi bin 0), a blank line, the - half
+      awk -F, -v m="$m" -v s="$s" '
+        NR == 1 {for (i = 1; i <= NF; i++) c[$i] = i; next}
+        {rows[NR] = $0; if ($c["phi_bin"] + 0 > np) np = $c["phi_bin"] + 0}
+        END {for (r in rows) { split(rows[r], f, ",");
+               if (f[c["method"]] != m || f[c["surface"]] != s) continue;
+               se = ("se" in c) ? f[c["se"]] : 0
+               if (f[c["phi_bin"]] == 0) print 1, f[c["theta_deg"]], f[c["radiance"]], se;
+               else if (f[c["phi_bin"]] == np) print 0, -f[c["theta_deg"]], f[c["radiance"]], se }}' \
+        "$dir/angular.csv" | sort -k1,1 -k2,2g \
+        | awk '{if (NR > 1 && $1 != h) print ""; h = $1; print $2, $3, $4}' > "$tmp/ang_${m//+/_}_$s.dat"
+    done
   done
-  echo "${cmd%, }"
-}
-gnuplot <<GP
-set terminal pngcairo size 1100,420 font ',10' noenhanced
-set output '$dir/plots/angular_x0.png.tmp'
-set multiplot layout 1,2 title '$(basename "$dir"): in-plane exit radiance at x = 0 (1/sr per unit irradiance)'
-set grid
-set xlabel 'signed theta (deg; + along t, - against t)'
-set ylabel 'radiance'
-set xrange [-90:90]
-set key top left
-set title 'S1 (t = +x); arrow: mirror direction of the light'
-set arrow 1 from $theta_l, graph 0 to $theta_l, graph 1 nohead dt 3 lc rgb 'red'
-plot $(plot_ang S1)
-set title 'S2 (t = -x); arrow: the beam direction'
-set arrow 1 from -$theta_l, graph 0 to -$theta_l, graph 1 nohead dt 3 lc rgb 'red'
-plot $(plot_ang S2)
-unset multiplot
-GP
-mv "$dir/plots/angular_x0.png.tmp" "$dir/plots/angular_x0.png"
+  ang_plot() { # $1 surface, $2: cartesian or polar
+    local s=$1 cmd="" m
+    for m in "${all_methods[@]}"; do
+      f="'$tmp/ang_${m//+/_}_$s.dat'"
+      if [ "$2" = cartesian ] && [ "$m" = "$ref" ]; then
+        cmd+="$f using 1:2:3 with yerrorbars pt 7 ps 0.5 lc rgb mcolor('$m') title '$m +- 1 s.e.', "
+        cmd+="$f using 1:2 with lines lc rgb mcolor('$m') notitle, "
+      elif [ "$2" = cartesian ]; then
+        cmd+="$f using 1:2 with linespoints pt mpoint('$m') ps 0.5 lc rgb mcolor('$m') title '$m', "
+      else
+        cmd+="$f using 1:2 with linespoints pt mpoint('$m') ps 0.5 lc rgb mcolor('$m') title '$m', "
+      fi
+    done
+    echo "plot ${cmd%, }"
+  }
+  {
+    echo "set multiplot layout 1,2 title '$name: in-plane exit radiance at x = 0 (1/sr per unit irradiance); + half: phi bin 0 (along t), - half: the last phi bin'"
+    echo "set grid; set xlabel 'signed theta from the normal (deg; + along t, - against t)'"
+    echo "set ylabel 'radiance'; set xrange [-90:90]; set key outside below center horizontal"
+    echo "set title 'S1 (t = +x); red dotted line: mirror direction of the light ($theta_l deg)'"
+    echo "set arrow 1 from $theta_l, graph 0 to $theta_l, graph 1 nohead dt 3 lc rgb 'red'"
+    ang_plot S1 cartesian
+    echo "set title 'S2 (t = -x); red dotted line: the beam direction continued'"
+    echo "set arrow 1 from -$theta_l, graph 0 to -$theta_l, graph 1 nohead dt 3 lc rgb 'red'"
+    ang_plot S2 cartesian
+    echo "unset multiplot"
+  } > "$tmp/body.gp"
+  render "$dir/plots/angular_x0" 1200 460
+  # Polar (paper Fig. 5): radius = radiance, angle = signed theta from the surface normal (up).
+  rmax=$(awk -F, 'NR > 1 && ($2 == "S1" || $2 == "S2") && $7 > m {m = $7} END {print (m > 0 ? 1.1 * m : 1)}' "$dir/angular.csv")
+  {
+    echo "set multiplot layout 1,2 title '$name: in-plane exit radiance at x = 0, polar (radius: radiance, 1/sr per unit irradiance; angle: theta from the normal, + along t)'"
+    echo "set polar; set angles degrees; set theta top clockwise; set grid polar 15"
+    echo "set rrange [0:$rmax]; set xrange [-$rmax:$rmax]; set yrange [0:$rmax]; set size ratio -1"
+    echo "unset border; unset xtics; unset ytics; set rtics; set ttics -75, 15, 75"
+    echo "set key outside below center horizontal"
+    echo "set title 'S1 (t = +x); red dotted: mirror direction of the light'"
+    echo "set arrow 1 from 0,0 to $rmax * sin($theta_l), $rmax * cos($theta_l) nohead dt 3 lc rgb 'red'"
+    ang_plot S1 polar
+    echo "set title 'S2 (t = -x); red dotted: the beam direction continued'"
+    echo "set arrow 1 from 0,0 to -$rmax * sin($theta_l), $rmax * cos($theta_l) nohead dt 3 lc rgb 'red'"
+    ang_plot S2 polar
+    echo "unset multiplot"
+  } > "$tmp/body.gp"
+  render "$dir/plots/angular_x0_polar" 1200 520
+fi
+
+# ---- images: all (labelled) and error figures (titled, numbered colour bar) ----
+img=$dir/images
+if [ -d "$img" ] && [ -s "$dir/angular.csv" ]; then
+  mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/angular.csv" | awk '!seen[$0]++')
+  present=()
+  for m in "${all_methods[@]}"; do [ -s "$img/$m.png" ] && present+=("$m"); done
+  n=${#present[@]}
+  if [ "$n" -gt 0 ]; then
+    {
+      echo "set multiplot layout 1,$n title \"$name: every method's picture (top: S1 and S3 from above; bottom: S2 and S3 from below; yellow arrow: the light, theta_L = $theta_l deg)\\nlinear radiance, one exposure per view shared by all methods: white = the Monte Carlo's 99th percentile in that view; brown: the cut\""
+      echo "unset border; unset tics; unset key; set size ratio -1; set margins 0.5, 0.5, 0.5, 2"
+      for m in "${present[@]}"; do
+        echo "set title '$m' font ',14'"
+        echo "plot '$img/$m.png' binary filetype=png with rgbimage"
+      done
+      echo "unset multiplot"
+    } > "$tmp/body.gp"
+    render "$img/all" $((n * 250 + 20)) 470
+  fi
+  for m in "${present[@]}"; do
+    [ -s "$img/errmap_$m.png" ] || continue
+    {
+      echo "set title \"$name: $m vs $ref\\nrelative error (L_$m - L_$ref) / L_$ref\\ntop: S1, S3 from above; bottom: S2, S3 from below\\nblack: no reference; brown: the cut\""
+      echo "unset border; unset tics; unset key; set size ratio -1"
+      echo "@coolwarm"
+      echo "set cbrange [-50:50]; set cbtics ('-50%%' -50, '-25%%' -25, '0' 0, '+25%%' 25, '+50%%' 50)"
+      echo "set colorbox vertical user origin screen 0.74, screen 0.12 size screen 0.04, screen 0.62"
+      echo "set lmargin at screen 0.04; set rmargin at screen 0.70; set tmargin at screen 0.82; set bmargin at screen 0.02"
+      echo "set cblabel 'relative error, clamped at +-50%' offset 1.5, 0"
+      echo "plot '$img/errmap_$m.png' binary filetype=png with rgbimage, '+' using (NaN):(NaN):(0) with points lc palette"
+    } > "$tmp/body.gp"
+    render "$img/error_$m" 560 640
+  done
+fi

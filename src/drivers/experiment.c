@@ -9,6 +9,7 @@
 #include "base/atomic_file.h"
 #include "io/csv.h"
 #include "io/images.h"
+#include "io/plots.h"
 #include "methods/registry.h"
 #include "base/progress.h"
 
@@ -309,8 +310,10 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
         write_provenance(ex, dir, err) || write_config_ini(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
-    return ppb_images_write(dir, &ex->cfg->scene, ex->res, ex->n, ref ? (int)(ref - ex->res) : -1,
-                            err);
+    if (ppb_images_write(dir, &ex->cfg->scene, ex->res, ex->n, ref ? (int)(ref - ex->res) : -1,
+                         err))
+        return -1;
+    return ppb_plots_write(dir, err); /* last: the figures read the files above */
 }
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)

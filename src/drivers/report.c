@@ -1,5 +1,6 @@
 #include "drivers/report.h"
 
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -183,6 +184,41 @@ static void copy_file(FILE *dst, const char *path)
     fclose(f);
 }
 
+/* The case's error figures (scripts/plots.sh's images/error_<method>.png), linked in name
+ * order under its line of the images section. */
+static int cmp_name(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+static void link_error_images(FILE *f, const char *dir, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s/images", dir, name);
+    DIR *d = opendir(path);
+    if (!d)
+        return;
+    char *found[64];
+    int n = 0;
+    for (struct dirent *e = readdir(d); e && n < 64; e = readdir(d)) {
+        size_t len = strlen(e->d_name);
+        if (!strncmp(e->d_name, "error_", 6) && len > 10 && !strcmp(e->d_name + len - 4, ".png"))
+            if ((found[n] = strdup(e->d_name)))
+                n++;
+    }
+    closedir(d);
+    qsort(found, (size_t)n, sizeof *found, cmp_name);
+    if (n > 0)
+        fprintf(f, "  - errors against mc:");
+    for (int k = 0; k < n; k++) {
+        int len = (int)strlen(found[k]);
+        fprintf(f, " [%.*s](%s/images/%s)", len - 10, found[k] + 6, name, found[k]);
+        free(found[k]);
+    }
+    if (n > 0)
+        fprintf(f, "\n");
+}
+
 static int write_readme(const char *dir, const char *const *cases, int ncases, ppb_err *err)
 {
     char path[1200];
@@ -203,11 +239,15 @@ static int write_readme(const char *dir, const char *const *cases, int ncases, p
     fprintf(f, "RMS versus x (paper Fig. 8) and in-plane angular distributions at x = 0 (Fig. "
                "5):\n\n");
     for (int c = 0; c < ncases; c++)
-        fprintf(f, "- %s: ![rms](%s/plots/rms_vs_x.png) ![angular](%s/plots/angular_x0.png)\n",
-                cases[c], cases[c], cases[c]);
+        fprintf(f,
+                "- %s: ![rms](%s/plots/rms_vs_x.png) ![angular](%s/plots/angular_x0.png) "
+                "![angular, polar](%s/plots/angular_x0_polar.png)\n",
+                cases[c], cases[c], cases[c], cases[c]);
     fprintf(f, "\n## Images (paper Fig. 6-7)\n\n");
-    for (int c = 0; c < ncases; c++)
+    for (int c = 0; c < ncases; c++) {
         fprintf(f, "- %s: ![all methods](%s/images/all.png)\n", cases[c], cases[c]);
+        link_error_images(f, dir, cases[c]);
+    }
     fprintf(f, "\nEach case's directory holds radiance.csv, rms.csv, summary.csv, totals.csv, "
                "summary_mc1.csv, timings.csv and provenance.txt (config, seed, photons, "
                "device, version, timings).\n");

@@ -1,24 +1,45 @@
+/* sweep_plot.c: a sweep's plots, drawn by gnuplot (see sweep_plot.h; reference: Sweeps). */
 #include "drivers/sweep_plot.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/atomic_file.h"
 #include "base/csv_read.h"
+#include "io/plots.h"
 #include "methods/registry.h"
 #include "model/metrics.h"
 
-/* Rows of one method whose axes beyond the first two sit at their first value, as
- * "x y rms_R rms_T" lines for gnuplot (the RMS of summary cells 0 and 1, R and T at x = 0).
- * sweep.csv's columns are found by name (sweep.c writes them). */
-static int emit_data(FILE *gp, const ppb_grid *grid, const char *csv, const char *method,
-                     ppb_err *err)
+#define MAX_ROWS_PANELS 6 /* panels of the third axis drawn; more are said in the title */
+
+/* One row of sweep.csv reduced to what is plotted: the grid indices of the first three axes
+ * and the RMS (%) of R_x0 and T_x0. */
+typedef struct cell_row {
+    int ix[3];
+    double rms[2];
+} cell_row;
+
+static int value_index(const ppb_axis *a, double v)
+{
+    for (int k = 0; k < a->n; k++)
+        if (a->values[k] == v)
+            return k;
+    return -1;
+}
+
+/* The rows of one method whose axes beyond the third sit at their first value. sweep.csv's
+ * columns are found by name (sweep.c writes them); its values print each axis value exactly
+ * (%.17g), so they are matched to the grid's. */
+static int read_rows(const ppb_grid *grid, const char *csv, const char *method, cell_row **out,
+                     int *nout, ppb_err *err)
 {
     ppb_csv c;
     if (ppb_csv_open(&c, csv, err))
         return -1;
-    int axis[PPB_MAX_AXES], col_method = -1, col_rms[2] = {-1, -1}, rc = 0;
+    int axis[PPB_MAX_AXES], col_method = -1, col_rms[2] = {-1, -1}, rc = 0, n = 0, cap = 0;
+    cell_row *rows = NULL;
     char name[80];
     for (int a = 0; a < grid->naxes && rc == 0; a++) {
         ppb_config_key_name(grid->axes[a].key, name, sizeof name);
@@ -34,63 +55,223 @@ static int emit_data(FILE *gp, const ppb_grid *grid, const char *csv, const char
         rc = 0;
         if (strcmp(ppb_csv_get(&c, col_method), method))
             continue;
+        cell_row r = {{0, 0, 0}, {0, 0}};
         int keep = 1;
-        for (int a = 2; a < grid->naxes; a++)
-            keep &= strtod(ppb_csv_get(&c, axis[a]), NULL) == grid->axes[a].values[0];
-        if (keep)
-            fprintf(gp, "%s %s %s %s\n", ppb_csv_get(&c, axis[0]), ppb_csv_get(&c, axis[1]),
-                    ppb_csv_get(&c, col_rms[0]), ppb_csv_get(&c, col_rms[1]));
+        for (int a = 0; a < grid->naxes && keep; a++) {
+            int k = value_index(&grid->axes[a], strtod(ppb_csv_get(&c, axis[a]), NULL));
+            keep = a < 3 ? k >= 0 : k == 0;
+            if (a < 3)
+                r.ix[a] = k;
+        }
+        if (!keep)
+            continue;
+        for (int k = 0; k < 2; k++)
+            r.rms[k] = 100 * strtod(ppb_csv_get(&c, col_rms[k]), NULL);
+        if (n == cap) {
+            cap = cap ? 2 * cap : 64;
+            cell_row *grown = realloc(rows, (size_t)cap * sizeof *rows);
+            if (!grown) {
+                rc = ppb_fail(err, "sweep plot: out of memory");
+                break;
+            }
+            rows = grown;
+        }
+        rows[n++] = r;
     }
     ppb_csv_close(&c);
-    return rc < 0 || rc == 1 ? -1 : 0;
+    if (rc < 0 || rc == 1) {
+        free(rows);
+        return -1;
+    }
+    *out = rows;
+    *nout = n;
+    return 0;
 }
 
-static int plot_method(const ppb_grid *grid, const char *dir, const char *method, ppb_err *err)
+/* gnuplot tics naming an axis's values at their grid indices (the cells are index-spaced, so a
+ * non-uniform list such as 0.5, 0.9, 0.99 still gets equal cells). */
+static void emit_tics(FILE *gp, const char *which, const ppb_axis *a)
 {
-    char csv[1200], png[1300], xname[64], yname[64];
-    snprintf(csv, sizeof csv, "%s/sweep.csv", dir);
-    snprintf(png, sizeof png, "%s/heatmap_%s.png", dir, method);
+    fprintf(gp, "set %s (", which);
+    for (int k = 0; k < a->n; k++)
+        fprintf(gp, "%s'%g' %d", k ? ", " : "", a->values[k], k);
+    fprintf(gp, ")\n");
+}
+
+/* The heat map script of one method: a row of panels (R, T) per value of the third axis. */
+static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, const cell_row *rows,
+                         int n)
+{
+    char xname[64], yname[64], zname[64] = "", rest[512] = "";
     ppb_config_key_name(grid->axes[0].key, xname, sizeof xname);
     ppb_config_key_name(grid->axes[1].key, yname, sizeof yname);
-    ppb_apath ap; /* gnuplot opens the file by name: it writes the temporary */
-    if (ppb_apath_begin(&ap, png, err))
-        return -1;
-    FILE *gp = popen("gnuplot 2>/dev/null", "w");
-    if (!gp)
-        return ppb_fail(err, "cannot start gnuplot for the sweep heat map");
-    fprintf(gp,
-            "set terminal pngcairo size 900,380 noenhanced\n"
-            "set output '%s'\n"
-            "set multiplot layout 1,2 title '%s: RMS against mc at x = 0 (%%)'\n"
-            "set xlabel '%s'\nset ylabel '%s'\nset palette rgb 33,13,10\nset view map\n",
-            ap.tmp, method, xname, yname);
-    for (int col = 3; col <= 4; col++) {
-        fprintf(gp, "set title '%s'\n", col == 3 ? "R (S1)" : "T (S2)");
-        fprintf(gp, "plot '-' using 1:2:(100*$%d) with points pt 5 ps 4 palette notitle\n", col);
-        if (emit_data(gp, grid, csv, method, err)) {
-            pclose(gp);
-            ppb_apath_abort(&ap);
-            return -1;
+    int nz = grid->naxes >= 3 ? grid->axes[2].n : 1;
+    int shown = nz <= MAX_ROWS_PANELS ? nz : MAX_ROWS_PANELS;
+    if (grid->naxes >= 3)
+        ppb_config_key_name(grid->axes[2].key, zname, sizeof zname);
+    for (int a = 3; a < grid->naxes; a++) {
+        char k[64];
+        ppb_config_key_name(grid->axes[a].key, k, sizeof k);
+        size_t len = strlen(rest);
+        snprintf(rest + len, sizeof rest - len, "%s%s = %g", len ? ", " : "; slice: ", k,
+                 grid->axes[a].values[0]);
+    }
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < 2; k++)
+            if (isfinite(rows[i].rms[k]) && rows[i].ix[2] < shown) {
+                lo = fmin(lo, rows[i].rms[k]);
+                hi = fmax(hi, rows[i].rms[k]);
+            }
+    if (!(hi >= lo))
+        lo = 0, hi = 1;
+    if (hi == lo)
+        hi = lo + 1;
+    for (int z = 0; z < shown; z++)
+        for (int k = 0; k < 2; k++) {
+            fprintf(gp, "$d%d_%d << EOD\n", z, k);
+            for (int i = 0; i < n; i++)
+                if (rows[i].ix[2] == z)
+                    fprintf(gp, "%d %d %.6g\n", rows[i].ix[0], rows[i].ix[1], rows[i].rms[k]);
+            fprintf(gp, "EOD\n");
         }
-        fprintf(gp, "e\n");
+    fprintf(gp, "@viridis\nset cbrange [%.6g:%.6g]\nset cblabel 'RMS (%%)' offset 1.5, 0\n", lo,
+            hi);
+    fprintf(gp,
+            "set multiplot layout %d,2 title '%s: RMS against mc at x = 0 (%%), values in the "
+            "cells%s%s'\n",
+            shown, method, rest, nz > shown ? "; the third key's first values only" : "");
+    fprintf(gp, "set xrange [-0.5:%d.5]\nset yrange [-0.5:%d.5]\n", grid->axes[0].n - 1,
+            grid->axes[1].n - 1);
+    emit_tics(gp, "xtics", &grid->axes[0]);
+    emit_tics(gp, "ytics", &grid->axes[1]);
+    fprintf(gp, "set xlabel '%s'\nset ylabel '%s'\nunset key\nset tics out nomirror\n", xname,
+            yname);
+    /* labels white on the dark half of viridis, black on the light half */
+    double mid = 0.5 * (lo + hi);
+    for (int z = 0; z < shown; z++)
+        for (int k = 0; k < 2; k++) {
+            char zt[128] = "";
+            if (grid->naxes >= 3)
+                snprintf(zt, sizeof zt, ", %s = %g", zname, grid->axes[2].values[z]);
+            fprintf(gp, "set title '%s%s'\n", k == 0 ? "R (S1)" : "T (S2)", zt);
+            fprintf(gp,
+                    "plot $d%d_%d using 1:2:3 with image, $d%d_%d using 1:2:(sprintf('%%.1f', "
+                    "$3)):($3 > %.6g ? 0 : 0xffffff) with labels tc rgb variable\n",
+                    z, k, z, k, mid);
+        }
+    fprintf(gp, "unset multiplot\n");
+}
+
+/* The 1-D sweep's script: RMS of R and T against the swept value, a line per method. */
+static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, const char *csv,
+                      ppb_err *err)
+{
+    char xname[64];
+    ppb_config_key_name(grid->axes[0].key, xname, sizeof xname);
+    int nm = 0;
+    for (int m = 0; m < cfg->nmethods; m++) {
+        const char *id = cfg->methods[m];
+        if (ppb_method_find(id)->reference == 1)
+            continue;
+        cell_row *rows = NULL;
+        int n = 0;
+        if (read_rows(grid, csv, id, &rows, &n, err))
+            return -1;
+        for (int k = 0; k < 2; k++) {
+            fprintf(gp, "$m%d_%d << EOD\n", nm, k);
+            for (int i = 0; i < n; i++)
+                fprintf(gp, "%.17g %.6g\n", grid->axes[0].values[rows[i].ix[0]], rows[i].rms[k]);
+            fprintf(gp, "EOD\n");
+        }
+        free(rows);
+        nm++;
+    }
+    fprintf(gp,
+            "set multiplot layout 1,2 title 'RMS against mc at x = 0 over %s'\nset grid\n"
+            "set xlabel '%s'\nset ylabel 'RMS (%%)'\nset key outside below horizontal\n",
+            xname, xname);
+    for (int k = 0; k < 2; k++) {
+        fprintf(gp, "set title '%s'\nplot ", k == 0 ? "R (S1)" : "T (S2)");
+        int j = 0;
+        for (int m = 0; m < cfg->nmethods; m++) {
+            const char *id = cfg->methods[m];
+            if (ppb_method_find(id)->reference == 1)
+                continue;
+            fprintf(gp,
+                    "%s$m%d_%d using 1:2 with linespoints pt mpoint('%s') lc rgb mcolor('%s') "
+                    "title '%s'",
+                    j ? ", " : "", j, k, id, id, id);
+            j++;
+        }
+        fprintf(gp, "%s\n", j ? "" : "NaN notitle");
     }
     fprintf(gp, "unset multiplot\n");
-    if (pclose(gp) != 0) {
-        ppb_apath_abort(&ap);
-        return ppb_fail(err, "gnuplot failed drawing %s", png);
+    return 0;
+}
+
+/* Draws one figure as <base>.png and <base>.pdf: method NULL is the 1-D line plot. */
+static int draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, const char *base,
+                const char *method, ppb_err *err)
+{
+    char csv[1200];
+    snprintf(csv, sizeof csv, "%s/sweep.csv", dir);
+    cell_row *rows = NULL;
+    int n = 0;
+    if (method && read_rows(grid, csv, method, &rows, &n, err))
+        return -1;
+    int nz = grid->naxes >= 3 ? grid->axes[2].n : 1;
+    int shown = nz <= MAX_ROWS_PANELS ? nz : MAX_ROWS_PANELS;
+    int rc = 0;
+    for (int t = 0; t < 2 && rc == 0; t++) {
+        char path[1300];
+        snprintf(path, sizeof path, "%s/%s.%s", dir, base, t ? "pdf" : "png");
+        ppb_apath ap; /* gnuplot opens the file by name: it writes the temporary */
+        if (ppb_apath_begin(&ap, path, err)) {
+            rc = -1;
+            break;
+        }
+        FILE *gp = popen("gnuplot 2>/dev/null", "w");
+        if (!gp) {
+            ppb_apath_abort(&ap);
+            rc = ppb_fail(err, "cannot start gnuplot for %s", path);
+            break;
+        }
+        int h = method ? 60 + 330 * shown : 420;
+        if (t)
+            fprintf(gp, "set terminal pdfcairo size %.2fin,%.2fin font ',7' noenhanced\n", 10.0,
+                    h / 100.0);
+        else
+            fprintf(gp, "set terminal pngcairo size 1000,%d font ',10' noenhanced\n", h);
+        fprintf(gp, "set output '%s'\nload '%s/plot_style.gp'\n", ap.tmp, ppb_plots_script_dir());
+        if (method)
+            emit_heatmap(gp, grid, method, rows, n);
+        else
+            rc = emit_lines(gp, cfg, grid, csv, err);
+        if (pclose(gp) != 0 && rc == 0)
+            rc = ppb_fail(err, "gnuplot failed drawing %s", path);
+        if (rc == 0)
+            rc = ppb_apath_commit(&ap, err);
+        else
+            ppb_apath_abort(&ap);
     }
-    return ppb_apath_commit(&ap, err);
+    free(rows);
+    return rc;
 }
 
 int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir, ppb_err *err)
 {
-    if (grid->naxes < 2)
+    if (grid->naxes < 1)
         return 0;
+    if (grid->naxes == 1)
+        return draw(cfg, grid, dir, "sweep_rms", NULL, err);
     for (int m = 0; m < cfg->nmethods; m++) {
         const char *id = cfg->methods[m];
         if (ppb_method_find(id)->reference == 1)
             continue; /* the reference: its RMS against itself is empty */
-        if (plot_method(grid, dir, id, err))
+        char base[128];
+        snprintf(base, sizeof base, "heatmap_%s", id);
+        if (draw(cfg, grid, dir, base, id, err))
             return -1;
     }
     return 0;

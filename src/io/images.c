@@ -5,19 +5,25 @@
  * paper's rows are laid out. Each view is VIEW_NX x VIEW_NY pixels. Written under
  * <out_dir>/images/, every file atomically:
  *   <method>.exr        linear 32-bit float RGB, R = G = B = the radiance toward the camera
- *                       (1/sr per unit E_perp); 0 on the background and on the cut caps.
- *   <method>.png        tone-mapped: L / L_white clamped to [0, 1], sRGB-encoded, with ONE
- *                       L_white for all methods: the 99th percentile of the reference's
- *                       (Monte Carlo's) surface pixels, else of the first method's. Background
- *                       slate blue, cut caps brown.
- *   error_<method>.png  for every method but the reference, when there is one: false colour of
+ *                       (1/sr per unit E_perp); 0 on the background and on the cut caps. No
+ *                       arrow, no labels: the data.
+ *   <method>.png        tone-mapped: L / L_white clamped to [0, 1], sRGB-encoded, with one
+ *                       L_white PER VIEW shared by all methods: the 99th percentile of the
+ *                       reference's (Monte Carlo's, else the first method's) surface pixels
+ *                       in that view. One exposure for both views saturated about 36% of the
+ *                       top view (S1 is several times brighter than S2) and hid the step's
+ *                       pattern on S1 (paper Fig. 7); per view, 1% of each view is white and
+ *                       methods stay comparable within a view. The top view carries the
+ *                       light arrow: the beam's direction w_L drawn in light yellow ending on
+ *                       S1 at x = -W/4, z = 0. Background slate blue, cut caps brown.
+ *   errmap_<method>.png for every method but the reference, when there is one: false colour of
  *                       the relative error e = (L_m - L_ref) / L_ref, clamped to +-50%,
- *                       diverging map blue (-50%) .. light grey (0) .. red (+50%); black
- *                       where L_ref <= 0 or L_m is not finite (no relative error). A colour
- *                       bar under the views spans -50% (left edge) to +50% (right edge),
- *                       black ticks every 25%.
- *   all.png             every method's tone-mapped picture side by side, in the experiment's
- *                       order (the order of radiance.csv), same exposure; no labels.
+ *                       diverging map blue (-50%) .. light grey (0) .. red (+50%), linear in
+ *                       sRGB bytes between those three stops; black where L_ref <= 0 or L_m is
+ *                       not finite (no relative error). Bare pixels, same size as <method>.png:
+ *                       scripts/plots.sh composes them into the titled error_<method>.png
+ *                       with a numbered colour bar, and the per-method PNGs into the labelled
+ *                       all.png (reference: Outputs).
  * Nothing is written in slab mode. */
 #include "io/images.h"
 
@@ -35,8 +41,6 @@
 #define VIEW_NY      240
 #define PANEL_NY     (2 * VIEW_NY)
 #define PANEL_PIXELS ((size_t)VIEW_NX * PANEL_NY)
-#define SHEET_GAP    4    /* pixels between methods on all.png */
-#define BAR_NY       16   /* height of the error colour bar */
 #define ERR_CLAMP    0.5  /* relative error at the ends of the colour map */
 #define WHITE_PCTL   0.99 /* percentile of the reference's surface pixels shown as white */
 
@@ -46,6 +50,7 @@ static const rgb8 background = {48, 56, 72};
 static const rgb8 cap_colour = {120, 96, 64};
 static const rgb8 no_reference = {0, 0, 0};
 /* Diverging map end points and middle (Moreland's cool-warm), display-space sRGB. */
+static const rgb8 arrow_colour = {255, 226, 110};
 static const rgb8 cool = {59, 76, 192}, neutral = {221, 221, 221}, warm = {180, 4, 38};
 
 /* Everything rendered once and shared by the writers. */
@@ -57,7 +62,8 @@ typedef struct img_ctx {
     unsigned char *kind; /* PPB_PIX_* per panel pixel, the same for every method */
     float **value;       /* per result, n of them */
     int ref;             /* index of the reference result, -1 if none */
-    double white;        /* radiance shown as white on every PNG */
+    double white[2];     /* radiance shown as white, per view (top, bottom) */
+    double arrow[2][2];  /* the light arrow on the top view: tail and tip, pixel coordinates */
 } img_ctx;
 
 static void free_ctx(img_ctx *c)
@@ -77,6 +83,14 @@ static int render_panels(img_ctx *c, ppb_err *err)
     c->value = calloc((size_t)c->n, sizeof *c->value);
     if (!c->kind || !c->value)
         return ppb_fail(err, "images: out of memory");
+    /* The light arrow: w_L ending on S1 (y = 0) at x = -W/4, z = 0, 0.6 W long (the top view
+     * looks down steeply, so the shaft is foreshortened). */
+    double w[3], tip[3] = {-0.25 * c->scene->width, 0, 0}, tail[3];
+    ppb_scene_light_dir(c->scene, w);
+    for (int k = 0; k < 3; k++)
+        tail[k] = tip[k] - 0.6 * c->scene->width * w[k];
+    ppb_tube_view_project(&views[0], tail, &c->arrow[0][0], &c->arrow[0][1]);
+    ppb_tube_view_project(&views[0], tip, &c->arrow[1][0], &c->arrow[1][1]);
     size_t half = PANEL_PIXELS / 2;
     for (int i = 0; i < c->n; i++) {
         c->value[i] = malloc(PANEL_PIXELS * sizeof(float));
@@ -96,11 +110,12 @@ static int cmp_float(const void *a, const void *b)
 
 /* The percentile rather than the maximum, so that a few hot pixels (a bright bin, MC noise)
  * do not darken every picture. */
-static double white_level(const img_ctx *c, int from)
+static double white_level(const img_ctx *c, int from, int view)
 {
-    float *v = malloc(PANEL_PIXELS * sizeof *v);
+    size_t half = PANEL_PIXELS / 2, k0 = (size_t)view * half;
+    float *v = malloc(half * sizeof *v);
     size_t n = 0;
-    for (size_t k = 0; v && k < PANEL_PIXELS; k++)
+    for (size_t k = k0; v && k < k0 + half; k++)
         if (c->kind[k] == PPB_PIX_SURFACE && isfinite(c->value[from][k]))
             v[n++] = c->value[from][k];
     double white = 0.0;
@@ -134,10 +149,46 @@ static void tone_map(const img_ctx *c, int i, unsigned char *rgb, size_t stride)
             size_t k = j * VIEW_NX + x;
             unsigned char *px = rgb + 3 * (j * stride + x);
             if (c->kind[k] == PPB_PIX_SURFACE)
-                memset(px, srgb_byte(c->value[i][k] / c->white), 3);
+                memset(px, srgb_byte(c->value[i][k] / c->white[j >= VIEW_NY]), 3);
             else
                 put(px, c->kind[k] == PPB_PIX_CAP ? cap_colour : background);
         }
+}
+
+static void dot(unsigned char *rgb, size_t stride, double x, double y)
+{
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            long px = lround(x) + dx, py = lround(y) + dy;
+            if (px >= 0 && px < VIEW_NX && py >= 0 && py < VIEW_NY)
+                put(rgb + 3 * ((size_t)py * stride + (size_t)px), arrow_colour);
+        }
+}
+
+static void segment(unsigned char *rgb, size_t stride, const double a[2], const double b[2])
+{
+    double len = hypot(b[0] - a[0], b[1] - a[1]);
+    int steps = (int)ceil(2 * len) + 1;
+    for (int k = 0; k <= steps; k++) {
+        double t = (double)k / steps;
+        dot(rgb, stride, a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
+    }
+}
+
+/* The light arrow on the top view: a shaft and a head of two strokes at +-25 degrees. */
+static void draw_arrow(const img_ctx *c, unsigned char *rgb, size_t stride)
+{
+    const double *tail = c->arrow[0], *tip = c->arrow[1];
+    double dx = tip[0] - tail[0], dy = tip[1] - tail[1], len = hypot(dx, dy);
+    if (!(len > 1))
+        return;
+    segment(rgb, stride, tail, tip);
+    double head = 0.25 * len < 12 ? 0.25 * len : 12, ux = dx / len, uy = dy / len;
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+        double ca = cos(25 * M_PI / 180), sa = sgn * sin(25 * M_PI / 180);
+        double end[2] = {tip[0] - head * (ca * ux - sa * uy), tip[1] - head * (sa * ux + ca * uy)};
+        segment(rgb, stride, tip, end);
+    }
 }
 
 static void image_path(const img_ctx *c, const char *prefix, const char *method, const char *ext,
@@ -166,6 +217,7 @@ static int write_png(const img_ctx *c, int i, ppb_err *err)
     if (!rgb)
         return ppb_fail(err, "images: out of memory");
     tone_map(c, i, rgb, VIEW_NX);
+    draw_arrow(c, rgb, VIEW_NX);
     char path[1300];
     image_path(c, "", c->res[i].method, "png", path, sizeof path);
     int rc = ppb_png_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
@@ -184,34 +236,9 @@ static void error_colour(double e, unsigned char *px)
         px[k] = (unsigned char)lround((1 - a) * neutral[k] + a * end[k]);
 }
 
-/* Ticks at -50, -25, 0, +25, +50 %: the pixel columns nearest each quarter of the bar. */
-static int is_tick(int x)
-{
-    for (int q = 0; q <= 4; q++)
-        if (x == q * (VIEW_NX - 1) / 4)
-            return 1;
-    return 0;
-}
-
-static void error_bar(unsigned char *rgb)
-{
-    for (int x = 0; x < VIEW_NX; x++) {
-        double e = ERR_CLAMP * (2.0 * (x + 0.5) / VIEW_NX - 1.0);
-        int tick = is_tick(x);
-        for (int j = 0; j < BAR_NY; j++) {
-            unsigned char *px = rgb + 3 * ((size_t)j * VIEW_NX + (size_t)x);
-            if (tick && j < BAR_NY / 2)
-                put(px, no_reference);
-            else
-                error_colour(e, px);
-        }
-    }
-}
-
 static int write_error(const img_ctx *c, int i, ppb_err *err)
 {
-    size_t ny = PANEL_NY + BAR_NY;
-    unsigned char *rgb = malloc(3 * VIEW_NX * ny);
+    unsigned char *rgb = malloc(3 * PANEL_PIXELS);
     if (!rgb)
         return ppb_fail(err, "images: out of memory");
     for (size_t k = 0; k < PANEL_PIXELS; k++) {
@@ -224,28 +251,9 @@ static int write_error(const img_ctx *c, int i, ppb_err *err)
         else
             error_colour((c->value[i][k] - ref) / ref, px);
     }
-    error_bar(rgb + 3 * PANEL_PIXELS);
     char path[1300];
-    image_path(c, "error_", c->res[i].method, "png", path, sizeof path);
-    int rc = ppb_png_write_rgb(path, VIEW_NX, (int)ny, rgb, err);
-    free(rgb);
-    return rc;
-}
-
-static int write_sheet(const img_ctx *c, ppb_err *err)
-{
-    int n = c->n;
-    size_t nx = (size_t)n * VIEW_NX + (size_t)(n - 1) * SHEET_GAP;
-    unsigned char *rgb = malloc(3 * nx * PANEL_NY);
-    if (!rgb)
-        return ppb_fail(err, "images: out of memory");
-    for (size_t k = 0; k < nx * PANEL_NY; k++)
-        put(rgb + 3 * k, background);
-    for (int i = 0; i < n; i++)
-        tone_map(c, i, rgb + 3 * (size_t)i * (VIEW_NX + SHEET_GAP), nx);
-    char path[1300];
-    snprintf(path, sizeof path, "%s/all.png", c->dir);
-    int rc = ppb_png_write_rgb(path, (int)nx, PANEL_NY, rgb, err);
+    image_path(c, "errmap_", c->res[i].method, "png", path, sizeof path);
+    int rc = ppb_png_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
     free(rgb);
     return rc;
 }
@@ -258,7 +266,7 @@ static int write_all(const img_ctx *c, ppb_err *err)
         if (c->ref >= 0 && i != c->ref && write_error(c, i, err))
             return -1;
     }
-    return write_sheet(c, err);
+    return 0;
 }
 
 int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_result *res, int n,
@@ -272,7 +280,8 @@ int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_result 
         return -1;
     int rc = render_panels(&c, err);
     if (rc == 0) {
-        c.white = white_level(&c, c.ref >= 0 ? c.ref : 0);
+        for (int view = 0; view < 2; view++)
+            c.white[view] = white_level(&c, c.ref >= 0 ? c.ref : 0, view);
         rc = write_all(&c, err);
     }
     free_ctx(&c);

@@ -1,0 +1,18 @@
+/* plots.h: an output set's figures (reference: Outputs): runs scripts/plots.sh, which draws them
+ * with gnuplot from the set's CSVs and images into <dir>/plots/ and <dir>/images/ (PNG and PDF).
+ * Owns only the running of the script: what is plotted and how is the script's. Found as
+ * $PPBENCH_SCRIPTS/plots.sh, else PPB_SCRIPT_DIR/plots.sh (the Makefile sets the source tree's
+ * scripts/), as the kernels are found. */
+#ifndef PPB_PLOTS_H
+#define PPB_PLOTS_H
+
+#include "base/err.h"
+
+/* The folder holding plots.sh and plot_style.gp (the style every gnuplot script loads). */
+const char *ppb_plots_script_dir(void);
+
+/* Draws the figures of the output set in dir (already holding its CSVs, provenance.txt and
+ * images); fails, naming the script, when it cannot be started or exits non-zero. */
+int ppb_plots_write(const char *dir, ppb_err *err);
+
+#endif

@@ -1,0 +1,244 @@
+/* test_plots.c: the figures of a run and of a sweep (scripts/plots.sh, src/io/plots.c,
+ * src/drivers/sweep_plot.c; reference: Outputs, Sweeps). `ppbench run` draws them inside its
+ * output set; every figure is there as PNG and PDF with the panels, labels and markers issue 16
+ * asks for, read from the gnuplot scripts plots.sh keeps under PPB_PLOTS_KEEP; without mc the
+ * run still succeeds and draws what exists; a sweep's heat map has a row of panels per value of
+ * its third key and a 1-D sweep gets a line plot. */
+#include "testutil.h"
+
+#include <stdarg.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+/* A shell command built like printf; its exit code, -1 when it did not exit. */
+static int pl_sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int pl_sh(const char *fmt, ...)
+{
+    char cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* The binary under test: $PPBENCH (make sets it), else ./ppbench. */
+static const char *pl_bin(void)
+{
+    const char *b = getenv("PPBENCH");
+    return b ? b : "./ppbench";
+}
+
+/* A fresh absolute scratch directory under $TMPDIR for one test; a static buffer. */
+static const char *pl_scratch(const char *name)
+{
+    static char dir[1024];
+    char *base = realpath(getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", NULL);
+    snprintf(dir, sizeof dir, "%s/ppbench-%s-%d", base ? base : "/tmp", name, (int)getpid());
+    free(base);
+    if (pl_sh("rm -rf '%s' && mkdir -p '%s'", dir, dir) != 0)
+        fail_msg("cannot make %s", dir);
+    return dir;
+}
+
+static void pl_write(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        fail_msg("cannot write %s", path);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* The first 64 KiB of a file ("" when it cannot be read); a static buffer. */
+static char *pl_read(const char *path)
+{
+    static char buf[1 << 16];
+    buf[0] = '\0';
+    FILE *f = fopen(path, "r");
+    if (f) {
+        size_t n = fread(buf, 1, sizeof buf - 1, f);
+        buf[n] = '\0';
+        fclose(f);
+    }
+    return buf;
+}
+
+static int exists(const char *dir, const char *name)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    struct stat st;
+    return stat(path, &st) == 0 && st.st_size > 0;
+}
+
+/* Width and height of a PNG from its IHDR chunk (big-endian at bytes 16..23). */
+static void png_size(const char *path, int *w, int *h)
+{
+    unsigned char b[24] = {0};
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    assert_int_equal(fread(b, 1, sizeof b, f), sizeof b);
+    fclose(f);
+    *w = (b[16] << 24) | (b[17] << 16) | (b[18] << 8) | b[19];
+    *h = (b[20] << 24) | (b[21] << 16) | (b[22] << 8) | b[23];
+}
+
+static void assert_has(const char *text, const char *needle)
+{
+    if (!strstr(text, needle))
+        fail_msg("missing \"%s\" in:\n%.2000s", needle, text);
+}
+
+static const char *small = "--quiet --set mc.photons=2e4 --set pp.directions=16 "
+                           "--set bins.samples_dir=2 --set tube.segments_top=32 "
+                           "--set tube.segments_side=8";
+
+static void test_run_draws_every_figure(void **state)
+{
+    (void)state;
+    const char *dir = pl_scratch("plots_run");
+    char out[1200], keep[1200], path[2048];
+    snprintf(out, sizeof out, "%s/out", dir);
+    snprintf(keep, sizeof keep, "%s/gp", dir);
+    assert_int_equal(pl_sh("mkdir -p '%s'", keep), 0);
+    /* the density step: step_x = 0, sigma_t = 1, so the markers sit at 0 and +-2 */
+    assert_int_equal(pl_sh("PPB_PLOTS_KEEP='%s' %s run %s --set experiment.methods=mc,pp,mp "
+                           "--out '%s' configs/density_step.ini",
+                           keep, pl_bin(), small, out),
+                     0);
+    const char *files[] = {"plots/rms_vs_x",  "plots/angular_x0", "plots/angular_x0_polar",
+                           "images/all",      "images/error_pp",  "images/error_mp",
+                           "images/error_mc1"};
+    for (size_t i = 0; i < sizeof files / sizeof *files; i++)
+        for (int t = 0; t < 2; t++) {
+            snprintf(path, sizeof path, "%s.%s", files[i], t ? "pdf" : "png");
+            if (!exists(out, path))
+                fail_msg("%s/%s not written", out, path);
+        }
+    assert_false(exists(out, "images/error_mc.png")); /* the reference has none */
+    /* no staging left beside it: the plots were drawn before the set was put in place */
+    assert_int_equal(pl_sh("ls -d '%s'.tmp.* 2>/dev/null | grep -q .", out), 1);
+
+    snprintf(path, sizeof path, "%s/rms_vs_x.gp", keep);
+    char *gp = pl_read(path);
+    for (int s = 1; s <= 4; s++) {
+        char t[16];
+        snprintf(t, sizeof t, "'S%d (", s);
+        assert_has(gp, t);
+    }
+    assert_has(gp, "set arrow 1 from 0, graph 0");
+    assert_has(gp, "set arrow 2 from (0 + -2 * 1), graph 0");
+    assert_has(gp, "set arrow 3 from (0 + 2 * 1), graph 0");
+    assert_has(gp, "set key at screen 0.99"); /* beside the panels, not over the curves */
+    assert_has(gp, "lc rgb mcolor('pp')");
+    /* S1 and S2 share one y range */
+    char *a = strstr(gp, "S1 (top"), *b = strstr(gp, "S2 (bottom");
+    assert_non_null(a);
+    assert_non_null(b);
+    char ra[64] = "", rb[64] = "";
+    assert_int_equal(sscanf(strstr(a, "set yrange"), "set yrange %63s", ra), 1);
+    assert_int_equal(sscanf(strstr(b, "set yrange"), "set yrange %63s", rb), 1);
+    assert_string_equal(ra, rb);
+
+    snprintf(path, sizeof path, "%s/angular_x0.gp", keep);
+    gp = pl_read(path);
+    assert_has(gp, "with yerrorbars");
+    assert_has(gp, "red dotted line");
+    if (strstr(gp, "arrow:"))
+        fail_msg("a dotted line labelled as an arrow:\n%.2000s", gp);
+    snprintf(path, sizeof path, "%s/angular_x0_polar.gp", keep);
+    assert_has(pl_read(path), "set polar");
+
+    snprintf(path, sizeof path, "%s/all.gp", keep);
+    gp = pl_read(path);
+    const char *ids[] = {"mc", "mc1", "pp", "mp"};
+    for (int i = 0; i < 4; i++) {
+        char t[64];
+        snprintf(t, sizeof t, "set title '%s' font", ids[i]);
+        assert_has(gp, t);
+    }
+    snprintf(path, sizeof path, "%s/error_pp.gp", keep);
+    gp = pl_read(path);
+    assert_has(gp, "pp vs mc");
+    assert_has(gp, "'-50%%' -50, '-25%%' -25, '0' 0, '+25%%' 25, '+50%%' 50");
+    snprintf(path, sizeof path, "%s/images/all.png", out);
+    int w, h;
+    png_size(path, &w, &h);
+    assert_int_equal(w, 4 * 250 + 20); /* one panel per method: mc, mc1, pp, mp */
+}
+
+/* Without the Monte Carlo: no reference, so no rms_vs_x and no error figures, and the run
+ * (and plots.sh) still succeed with the rest. */
+static void test_without_mc(void **state)
+{
+    (void)state;
+    const char *dir = pl_scratch("plots_nomc");
+    char out[1200];
+    snprintf(out, sizeof out, "%s/out", dir);
+    assert_int_equal(pl_sh("%s run %s --set experiment.methods=pp,ss --out '%s' "
+                           "configs/uniform_g0_normal.ini",
+                           pl_bin(), small, out),
+                     0);
+    assert_true(exists(out, "plots/angular_x0.png"));
+    assert_true(exists(out, "plots/angular_x0_polar.pdf"));
+    assert_true(exists(out, "images/all.png"));
+    assert_false(exists(out, "plots/rms_vs_x.png"));
+    assert_false(exists(out, "images/error_pp.png"));
+    char path[2048];
+    snprintf(path, sizeof path, "%s/images/all.png", out);
+    int w, h;
+    png_size(path, &w, &h);
+    assert_int_equal(w, 2 * 250 + 20);
+}
+
+static void write_sweep(const char *path, const char *lists, const char *out)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "[experiment]\nname = s\ngeometry = slab\nmethods = mc, ss\n%s[mc]\nphotons = "
+             "2e3\n[pp]\ndirections = 16\n[output]\ndir = %s\n",
+             lists, out);
+    pl_write(path, text);
+}
+
+/* Three swept keys: a row of (R, T) panels per value of the third, so the PNG is 60 + 330 x 3
+ * pixels high (sweep_plot.c); one key: a line plot and no heat map. */
+static void test_sweep_plots(void **state)
+{
+    (void)state;
+    const char *dir = pl_scratch("plots_sweep");
+    char ini[1200], out[1200], path[2048];
+    snprintf(ini, sizeof ini, "%s/s3.ini", dir);
+    snprintf(out, sizeof out, "%s/s3", dir);
+    write_sweep(ini, "[medium]\ng = 0, 0.5\nalbedo = 0.5, 0.9\n[light]\ntheta_deg = 0, 30, 60\n",
+                out);
+    assert_int_equal(pl_sh("%s sweep --quiet '%s' > /dev/null 2>&1", pl_bin(), ini), 0);
+    assert_true(exists(out, "heatmap_ss.png"));
+    assert_true(exists(out, "heatmap_ss.pdf"));
+    assert_false(exists(out, "heatmap_mc.png"));
+    snprintf(path, sizeof path, "%s/heatmap_ss.png", out);
+    int w, h;
+    png_size(path, &w, &h);
+    assert_int_equal(h, 60 + 330 * 3);
+
+    snprintf(ini, sizeof ini, "%s/s1.ini", dir);
+    snprintf(out, sizeof out, "%s/s1", dir);
+    write_sweep(ini, "[medium]\ng = 0, 0.5, 0.8\n", out);
+    assert_int_equal(pl_sh("%s sweep --quiet '%s' > /dev/null 2>&1", pl_bin(), ini), 0);
+    assert_true(exists(out, "sweep_rms.png"));
+    assert_true(exists(out, "sweep_rms.pdf"));
+    assert_false(exists(out, "heatmap_ss.png"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_run_draws_every_figure),
+        cmocka_unit_test(test_without_mc),
+        cmocka_unit_test(test_sweep_plots),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
