@@ -104,6 +104,56 @@ inline int ppb_mc_segment(const ppb_mc_params *p, int surf, float x, float y)
     return ppb_segment_of((double)y, -(double)p->height, (double)p->height, p->nseg[surf]);
 }
 
+/* The phi-bin edges e_k = k pi / nphi, k = 1 .. nphi - 1, as (cos e_k, sin e_k): computed once
+ * per work-item so that binning an exit needs no atan2 (issue 21: atan2 was a fifth of the
+ * kernel's time). */
+typedef struct ppb_mc_edges {
+    double c[PPB_MC_MAX_PHI], s[PPB_MC_MAX_PHI];
+} ppb_mc_edges;
+
+inline void ppb_mc_edges_init(const ppb_mc_params *p, ppb_mc_edges *e)
+{
+    for (int k = 1; k < p->nphi && k < PPB_MC_MAX_PHI; k++) {
+        double a = (double)k * (PPB_PI / (double)p->nphi);
+        e->c[k] = cos(a), e->s[k] = sin(a);
+    }
+}
+
+/* ppb_phi_bin (ppb_conventions.h) without atan2, the same bin bit for bit. For b = |w.b| >= 0
+ * the direction's angle phi = atan2(b, t) lies in [0, pi], and so does every edge, so
+ * c_k = b cos e_k - t sin e_k = r sin(phi - e_k) is positive exactly where phi > e_k and
+ * falls with k: the bin is the number of edges with c_k > 0, found by bisection. t and b are
+ * floats promoted to double (|t|, |b| <= 1), so c_k is within 1e-15 of its exact value, and
+ * ppb_phi_bin's own edge (where phi / pi nphi, with atan2's ulp error, crosses k) is within
+ * 1e-14 rad of e_k; wherever some tested |c_k| <= 1e-12 the direction is too close to an edge
+ * to decide so, and ppb_phi_bin itself decides (a probability of order 1e-11 per exit). */
+inline int ppb_mc_phi_bin(const ppb_mc_edges *e, double t, double b, int nphi)
+{
+    if (nphi > PPB_MC_MAX_PHI)
+        return ppb_phi_bin(t, b, nphi);
+    int lo = 0, hi = nphi - 1; /* the bin lies in [lo, hi] */
+    while (lo < hi) {
+        int k = (lo + hi + 1) / 2; /* edge k separates bins k - 1 and k */
+        double c = b * e->c[k] - t * e->s[k];
+        if (fabs(c) <= 1e-12)
+            return ppb_phi_bin(t, b, nphi);
+        if (c > 0.0)
+            lo = k;
+        else
+            hi = k - 1;
+    }
+    return lo;
+}
+
+/* ppb_dir_bin (ppb_conventions.h) with the phi bin above: the same bin. */
+inline int ppb_mc_dir_bin(const ppb_mc_params *p, const ppb_mc_edges *e, int surf, double wx,
+                          double wy, double wz)
+{
+    double mu = wx * ppb_normal_x(surf) + wy * ppb_normal_y(surf);
+    double wt = wx * ppb_tangent_x(surf) + wy * ppb_tangent_y(surf);
+    return ppb_theta_bin(mu, p->ntheta) * p->nphi + ppb_mc_phi_bin(e, wt, fabs(wz), p->nphi);
+}
+
 /* Fixed-point weight (kernels/mc_params.h). */
 inline ulong ppb_mc_fixed(float w)
 {
@@ -143,8 +193,8 @@ inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong p
 }
 
 /* Tallies lane l's photon, which has left (s->left) or died. */
-inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_lanes *s, int l,
-                          __global ulong *base, ppb_mc_sums *sums)
+inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_mc_lanes *s,
+                          int l, __global ulong *base, ppb_mc_sums *sums)
 {
     if (s->left[l]) {
         float wx = s->wx[l], wy = s->wy[l];
@@ -154,8 +204,7 @@ inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_lanes *s, int l,
             sums->ballistic += q;
         } else {
             int seg = ppb_mc_segment(p, surf, s->x[l], s->y[l]);
-            int bin =
-                ppb_dir_bin(surf, (double)wx, (double)wy, (double)s->wz[l], p->ntheta, p->nphi);
+            int bin = ppb_mc_dir_bin(p, e, surf, (double)wx, (double)wy, (double)s->wz[l]);
             size_t cell =
                 ppb_cell_index(p->offset[surf], seg, ppb_bin_count(p->ntheta, p->nphi), bin);
             atom_add(base + PPB_MC_TALLY_ALL * p->ncells + cell, q);
@@ -334,6 +383,9 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     medium[4] = (float)ppb_albedo_at(p.step_x - 1.0, p.step, p.step_x, p.albedo, p.albedo_right);
     medium[5] = (float)ppb_albedo_at(p.step_x, p.step, p.step_x, p.albedo, p.albedo_right);
 
+    ppb_mc_edges edges;
+    ppb_mc_edges_init(&p, &edges);
+
     ppb_mc_sums sums = {0, 0, 0, 0, 0, 0};
     ppb_mc_lanes s;
     ulong m = q0;
@@ -350,7 +402,7 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
         int busy = 0;
         for (int l = 0; l < LANES; l++) {
             if (s.active[l] && s.done[l]) {
-                ppb_mc_finish(&p, &s, l, base, &sums);
+                ppb_mc_finish(&p, &edges, &s, l, base, &sums);
                 if (m < n) {
                     ppb_mc_start(&p, &s, l, p.first + off + batches * m);
                     m += per_batch;

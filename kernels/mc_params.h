@@ -44,6 +44,10 @@ typedef uint32_t ppb_u32;
 #define PPB_MC_CAP_WMAX  512.0f
 #define PPB_MC_EVENT_CAP 10000
 
+/* Up to this many phi bins the kernel bins exits by the precomputed edges of mc.cl's
+ * ppb_mc_phi_bin; more (the config allows 64) take ppb_phi_bin's atan2, the same bins. */
+#define PPB_MC_MAX_PHI 64
+
 /* Per-batch totals (each a fixed-point weight sum unless noted). */
 enum {
     PPB_MC_T_BALLISTIC = 0, /* unscattered exits, any surface */
