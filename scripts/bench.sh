@@ -18,12 +18,15 @@ while [ $# -gt 0 ]; do
   shift
 done
 mapfile -t cases < configs/study.list
+# The Monte Carlo references are kept by fingerprint (SPEC 13, docs/external.md): a second
+# bench that only adds a method traces no photon. PPB_REF_CACHE moves it.
+cache=${PPB_REF_CACHE:-build/ref-cache}
 mkdir -p "$out"
 t0=$(date +%s)
 for i in "${!cases[@]}"; do
   c=${cases[$i]}
   printf '[%d/%d] %s (%ds elapsed)\n' $((i + 1)) ${#cases[@]} "$c" $(( $(date +%s) - t0 )) >&2
-  ./ppbench run "${sets[@]}" --out "$out/$c" "configs/$c.ini"
+  ./ppbench run "${sets[@]}" --ref-cache "$cache" --out "$out/$c" "configs/$c.ini"
   theta=$(awk -F' *= *' '$1 == "theta_deg" {print $2}' "configs/$c.ini")
   bash scripts/plots.sh "$out/$c" "${theta:-0}"
 done

@@ -442,6 +442,55 @@ static void test_python(void **state)
     assert_int_equal(rc, 0);
 }
 
+/* The reference cache: a second run with --ref-cache that needs the same Monte Carlo reference
+ * (here: adding a method) traces no photon -- counted, not timed: provenance.txt records
+ * mc.photons_traced for a traced reference and none for a cached one, and the run says "0
+ * traced" -- and its mc rows are the first run's byte for byte; another seed is another
+ * reference and is traced. */
+static void test_ref_cache(void **state)
+{
+    (void)state;
+    char dir[1024], text[4096], args[8192], cache[1100], a[1100], b[1100], c[1100], cmd[8192];
+    snprintf(dir, sizeof dir, "%s", tu_scratch("ext_cache"));
+    snprintf(cache, sizeof cache, "%s/cache", dir);
+    snprintf(a, sizeof a, "%s/a", dir);
+    snprintf(b, sizeof b, "%s/b", dir);
+    snprintf(c, sizeof c, "%s/c", dir);
+    snprintf(text, sizeof text, "[experiment]\nmethods = mc, mp\n%s", tiny);
+    snprintf(args, sizeof args, "run --quiet --ref-cache %s --out %s %s", cache, a,
+             cli_config("ext_cache1", text));
+    cli_expect(args, 0, "");
+    assert_true(file_has(a, "provenance.txt", "mc.photons_traced = 20000\n"));
+    snprintf(text, sizeof text,
+             "[experiment]\nmethods = mc, mp, mp2\n%s[method.mp2]\ncommand = sh %s/copy.sh {out}\n",
+             tiny, dir);
+    FILE *f = fopen(strcat(strcpy(cmd, dir), "/copy.sh"), "w");
+    assert_non_null(f);
+    fprintf(f,
+            "awk -F, -v OFS=, 'NR == 1 || $1 == \"mp\" { if (NR > 1) $1 = \"mp2\"; print }' "
+            "%s/radiance.csv > \"$1/radiance.csv\"\n",
+            a);
+    fclose(f);
+    snprintf(args, sizeof args, "run --ref-cache %s --out %s %s", cache, b,
+             cli_config("ext_cache2", text));
+    cli_expect(args, 0, "mc: 20000 photons from the reference cache");
+    assert_true(strstr(cli_out, "0 traced") != NULL);
+    assert_false(file_has(b, "provenance.txt", "mc.photons_traced"));
+    assert_same_rows(b, "summary.csv", "mp2", "mp");
+    char *ra = rows_of(a, "radiance.csv", "mc"), *rb = rows_of(b, "radiance.csv", "mc");
+    assert_true(*ra);
+    assert_string_equal(ra, rb);
+    free(ra);
+    free(rb);
+    /* Another seed: not the cached reference. */
+    snprintf(args, sizeof args, "run --quiet --set mc.seed=2 --ref-cache %s --out %s %s", cache, c,
+             cli_config("ext_cache1", "[experiment]\nmethods = mc\n[tube]\nsegments_top = 8\n"
+                                      "segments_side = 3\n[bins]\ntheta = 2\nphi = 2\n[mc]\n"
+                                      "photons = 20000\n"));
+    cli_expect(args, 0, "");
+    assert_true(file_has(c, "provenance.txt", "mc.photons_traced = 20000\n"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -450,6 +499,7 @@ int main(void)
         cmocka_unit_test(test_external_refusals),
         cmocka_unit_test(test_score),
         cmocka_unit_test(test_python),
+        cmocka_unit_test(test_ref_cache),
     };
     return cmocka_run_group_tests(tests, make_ref, NULL);
 }

@@ -43,6 +43,7 @@ enum {
     OPT_YES = 1 << 5,
     OPT_QUIET = 1 << 6,
     OPT_REF = 1 << 20,
+    OPT_REF_CACHE = 1 << 21,
     OPT_SHARDS = 1 << 7, /* slurm's: its job array and scripts (drivers/slurm.h) */
     OPT_PARTITION = 1 << 8,
     OPT_TIME = 1 << 9,
@@ -65,6 +66,9 @@ static const struct option_doc {
     {OPT_YES, "--yes", NULL, "sweep: allow a grid larger than the safety limit"},
     {OPT_QUIET, "--quiet", NULL, "no progress lines on stderr"},
     {OPT_REF, "--ref", "DIR", "score: the finished experiment to score against"},
+    {OPT_REF_CACHE, "--ref-cache", "DIR",
+     "run: reuse the Monte Carlo reference stored under DIR\nby its fingerprint (and "
+     "store it there)"},
     {OPT_SHARDS, "--shards", "N",
      "slurm: N array tasks, each one shard (1 to 1000; at most\nthe grid points or photons)"},
     {OPT_PARTITION, "--partition", "P", "slurm: #SBATCH --partition (default: the cluster's)"},
@@ -88,6 +92,7 @@ typedef struct cli {
     int shard_i, shard_n;
     int jobs;
     const char *ref;
+    const char *ref_cache;
     int shards, cpus, submit; /* slurm's */
     const char *partition, *time, *mem;
     const char **args;
@@ -187,6 +192,9 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
             break;
         case OPT_REF:
             c->ref = v;
+            break;
+        case OPT_REF_CACHE:
+            c->ref_cache = v;
             break;
         case OPT_SUBMIT:
             c->submit = 1;
@@ -421,7 +429,8 @@ static int cmd_run(const cli *c)
     for (int i = 0; i < c->nargs && code == EXIT_OK; i++) {
         const ppb_config *cfg = &cfgs[i];
         ppb_experiment ex = {0};
-        ppb_run_ctx ctx = {.device_selector = c->device, .quiet = c->quiet};
+        ppb_run_ctx ctx = {
+            .device_selector = c->device, .quiet = c->quiet, .ref_cache = c->ref_cache};
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
@@ -667,7 +676,7 @@ static const command commands[] = {
      "run every method of each experiment config and write\nthe outputs of docs/reference.md under "
      "[output] dir",
      "ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini",
-     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET, 1, cmd_run},
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET | OPT_REF_CACHE, 1, cmd_run},
     {"sweep", "CONFIG", 0, "run a grid sweep (keys holding lists) into <dir>/sweep.csv",
      "ppbench sweep --shard 2/3 --jobs 2 configs/sweep_example.ini",
      OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARD | OPT_JOBS | OPT_YES | OPT_QUIET, 1, cmd_sweep},

@@ -29,6 +29,7 @@ typedef struct ppb_run_ctx {
      * byte-identical to computing them again, and computes them itself otherwise. */
     const ppb_result *prior;
     int nprior;
+    const char *ref_cache; /* --ref-cache DIR: mc's tallies reused from there (mc_cache.h) */
 } ppb_run_ctx;
 
 /* The device, opened on first call and shared by every method of the run. */

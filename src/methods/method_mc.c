@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "kernels/ppb_fresnel.h"
+#include "methods/mc_cache.h"
 #include "model/metrics.h"
 #include "base/memory.h"
 #include "base/progress.h"
@@ -429,11 +430,21 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     char detail[128];
     snprintf(detail, sizeof detail, "tallies of %d batches, %.3g GB x 3", cfg->mc.batches,
              tally / 1e9);
-    if (ppb_memory_check(3.0 * tally, cfg->memory_limit, "mc", detail, err) ||
-        ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
+    if (ppb_memory_check(3.0 * tally, cfg->memory_limit, "mc", detail, err))
         return -1;
-    ppb_mc_trace_info info;
-    int status = ppb_mc_trace(ctx, cfg->mc.first, cfg->mc.photons, &t, &info, err);
+    ppb_mc_trace_info info = {0};
+    int status = 0;
+    if (ctx->ref_cache && ppb_mc_cache_get(ctx->ref_cache, cfg, &t)) {
+        /* The same reference was traced before (SPEC 13): no photon is traced now. */
+        fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n", cfg->name,
+                (unsigned long long)t.count, ctx->ref_cache);
+    } else {
+        if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
+            return -1;
+        status = ppb_mc_trace(ctx, cfg->mc.first, cfg->mc.photons, &t, &info, err);
+        if (status == 0 && !info.interrupted && ctx->ref_cache)
+            ppb_mc_cache_put(ctx->ref_cache, cfg, &t, info.traced);
+    }
     if (status == 0) {
         /* Said, not hidden: interactions past the event cap were rouletted (mc_params.h). */
         uint64_t capped = 0;
