@@ -54,7 +54,10 @@ typedef PPB_VEC(uint) vuint;
 #define AS_VFLOAT      PPB_CAT(as_float, PPB_MC_LANES)
 #define CONVERT_VFLOAT PPB_CAT(convert_float, PPB_MC_LANES)
 #define CONVERT_VINT   PPB_CAT(convert_int, PPB_MC_LANES)
-#define LANES          PPB_MC_LANES
+#define CONVERT_VUINT  PPB_CAT(convert_uint, PPB_MC_LANES)
+#define CONVERT_VULONG PPB_CAT(convert_ulong, PPB_MC_LANES)
+typedef PPB_VEC(ulong) vulong;
+#define LANES PPB_MC_LANES
 
 /* Uniforms and the scattering samplers (tests/test_mc.c runs them alone). */
 #include "ppb_sampling.h"
@@ -71,8 +74,13 @@ inline ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
             k0 += PHILOX_W32_0;
             k1 += PHILOX_W32_1;
         }
-        vuint lo0 = (vuint)PHILOX_M4x32_0 * c.v0, hi0 = mul_hi((vuint)PHILOX_M4x32_0, c.v0);
-        vuint lo1 = (vuint)PHILOX_M4x32_1 * c.v2, hi1 = mul_hi((vuint)PHILOX_M4x32_1, c.v2);
+        /* The 32 x 32 -> 64-bit products as such (one widening multiply per half of the
+         * lanes on x86, vpmuludq): PoCL's vector mul_hi splits into 16-bit pieces, which cost
+         * 40% of the step (issue 21). The same words. */
+        vulong p0 = CONVERT_VULONG(c.v0) * (ulong)PHILOX_M4x32_0;
+        vulong p1 = CONVERT_VULONG(c.v2) * (ulong)PHILOX_M4x32_1;
+        vuint lo0 = CONVERT_VUINT(p0), hi0 = CONVERT_VUINT(p0 >> 32);
+        vuint lo1 = CONVERT_VUINT(p1), hi1 = CONVERT_VUINT(p1 >> 32);
         ppb_mc_vctr out = {hi1 ^ c.v1 ^ k0, lo1, hi0 ^ c.v3 ^ k1, lo0};
         c = out;
     }
@@ -165,6 +173,30 @@ typedef struct ppb_mc_sums {
     ulong ballistic, capture, rgain, rloss, events, capped;
 } ppb_mc_sums;
 
+/* Cell-tally additions waiting to be made, flushed PPB_MC_PEND at a time (issue 21: the lock
+ * add of each exit, made at once, was a sixth of the kernel's time, stalled behind the step's
+ * pending stores and the cell's cache miss). A flush first reads every pending cell, so their
+ * cache misses overlap, then adds; integer sums do not depend on the order of the additions. */
+#define PPB_MC_PEND 32
+typedef struct ppb_mc_pending {
+    size_t cell[PPB_MC_PEND];
+    ulong q[PPB_MC_PEND];
+    int n;
+} ppb_mc_pending;
+
+inline void ppb_mc_flush(ppb_mc_pending *pend, __global ulong *base, __global ulong *spare)
+{
+    ulong touch = 0;
+    for (int i = 0; i < pend->n; i++)
+        touch += base[pend->cell[i]];
+    for (int i = 0; i < pend->n; i++)
+        atom_add(base + pend->cell[i], pend->q[i]);
+    pend->n = 0;
+    /* Keeps the reads above (their sum is otherwise unused); adding 0 changes nothing. */
+    if (touch == 0x9e3779b97f4a7c15UL)
+        atom_add(spare, 0UL);
+}
+
 /* The state of every lane, kept in private arrays so that one lane can be finished and
  * restarted on its own; the step loads them into vectors. */
 typedef struct ppb_mc_lanes {
@@ -194,7 +226,7 @@ inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong p
 
 /* Tallies lane l's photon, which has left (s->left) or died. */
 inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_mc_lanes *s,
-                          int l, __global ulong *base, ppb_mc_sums *sums)
+                          int l, ppb_mc_pending *pend, ppb_mc_sums *sums)
 {
     if (s->left[l]) {
         float wx = s->wx[l], wy = s->wy[l];
@@ -207,9 +239,9 @@ inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const p
             int bin = ppb_mc_dir_bin(p, e, surf, (double)wx, (double)wy, (double)s->wz[l]);
             size_t cell =
                 ppb_cell_index(p->offset[surf], seg, ppb_bin_count(p->ntheta, p->nphi), bin);
-            atom_add(base + PPB_MC_TALLY_ALL * p->ncells + cell, q);
+            pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = q;
             if (s->nscat[l] == 1)
-                atom_add(base + PPB_MC_TALLY_ONCE * p->ncells + cell, q);
+                pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n++] = q;
         }
     }
     sums->capture += ppb_mc_fixed(s->capture[l]);
@@ -387,6 +419,9 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     ppb_mc_edges_init(&p, &edges);
 
     ppb_mc_sums sums = {0, 0, 0, 0, 0, 0};
+    ppb_mc_pending pend;
+    pend.n = 0;
+    __global ulong *spare = totals + (size_t)batch * PPB_MC_NTOT + PPB_MC_NTOT - 1;
     ppb_mc_lanes s;
     ulong m = q0;
     for (int l = 0; l < LANES; l++) {
@@ -402,7 +437,9 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
         int busy = 0;
         for (int l = 0; l < LANES; l++) {
             if (s.active[l] && s.done[l]) {
-                ppb_mc_finish(&p, &edges, &s, l, base, &sums);
+                ppb_mc_finish(&p, &edges, &s, l, &pend, &sums);
+                if (pend.n > PPB_MC_PEND - 2)
+                    ppb_mc_flush(&pend, base, spare);
                 if (m < n) {
                     ppb_mc_start(&p, &s, l, p.first + off + batches * m);
                     m += per_batch;
@@ -416,6 +453,7 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
             break;
     }
 
+    ppb_mc_flush(&pend, base, spare);
     __global ulong *tot = totals + (size_t)batch * PPB_MC_NTOT;
     atom_add(tot + PPB_MC_T_BALLISTIC, sums.ballistic);
     atom_add(tot + PPB_MC_T_CAPTURE, sums.capture);
