@@ -87,9 +87,9 @@ if [ -s "$dir/rms.csv" ] && [ "$(prov experiment.geometry)" != slab ]; then
       mfp=$(awk -v s="${sigma_t:-1}" 'BEGIN {print 1 / s}')
       echo "set arrow 1 from $step_x, graph 0 to $step_x, graph 1 nohead dt 2 lw 1.5 lc rgb '#444444'"
       for d in -2 2; do
-        echo "set arrow $((d < 0 ? 2 : 3)) from ($step_x + $d * $mfp), graph 0 to ($step_x + $d * $mfp), graph 1 nohead dt 3 lc rgb '#888888'"
+        echo "set arrow $((d < 0 ? 2 : 3)) from ($step_x + $d * $mfp), graph 0 to ($step_x + $d * $mfp), graph 1 nohead dt '.-' lw 1.5 lc rgb '#7B3294'"
       done
-      markers="dashed: step_x = $step_x; dotted: step_x +- 2 mfp (mfp = 1/sigma_t = $mfp)"
+      markers="grey dashed: step_x = $step_x; purple dash-dot: step_x +- 2 mfp (mfp = 1/sigma_t = $mfp)"
     else
       markers="no step"
     fi
@@ -165,7 +165,7 @@ if [ -s "$dir/angular.csv" ]; then
   {
     echo "set multiplot layout 1,2 title '$name: in-plane exit radiance at x = 0 (1/sr per unit irradiance); + half: phi bin 0 (along t), - half: the last phi bin'"
     echo "set grid; set xlabel 'signed theta from the normal (deg; + along t, - against t)'"
-    echo "set ylabel 'radiance'; set xrange [-90:90]; set key outside below center horizontal"
+    echo "set ylabel 'radiance'; set xrange [-90:90]; set key outside right top vertical"
     echo "set title 'S1 (t = +x); red dotted line: mirror direction of the light ($theta_l deg)'"
     echo "set arrow 1 from $theta_l, graph 0 to $theta_l, graph 1 nohead dt 3 lc rgb 'red'"
     ang_plot S1 cartesian

@@ -189,7 +189,7 @@ static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, con
     }
     fprintf(gp,
             "set multiplot layout 1,2 title 'RMS against mc at x = 0 over %s'\nset grid\n"
-            "set xlabel '%s'\nset ylabel 'RMS (%%)'\nset key outside below horizontal\n",
+            "set xlabel '%s'\nset ylabel 'RMS (%%)'\nset key outside right top vertical\n",
             xname, xname);
     for (int k = 0; k < 2; k++) {
         fprintf(gp, "set title '%s'\nplot ", k == 0 ? "R (S1)" : "T (S2)");
