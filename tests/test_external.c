@@ -88,6 +88,17 @@ static void test_scene_json(void **state)
     assert_string_equal(json_string_value(json_object_get(first, "surface")), "S1");
     assert_close(num(first, "s"), -5.0 + 0.5 * 10.0 / 7, 1e-12); /* SPEC 2: from x = -W/2 */
     json_decref(doc);
+    /* The medium as the config sets it (the value given is the expected one). */
+    snprintf(args, sizeof args,
+             "scene --out %s/n --set experiment.methods=mc --set medium.n=1.4 --set medium.g=0.5 "
+             "configs/uniform_g0_normal.ini",
+             dir);
+    cli_expect(args, 0, "");
+    snprintf(path, sizeof path, "%s/n/scene.json", dir);
+    doc = load_json(path);
+    assert_close(num(json_object_get(doc, "medium"), "n"), 1.4, 0);
+    assert_close(num(json_object_get(doc, "medium"), "g"), 0.5, 0);
+    json_decref(doc);
     /* A bad config is refused before anything is written (exit 2, README). */
     snprintf(args, sizeof args,
              "scene --out %s/bad --set medium.albedo=2 "

@@ -77,6 +77,8 @@ def main(argv):
     m, light = sc["medium"], sc["light"]
     if m["step"] != "none":
         sys.exit("ppbench.dipole: uniform media only")
+    if m.get("n", 1.0) != 1.0:
+        sys.exit("ppbench.dipole: n = 1 only (the boundary factor A = 1)")
     R, T = dipole_RT(m["sigma_t"], m["albedo"], m["g"], sc["geometry"]["height"])
     cos_l = light["irradiance_s1"]  # cos(theta_L): the irradiance S1 receives
     # Where the first source lies below a thin slab T comes out negative: 0, as the C mp does.

@@ -17,6 +17,9 @@ static const char *const conventions[][2] = {
     {"light", "a collimated beam w_L = (sin theta_L, -cos theta_L, 0) into S1, irradiance 1 on a "
               "plane perpendicular to it (S1 receives cos theta_L per unit area); only S1 is lit, "
               "and with the shadow step only x < step_x"},
+    {"medium", "sigma_t, albedo, Henyey-Greenstein g, piecewise constant: the *_right values hold "
+               "for x >= step_x under the density or albedo step; n is the medium's refractive "
+               "index, 1 outside (n = 1: matched boundaries, no reflection or refraction)"},
     {"radiance", "outgoing radiance of SCATTERED light only, divided by the beam's irradiance "
                  "E_perp: units 1/sr; the unscattered beam is not radiance"},
     {"frame", "at each sample point: n the outward normal, b = +z, t = n x b (given per point); "
@@ -167,7 +170,7 @@ static json_t *scene_doc(const ppb_config *cfg)
             json_pack("{sfsfsfsssssfsfsfsf}", "sigma_t", sc->sigma_t, "albedo", sc->albedo, "g",
                       sc->g, "phase", "Henyey-Greenstein", "step", step_name(sc->step), "step_x",
                       sc->step_x, "sigma_t_right", sc->sigma_t_right, "albedo_right",
-                      sc->albedo_right, "n", 1.0)) ||
+                      sc->albedo_right, "n", sc->n)) ||
         add(doc, "light",
             json_pack("{sfsfsfs[fff]sfsf}", "theta_deg", sc->theta_deg, "irradiance_perp", 1.0,
                       "irradiance_s1", ppb_scene_cos_theta_l(sc), "direction", wl[0], wl[1], wl[2],
