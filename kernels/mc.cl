@@ -145,10 +145,9 @@ inline int ppb_mc_phi_bin(const ppb_mc_edges *e, double t, double b, int nphi)
         double c = b * e->c[k] - t * e->s[k];
         if (fabs(c) <= 1e-12)
             return ppb_phi_bin(t, b, nphi);
-        if (c > 0.0)
-            lo = k;
-        else
-            hi = k - 1;
+        int up = c > 0.0; /* selects, not branches: the side is a coin toss per exit */
+        lo = up ? k : lo;
+        hi = up ? hi : k - 1;
     }
     return lo;
 }
@@ -165,7 +164,11 @@ inline int ppb_mc_dir_bin(const ppb_mc_params *p, const ppb_mc_edges *e, int sur
 /* Fixed-point weight (kernels/mc_params.h). */
 inline ulong ppb_mc_fixed(float w)
 {
-    return convert_ulong_rte(w * PPB_MC_FIXED_SCALE);
+    /* convert_ulong_rte(w * 2^32) without PoCL's generic float -> ulong conversion: w * 2^32 is
+     * exact in float (a power-of-two scale), and as a double rint rounds it half to even, as
+     * _rte does, to an integer below 2^45 (weights are at most 8 PPB_MC_CAP_WMAX), which
+     * converts to long exactly. */
+    return (ulong)(long)rint((double)(w * PPB_MC_FIXED_SCALE));
 }
 
 /* Per-work-item sums of the totals: integers, added to the batch's totals once at the end. */
@@ -207,21 +210,61 @@ typedef struct ppb_mc_lanes {
     int capped[LANES]; /* roulettes forced by the event cap */
 } ppb_mc_lanes;
 
-/* Starts photon `photon` in lane l: entry on S1 (y = 0) along w_L. */
-inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong photon)
+/* The entry words (Philox word 0 of the counter (i mod 2^32, i / 2^32, 0, 1)) of the photons
+ * photon0 + j stride, j = 0 .. LANES - 1, a work-item's next LANES photons, by one vector
+ * Philox: a scalar one per photon was a tenth of the kernel's time (issue 21). The same words
+ * as Random123's philox4x32 (tests/test_mc.c checks the vector Philox against it). */
+inline void ppb_mc_entry_words(const ppb_mc_params *p, ulong photon0, ulong stride, uint *w)
+{
+    uint c0[LANES], c1[LANES];
+    for (int l = 0; l < LANES; l++) {
+        ulong photon = photon0 + stride * (ulong)l;
+        c0[l] = (uint)photon, c1[l] = (uint)(photon >> 32);
+    }
+    ppb_mc_vctr c = {VLOAD(0, c0), VLOAD(0, c1), (vuint)0, (vuint)1};
+    c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
+    VSTORE(c.v0, 0, w);
+}
+
+/* Starts photon `photon` in lane l: entry on S1 (y = 0) along w_L, at the point its entry word
+ * (ppb_mc_entry_words) gives in the tube. */
+inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong photon,
+                         uint entry_word)
 {
     s->ctr0[l] = (uint)photon, s->ctr1[l] = (uint)(photon >> 32), s->step[l] = 0;
     float x = 0.0f;
-    if (p->tube) {
-        philox4x32_ctr_t c = {{(uint)photon, (uint)(photon >> 32), 0, 1}};
-        philox4x32_key_t k = {{(uint)p->seed, (uint)(p->seed >> 32)}};
-        x = p->enter_x0 + p->enter_width * ppb_mc_uniform1(philox4x32(c, k).v[0]);
-    }
+    if (p->tube)
+        x = p->enter_x0 + p->enter_width * ppb_mc_uniform1(entry_word);
     s->x[l] = x, s->y[l] = 0.0f;
     s->wx[l] = p->light_x, s->wy[l] = p->light_y, s->wz[l] = 0.0f;
     s->weight[l] = p->entry_weight, s->capture[l] = s->rgain[l] = s->rloss[l] = 0.0f,
     s->tau[l] = 0.0f;
     s->nscat[l] = 0, s->need_tau[l] = -1, s->active[l] = -1, s->capped[l] = 0;
+}
+
+/* The work-item's photons in order: the m-th is first + off + batches m, m = q0, q0 + P, ...
+ * Entry words are made LANES photons at a time. */
+typedef struct ppb_mc_queue {
+    ulong m, n, step, base, stride; /* next m, end, P, first + off, batches */
+    uint word[LANES];
+    int used;
+} ppb_mc_queue;
+
+/* Starts the next photon in lane l, or marks the lane idle when none is left. */
+inline void ppb_mc_next(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ppb_mc_queue *q)
+{
+    if (q->m >= q->n) {
+        s->active[l] = 0;
+        return;
+    }
+    ulong photon = q->base + q->stride * q->m;
+    if (q->used == LANES) {
+        if (p->tube)
+            ppb_mc_entry_words(p, photon, q->stride * q->step, q->word);
+        q->used = 0;
+    }
+    ppb_mc_start(p, s, l, photon, q->word[q->used++]);
+    q->m += q->step;
 }
 
 /* Tallies lane l's photon, which has left (s->left) or died. */
@@ -240,8 +283,9 @@ inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const p
             size_t cell =
                 ppb_cell_index(p->offset[surf], seg, ppb_bin_count(p->ntheta, p->nphi), bin);
             pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = q;
-            if (s->nscat[l] == 1)
-                pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n++] = q;
+            /* mc1's addition, kept only for a once-scattered photon (no branch to mispredict) */
+            pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n] = q;
+            pend->n += s->nscat[l] == 1;
         }
     }
     sums->capture += ppb_mc_fixed(s->capture[l]);
@@ -423,15 +467,10 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     pend.n = 0;
     __global ulong *spare = totals + (size_t)batch * PPB_MC_NTOT + PPB_MC_NTOT - 1;
     ppb_mc_lanes s;
-    ulong m = q0;
-    for (int l = 0; l < LANES; l++) {
-        if (m < n) {
-            ppb_mc_start(&p, &s, l, p.first + off + batches * m);
-            m += per_batch;
-        } else {
-            s.active[l] = 0;
-        }
-    }
+    ppb_mc_queue queue = {q0, n, per_batch, p.first + off, batches};
+    queue.used = LANES;
+    for (int l = 0; l < LANES; l++)
+        ppb_mc_next(&p, &s, l, &queue);
     for (;;) {
         ppb_mc_step(&p, &s, medium);
         int busy = 0;
@@ -440,12 +479,7 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
                 ppb_mc_finish(&p, &edges, &s, l, &pend, &sums);
                 if (pend.n > PPB_MC_PEND - 2)
                     ppb_mc_flush(&pend, base, spare);
-                if (m < n) {
-                    ppb_mc_start(&p, &s, l, p.first + off + batches * m);
-                    m += per_batch;
-                } else {
-                    s.active[l] = 0;
-                }
+                ppb_mc_next(&p, &s, l, &queue);
             }
             busy |= s.active[l];
         }
