@@ -1,19 +1,20 @@
-/* Methods from outside (issue 17, SPEC 13), through the built binary ($PPBENCH):
+/* Methods from outside (issue 17; docs/external.md), through the built binary ($PPBENCH):
  * - `ppbench scene` writes scene.json whose sample points and bins are the conventions' own:
  *   checked against kernels/ppb_conventions.h (the point count of the layout, the bin index of
- *   every averaging direction as the Monte Carlo tallies bin it, w_k summing to pi -- SPEC 4:
- *   the bins cover the projected solid angle of the hemisphere, pi);
+ *   every averaging direction as the Monte Carlo tallies bin it, w_k summing to pi -- reference:
+ * Bins: the bins cover the projected solid angle of the hemisphere, pi);
  * - an external method end to end: its command copies the rows of a built-in method (mp) from
  *   an earlier run under its own name, so every output of it (summary, rms, totals, images) must
  *   equal mp's -- mp's own rows are the expected values; without a totals.csv its R, T and sides
- *   are the radiance integrated (SPEC 4's cell measure), which must give the Monte Carlo's own
- *   R, T, sides when it copies the mc rows (energy per cell is what the tallies count);
+ *   are the radiance integrated (the cell measure, reference: Bins), which must give the Monte
+ * Carlo's own R, T, sides when it copies the mc rows (energy per cell is what the tallies count);
  * - each bad output (missing row, duplicate, NaN, negative, wrong columns, non-zero exit,
  *   timeout) is refused with file:line or the reason, and none of its rows or images is written;
  *   on timeout the command's process group is gone.
  * Expected values come from the conventions' functions (an independent path: the tallies'
- * binning of a direction, not the writer's loop), from SPEC 4's sum, from a built-in method's
- * own outputs and from exit codes of README.md. Tiny grids: bookkeeping, not physics. */
+ * binning of a direction, not the writer's loop), from the bins' sum (reference: Bins), from a
+ * built-in method's own outputs and from exit codes of README.md. Tiny grids: bookkeeping, not
+ * physics. */
 #include "cliutil.h"
 
 #include <jansson.h>
@@ -86,7 +87,8 @@ static void test_scene_json(void **state)
     }
     json_t *first = json_array_get(pts, 0);
     assert_string_equal(json_string_value(json_object_get(first, "surface")), "S1");
-    assert_close(num(first, "s"), -5.0 + 0.5 * 10.0 / 7, 1e-12); /* SPEC 2: from x = -W/2 */
+    assert_close(num(first, "s"), -5.0 + 0.5 * 10.0 / 7,
+                 1e-12); /* reference: Geometry, from x = -W/2 */
     json_decref(doc);
     /* The medium as the config sets it (the value given is the expected one). */
     snprintf(args, sizeof args,

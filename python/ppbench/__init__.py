@@ -1,4 +1,4 @@
-"""ppbench from Python: read an experiment's outputs, recompute SPEC 5's metrics, read a
+"""ppbench from Python: read an experiment's outputs, recompute the metrics (docs/reference.md: Metrics), read a
 scene.json (docs/external.md). Standard library only; with pandas installed, load() returns
 DataFrames, otherwise lists of dicts.
 
@@ -49,7 +49,7 @@ def read_config(directory):
 
 
 def bin_edges(ntheta, nphi):
-    """SPEC 4's bins: {bin index: (theta_lo, theta_hi, phi_lo, phi_hi, w_k)}, radians; theta
+    """The bins (docs/reference.md: Bins): {bin index: (theta_lo, theta_hi, phi_lo, phi_hi, w_k)}, radians; theta
     edges at sin^2(theta) = k / ntheta, phi folded to [0, pi], w_k = pi / (ntheta nphi)."""
     out = {}
     for it in range(ntheta):
@@ -86,7 +86,7 @@ def _rows(table):
 
 
 def _cell_points(cell, nseg):
-    """The sample points (surface, segment) of a Table 2 / whole-surface cell (SPEC 5): R_x0 and
+    """The sample points (surface, segment) of a Table 2 / whole-surface cell (docs/reference.md: Metrics): R_x0 and
     T_x0 the two S1 (S2) segments next to x = 0, Sk_all every segment of Sk."""
     if cell in ("R_x0", "T_x0"):
         surf, n = ("S1" if cell == "R_x0" else "S2"), nseg["S1" if cell == "R_x0" else "S2"]
@@ -96,7 +96,7 @@ def _cell_points(cell, nseg):
 
 
 def metrics(radiance, method, cell=None, points=None, ref="mc"):
-    """SPEC 5 for `method` against `ref` over a set of sample points: points = {(surface,
+    """The metrics (docs/reference.md: Metrics) of `method` against `ref` over a set of sample points: points = {(surface,
     segment)}, or cell = "R_x0", "T_x0", "S1_all", ...; returns rms_rel, noise_rel, rms_excess:
         rms_rel   = sqrt(sum w_k (L_m - L_r)^2 / sum w_k L_r^2)
         noise_rel = sqrt(sum w_k se_r^2 / sum w_k L_r^2)

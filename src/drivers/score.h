@@ -1,4 +1,4 @@
-/* score.h: `ppbench score RADIANCE.csv --ref DIR [--out DIR2]` (SPEC 13; docs/external.md):
+/* score.h: `ppbench score RADIANCE.csv --ref DIR [--out DIR2]` (docs/external.md):
  * scores the methods of a radiance file against a finished experiment, as `run` would have.
  *
  * The experiment's settings come from DIR/provenance.txt (its resolved config), the reference's

@@ -7,7 +7,8 @@
 #include "base/atomic_file.h"
 #include "model/scene.h"
 
-/* The units and conventions of SPEC 2-5 in words, for a reader who has only this file. */
+/* The units and conventions of the conventions of docs/reference.md (Medium to Metrics) in words,
+ * for a reader who has only this file. */
 static const char *const conventions[][2] = {
     {"lengths", "mean free paths of the left medium (sigma_t = 1 there by default); positions "
                 "(x, y) in the tube's cross-section, z along the tube (uniform)"},

@@ -1,4 +1,4 @@
-/* scene_json.h: the experiment as scene.json, what an external method reads (SPEC 13;
+/* scene_json.h: the experiment as scene.json, what an external method reads (docs/external.md;
  * docs/external.md): geometry, medium, light, every sample point (surface, segment, s, position,
  * normal, tangent, segment extent) and every bin (index, theta/phi edges, projected solid angle
  * w_k, the directions a deterministic method averages over), with the units and conventions in

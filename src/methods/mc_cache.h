@@ -1,4 +1,4 @@
-/* mc_cache.h: the Monte Carlo reference cache (SPEC 13; `--ref-cache DIR`, docs/external.md):
+/* mc_cache.h: the Monte Carlo reference cache (`--ref-cache DIR`, docs/external.md):
  * tallies of a finished trace stored under DIR by what determines them, so a run that needs the
  * same reference traces no photon.
  *

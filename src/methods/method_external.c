@@ -174,7 +174,7 @@ int ppb_external_read_radiance(const char *path, const char *id, int others_ok, 
         if (k >= c.ncol || strcmp(c.col[k], columns[k]) != 0) {
             ppb_fail(err,
                      "%s:1: the columns must begin method,surface,segment,s,theta_bin,phi_bin,"
-                     "radiance,stderr (SPEC 8); column %d is '%s'",
+                     "radiance,stderr (docs/reference.md: Outputs); column %d is '%s'",
                      path, k + 1, k < c.ncol ? c.col[k] : "(none)");
             goto done;
         }
@@ -261,7 +261,7 @@ int ppb_external_totals(const char *path, const ppb_scene *sc, ppb_result *r, pp
     memset(t, 0, sizeof *t);
     if (access(path, F_OK) != 0) {
         /* No totals.csv: the scattered exits integrated from the radiance; the ballistic part
-         * is not radiance (SPEC 4), so it stays 0 and absorbed is the rest. */
+         * is not radiance (reference: Bins), so it stays 0 and absorbed is the rest. */
         const ppb_layout *lo = &r->layout;
         double P = ppb_scene_power_in(sc);
         for (int surf = 0; surf < lo->nsurf; surf++) {

@@ -1,4 +1,4 @@
-/* method_external.h: a method that is not ppbench's (SPEC 13; docs/external.md): a config's
+/* method_external.h: a method that is not ppbench's (docs/external.md): a config's
  * [method.NAME] command, run on the experiment's scene.json, its radiance.csv validated and
  * turned into a result like any built-in method's.
  *
@@ -23,11 +23,11 @@ int ppb_method_external(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 /* The form of a definition, checked when the config is loaded: its command holds {out}. */
 int ppb_external_check(const ppb_config *cfg, const ppb_external_def *d, ppb_err *err);
 
-/* Reads a radiance.csv (SPEC 8 columns, in order; more may follow) whose rows are those of
- * method `id` (others_ok: rows of other methods are passed over; 0: refused), into r (initialised
- * with the scene's layout): every (surface, segment, bin) once, radiance and stderr finite and >=
- * 0, s the sample point's (within a quarter segment). Fails with "path:line: reason", or "path:
- * missing row ..." naming the first missing one. Also used by `ppbench score`. */
+/* Reads a radiance.csv (the columns of reference: Outputs, in order; more may follow) whose rows
+ * are those of method `id` (others_ok: rows of other methods are passed over; 0: refused), into r
+ * (initialised with the scene's layout): every (surface, segment, bin) once, radiance and stderr
+ * finite and >= 0, s the sample point's (within a quarter segment). Fails with "path:line: reason",
+ * or "path: missing row ..." naming the first missing one. Also used by `ppbench score`. */
 int ppb_external_read_radiance(const char *path, const char *id, int others_ok, const ppb_scene *sc,
                                ppb_result *r, ppb_err *err);
 
