@@ -52,6 +52,14 @@ inline double rte_ray(const ppb_rte_params *P, __global const double *plane, dou
                       double py, double wx, double wy)
 {
     double mx = -wx, my = -wy;
+    /* A direction in a wall's plane must run along it: the cells centred at phi = pi/2 have
+     * wx = cos(pi/2) ~ 6e-17, not 0, and that sign made lfar = 0 at the nodes of S3 alone, so
+     * those cells carried no radiance there and S3 came out ~1 % below S4 (issue 19). A planar
+     * component under 1e-12 moves the ray under 4e-11 mfp before d_cap stops it. */
+    if (fabs(mx) < 1e-12)
+        mx = 0.0;
+    if (fabs(my) < 1e-12)
+        my = 0.0;
     double lfar = INFINITY;
     if (my > 0.0)
         lfar = -py / my;
