@@ -71,7 +71,7 @@ done
 # --- every CSV header, verbatim ---
 for f in $(cd "$tmp/out" && find . -name '*.csv' ! -path '*/points/*' | sort); do
   h=$(head -n 1 "$tmp/out/$f")
-  case $f in */sweep.csv) h=method,${h#*,method,} ;; esac
+  case $f in */sweep.csv | */failures.csv) h=method,${h#*,method,} ;; esac
   grep -qxF -- "$h" "$tmp/lines" || missing "the header line of $(basename "$f"): $h"
 done
 h=$(head -n 1 "$tmp/out/table2.md")

@@ -7,10 +7,12 @@
 #include <time.h>
 
 #include "base/atomic_file.h"
+#include "base/memory.h"
 #include "io/csv.h"
 #include "io/images.h"
 #include "io/plots.h"
 #include "methods/registry.h"
+#include "methods/work_estimate.h"
 #include "base/progress.h"
 
 #ifndef PPB_VERSION
@@ -86,6 +88,16 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
     memset(ex, 0, sizeof *ex);
     ex->cfg = cfg;
     ctx->cfg = cfg;
+    /* Issue 15: the result arrays are estimated and checked before any is allocated, and the
+     * work is said before it starts (methods/work_estimate.h). */
+    double bytes = ppb_work_results_bytes(cfg);
+    char detail[128];
+    snprintf(detail, sizeof detail, "its result arrays: radiance and standard error of %zu cells",
+             ppb_scene_layout(&cfg->scene).ncells);
+    if (ppb_memory_check(bytes, cfg->memory_limit, "the experiment", detail, err))
+        return -1;
+    if (!ctx->quiet)
+        ppb_work_print(stderr, cfg);
     int i = 0;
     for (; i < cfg->nmethods && !ppb_interrupted(); i++)
         if (run_method(ex, ppb_method_find(cfg->methods[i]), ctx, err))

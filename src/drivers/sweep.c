@@ -19,6 +19,7 @@
 #include "physics/march_tables.h"
 #include "model/metrics.h"
 #include "base/progress.h"
+#include "drivers/sweep_failures.h"
 #include "drivers/sweep_plot.h"
 
 /* A hash (base/hash.h) of the resolved settings that shape results (output.dir and the name
@@ -117,6 +118,7 @@ static int run_point(const ppb_config *cfg, const ppb_config *pt, uint64_t h, pp
         ppb_experiment_free(&ex);
         return 0;
     }
+    rc = ppb_sweep_failures_point(cfg->out_dir, h, &ex, rc, err); /* issue 15: recorded */
     if (rc == 0) {
         char path[1300];
         ppb_afile af;
@@ -370,7 +372,7 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
     }
     if (ppb_afile_commit(&csv, err) || ppb_afile_commit(&tim, err))
         return -1;
-    return 0;
+    return ppb_sweep_failures_assemble(dirs, ndirs, out, err) ? -1 : 0;
 }
 
 /* The points with index % parts == part, one device context for all of them. */

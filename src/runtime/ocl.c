@@ -273,6 +273,9 @@ int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err)
 
 void ppb_ocl_close(ppb_ocl *ocl)
 {
+    for (int i = 0; i < ocl->nbuilt; i++)
+        clReleaseProgram(ocl->built[i].prog);
+    ocl->nbuilt = 0;
     if (ocl->queue)
         clReleaseCommandQueue(ocl->queue);
     if (ocl->context)
@@ -331,7 +334,13 @@ static int build_failed(ppb_ocl *ocl, cl_program prog, const char *path, cl_int 
 
 int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog, ppb_err *err)
 {
-    char path[2048], opts[4096];
+    char path[2048], opts[4096], key[256];
+    int keyed = snprintf(key, sizeof key, "%s\n%s", file, extra ? extra : "") < (int)sizeof key;
+    for (int i = 0; keyed && i < ocl->nbuilt; i++)
+        if (strcmp(ocl->built[i].key, key) == 0 && clRetainProgram(ocl->built[i].prog) == 0) {
+            *prog = ocl->built[i].prog;
+            return 0;
+        }
     const char *dir = kernel_dir();
     snprintf(path, sizeof path, "%s/%s", dir, file);
     char *src = read_file(path, err);
@@ -353,6 +362,13 @@ int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program 
         cl_program failed = *prog;
         *prog = NULL;
         return build_failed(ocl, failed, path, rc, err);
+    }
+    int n = ocl->nbuilt;
+    if (keyed && n < (int)(sizeof ocl->built / sizeof ocl->built[0]) &&
+        clRetainProgram(*prog) == CL_SUCCESS) {
+        snprintf(ocl->built[n].key, sizeof ocl->built[n].key, "%s", key);
+        ocl->built[n].prog = *prog;
+        ocl->nbuilt = n + 1;
     }
     return 0;
 }

@@ -23,6 +23,13 @@ typedef struct ppb_ocl {
     size_t max_workgroup;
     cl_ulong global_mem;
     cl_ulong max_alloc;
+    /* Programs built so far, by file and options (ppb_ocl_build): a process that runs many
+     * points (a sweep, the robustness test) builds each kernel once, not once per point. */
+    struct {
+        char key[256];
+        cl_program prog;
+    } built[8];
+    int nbuilt;
 } ppb_ocl;
 
 const char *ppb_cl_errname(cl_int code);
@@ -39,7 +46,9 @@ int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err);
 void ppb_ocl_close(ppb_ocl *ocl);
 
 /* Builds kernels/<file> (directory from $PPBENCH_KERNELS, else the build-time path) with
- * options "-I <kernels> -I <Random123> <extra>". On failure err holds the build log. */
+ * options "-I <kernels> -I <Random123> <extra>". On failure err holds the build log. A program
+ * built before on this ocl with the same file and extra is returned again (retained: the caller
+ * releases it as a fresh one); ppb_ocl_close releases them. */
 int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog,
                   ppb_err *err);
 
