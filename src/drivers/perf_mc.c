@@ -1,10 +1,12 @@
 #include "drivers/perf_mc.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base/csv_read.h"
 #include "methods/method_mc.h"
+#include "model/metrics.h"
 
 /* Photons per timed case: enough for a few seconds on a 2-core CPU (the launches then dominate
  * the fixed costs); $PPBENCH_PERF_MC_PHOTONS overrides it for quick or long runs. */
@@ -24,9 +26,27 @@ static int perf_config(const ppb_run_ctx *ctx, double g, ppb_config *cfg, ppb_er
     return 0;
 }
 
-/* Traces count photons; returns wall seconds and scattering events through the pointers. */
+/* noise_rel of the tallies at the Table 2 cells (the x = 0 cells of S1 and S2, reference:
+ * Metrics), the larger of the two, as [mc] target_noise measures it (method_mc.c); INFINITY
+ * while either has no signal. */
+static double table2_noise(const ppb_mc_tallies *t, const ppb_scene *sc, ppb_err *err)
+{
+    ppb_layout lo = ppb_scene_layout(sc);
+    ppb_result r;
+    if (ppb_result_init(&r, "mc", &lo, err))
+        return NAN;
+    ppb_mc_tallies_to_results(t, sc, &r, NULL);
+    ppb_point pr[2], pt[2];
+    double nr = ppb_noise_points(&r, pr, ppb_cell_points(&lo, PPB_CELL_R_X0, pr, 2));
+    double nt = ppb_noise_points(&r, pt, ppb_cell_points(&lo, PPB_CELL_T_X0, pt, 2));
+    ppb_result_free(&r);
+    return (isnan(nr) || isnan(nt)) ? INFINITY : (nr > nt ? nr : nt);
+}
+
+/* Traces count photons; returns wall seconds, scattering events and the Table 2 noise
+ * (table2_noise) through the pointers. */
 static int perf_trace(ppb_run_ctx *ctx, const ppb_config *cfg, long long count, double *seconds,
-                      double *events, ppb_err *err)
+                      double *events, double *noise, ppb_err *err)
 {
     ppb_run_ctx sub = *ctx;
     sub.cfg = cfg;
@@ -41,6 +61,9 @@ static int perf_trace(ppb_run_ctx *ctx, const ppb_config *cfg, long long count, 
         ppb_mc_tallies_totals(&t, &cfg->scene, 0, &st);
         *seconds = info.seconds;
         *events = st.events_per_photon * (double)info.traced;
+        *noise = table2_noise(&t, &cfg->scene, err);
+        if (isnan(*noise))
+            rc = -1;
     }
     ppb_mc_tallies_free(&t);
     return rc;
@@ -118,22 +141,26 @@ int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
     if (env && atoll(env) > 0)
         photons = atoll(env);
     fprintf(out, "device: %s\n", ocl->name);
-    fprintf(out, "%-28s %12s %14s %16s %10s\n", "case", "photons", "photons/s", "events/s",
-            "events/ph");
+    /* Time to a noise floor: noise_rel falls as 1/sqrt(photons) (independent batches), so
+     * reaching a floor f from the timed run's noise n in its s seconds takes s (n / f)^2. */
+    fprintf(out, "%-28s %12s %14s %16s %10s %10s %10s %10s\n", "case", "photons", "photons/s",
+            "events/s", "events/ph", "noise", "s to 1%", "s to 0.5%");
     const double gs[2] = {0.0, 0.5};
     for (int i = 0; i < 2; i++) {
         ppb_config cfg;
-        double sec, ev;
+        double sec, ev, noise;
         if (perf_config(ctx, gs[i], &cfg, err))
             return -1;
         /* Warm-up: the first launch compiles the kernel for its work-group size. */
-        if (perf_trace(ctx, &cfg, 20000, &sec, &ev, err) ||
-            perf_trace(ctx, &cfg, photons, &sec, &ev, err))
+        if (perf_trace(ctx, &cfg, 20000, &sec, &ev, &noise, err) ||
+            perf_trace(ctx, &cfg, photons, &sec, &ev, &noise, err))
             return -1;
         char name[64];
         snprintf(name, sizeof name, "tube uniform g=%.1f", gs[i]);
-        fprintf(out, "%-28s %12lld %14.4g %16.4g %10.3f  %s\n", name, photons,
-                (double)photons / sec, ev / sec, ev / (double)photons,
+        double t1 = sec * (noise / 0.01) * (noise / 0.01);
+        double t05 = sec * (noise / 0.005) * (noise / 0.005);
+        fprintf(out, "%-28s %12lld %14.4g %16.4g %10.3f %9.3f%% %10.4g %10.4g  %s\n", name, photons,
+                (double)photons / sec, ev / sec, ev / (double)photons, 100 * noise, t1, t05,
                 ev / sec >= 20e6 ? "(>= 20 M events/s target)"
                                  : "(below the 20 M events/s target)");
     }
@@ -147,11 +174,11 @@ int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
     const long long mcx_photons = 1000000;
     for (int i = 0; i < 2; i++) {
         ppb_config cfg;
-        double sec, ev;
+        double sec, ev, noise;
         if (perf_config(ctx, gs[i], &cfg, err))
             return -1;
         cfg.scene.geometry = PPB_GEOM_SLAB;
-        if (perf_trace(ctx, &cfg, photons, &sec, &ev, err))
+        if (perf_trace(ctx, &cfg, photons, &sec, &ev, &noise, err))
             return -1;
         char device[512] = "?", note[128];
         double mcx =
