@@ -203,7 +203,7 @@ if [ -d "$img" ] && [ -s "$dir/angular.csv" ]; then
   n=${#present[@]}
   if [ "$n" -gt 0 ]; then
     {
-      echo "set multiplot layout 1,$n title \"$name: every method's picture (top: S1 and S3 from above; bottom: S2 and S3 from below; yellow arrow: the light, theta_L = $theta_l deg)\\nlinear radiance, one exposure per view shared by all methods: white = the Monte Carlo's 99th percentile in that view; brown: the cut\""
+      echo "set multiplot layout 1,$n title \"$name: every method's picture (top: S1 and S3 from above; bottom: S2 and S3 from below; yellow arrow: the light, theta_L = $theta_l deg)\\nradiance linear to 0.75 of the Monte Carlo's 99th percentile in each view (one exposure per view, shared by all methods), a smooth shoulder above; brown: the cut\""
       echo "unset border; unset tics; unset key; set size ratio -1; set margins 0.5, 0.5, 0.5, 2"
       for m in "${present[@]}"; do
         echo "set title '$m' font ',14'"

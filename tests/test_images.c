@@ -356,7 +356,8 @@ static void test_segment_field_through_exr(void **state)
     fake_free(f);
 }
 
-/* One exposure for every method: half the reference's radiance is sRGB(0.5) grey, not white.
+/* One exposure for every method: half the reference's radiance is sRGB(0.5) grey, and the
+ * reference's own level is not clipped to white (the shoulder).
  * Every file is there and no temporary is left; all.png and error_<m>.png are plots.sh's (the
  * labelled figures), not written here. */
 static void test_shared_exposure_and_files(void **state)
@@ -371,8 +372,11 @@ static void test_shared_exposure_and_files(void **state)
     float *exr = read_exr(f, "mc.exr", &w, &h);
     for (long k = 0; k < (long)w * h; k++)
         if (exr[3 * k] > 0 && !is_arrow(mc + 3 * k)) {
-            assert_int_equal(mc[3 * k], 255);
-            assert_int_equal(pp[3 * k], 188); /* 255 * (1.055 * 0.5^(1/2.4) - 0.055) */
+            /* the reference at its white level, x = 1: the shoulder gives
+             * 0.75 + 0.25 (1 - e^-1) = 0.908, sRGB 244, not a clipped 255 */
+            assert_int_equal(mc[3 * k], 244);
+            assert_int_equal(pp[3 * k],
+                             188); /* below the knee: 255 * (1.055 * 0.5^(1/2.4) - 0.055) */
         }
     char path[1300];
     const char *want[] = {"mc.exr", "mc.png", "pp.exr", "pp.png", "errmap_pp.png"};

@@ -7,13 +7,19 @@
  *   <method>.exr        linear 32-bit float RGB, R = G = B = the radiance toward the camera
  *                       (1/sr per unit E_perp); 0 on the background and on the cut caps. No
  *                       arrow, no labels: the data.
- *   <method>.png        tone-mapped: L / L_white clamped to [0, 1], sRGB-encoded, with one
- *                       L_white PER VIEW shared by all methods: the 99th percentile of the
- *                       reference's (Monte Carlo's, else the first method's) surface pixels
- *                       in that view. One exposure for both views saturated about 36% of the
- *                       top view (S1 is several times brighter than S2) and hid the step's
- *                       pattern on S1 (paper Fig. 7); per view, 1% of each view is white and
- *                       methods stay comparable within a view. The top view carries the
+ *   <method>.png        tone-mapped: x = L / L_white through a shoulder curve, then
+ *                       sRGB-encoded. L_white is set PER VIEW and shared by all methods: the
+ *                       99th percentile of the reference's (Monte Carlo's, else the first
+ *                       method's) surface pixels in that view. The curve is the identity up
+ *                       to x = KNEE (0.75) and above it rolls off smoothly (same slope at the
+ *                       knee) toward 1, k + (1 - k)(1 - exp(-(x - k) / (1 - k))), so only
+ *                       pixels above about 1.8 L_white are pure white. A plain clamp with one
+ *                       exposure for the whole picture left much of S1 pure white (issue 16:
+ *                       about 36% of S1 pixels) and hid the density step's pattern on S1
+ *                       (paper Fig. 7); a method brighter than the reference (pp, mp) clipped
+ *                       most of its top view even with one exposure per view (63% of pp's on
+ *                       uniform_g0_normal). Below the knee, grey levels compare linearly
+ *                       between methods; the top view carries the
  *                       light arrow: the beam's direction w_L drawn in light yellow ending on
  *                       S1 at x = -W/4, z = 0. Background slate blue, cut caps brown.
  *   errmap_<method>.png for every method but the reference, when there is one: false colour of
@@ -42,7 +48,8 @@
 #define PANEL_NY     (2 * VIEW_NY)
 #define PANEL_PIXELS ((size_t)VIEW_NX * PANEL_NY)
 #define ERR_CLAMP    0.5  /* relative error at the ends of the colour map */
-#define WHITE_PCTL   0.99 /* percentile of the reference's surface pixels shown as white */
+#define WHITE_PCTL   0.99 /* percentile of the reference's surface pixels at x = 1 */
+#define KNEE         0.75 /* the tone curve is the identity below, a shoulder above */
 
 typedef unsigned char rgb8[3];
 
@@ -141,6 +148,14 @@ static void put(unsigned char *px, const rgb8 colour)
     memcpy(px, colour, 3);
 }
 
+/* The shoulder (see the header): identity to KNEE, then exp roll-off toward 1, C1 at KNEE. */
+static double shoulder(double x)
+{
+    if (!(x > KNEE))
+        return x;
+    return KNEE + (1 - KNEE) * (1 - exp(-(x - KNEE) / (1 - KNEE)));
+}
+
 /* The tone-mapped picture of result i into an RGB buffer of row stride `stride` pixels. */
 static void tone_map(const img_ctx *c, int i, unsigned char *rgb, size_t stride)
 {
@@ -149,7 +164,7 @@ static void tone_map(const img_ctx *c, int i, unsigned char *rgb, size_t stride)
             size_t k = j * VIEW_NX + x;
             unsigned char *px = rgb + 3 * (j * stride + x);
             if (c->kind[k] == PPB_PIX_SURFACE)
-                memset(px, srgb_byte(c->value[i][k] / c->white[j >= VIEW_NY]), 3);
+                memset(px, srgb_byte(shoulder(c->value[i][k] / c->white[j >= VIEW_NY])), 3);
             else
                 put(px, c->kind[k] == PPB_PIX_CAP ? cap_colour : background);
         }
