@@ -13,6 +13,7 @@
 #include "methods/mc_tally.h"
 #include "methods/method_mc.h"
 #include "model/config.h"
+#include "physics/ppsolver.h"
 
 /* ---- the reflectance ---- */
 
@@ -173,6 +174,130 @@ static void test_mc_vs_adding_doubling(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
+/* ---- the plane-parallel solver with Fresnel boundaries ---- */
+
+#define PP_FRESNEL_DIRS 1000 /* cells per hemisphere of the adding-doubling comparison */
+
+/* Every case of fresnel_ref.csv: the solver's UR1 = specular + R + unscattered out of S1 and
+ * UT1 = T + unscattered out of S2 within 2e-4 absolute of adding-doubling (issue 18's bound;
+ * iadpython's own quad_pts 16 -> 24 change, the csv's last columns, is ~1e-4), and energy:
+ * R + T + ballistic + absorbed + specular = 1 to rounding (the discrete system conserves). The
+ * unscattered light's split between the faces is checked against the geometric series of
+ * test_mc_vs_adding_doubling. */
+static void test_ppslab_vs_adding_doubling(void **state)
+{
+    (void)state;
+    ref_case c[64];
+    int nc = read_refs(c, 64);
+    assert_int_equal(nc, 36);
+    double worst = 0;
+    for (int i = 0; i < nc; i++) {
+        pp_params p = {c[i].tau0, c[i].albedo, c[i].g, 1.0, PP_FRESNEL_DIRS};
+        pp_solution *s;
+        ppb_err err;
+        if (pp_solve_fresnel(&p, c[i].n, NULL, &s, NULL, &err) != 0)
+            fail_msg("%s", err.msg);
+        double R, T, B, spec, btop;
+        pp_totals(s, &R, &T, &B);
+        pp_boundary_totals(s, &spec, &btop);
+        double f0 = ppb_fresnel(1.0, c[i].n), e = exp(-c[i].tau0);
+        assert_close(spec, f0, 1e-15);
+        assert_close(B, (1 - f0) * (1 - f0) * e * (1 + f0 * e) / (1 - f0 * f0 * e * e), 1e-12);
+        assert_close(btop, B * f0 * e / (1 + f0 * e), 1e-12);
+        double ur1 = spec + R + btop, ut1 = T + (B - btop);
+        printf("# pp tau0 %g albedo %g g %+.1f n %.2f: UR1 %.6f (AD %.6f, %+.1e)  UT1 %.6f "
+               "(AD %.6f, %+.1e)\n",
+               c[i].tau0, c[i].albedo, c[i].g, c[i].n, ur1, c[i].ur1, ur1 - c[i].ur1, ut1, c[i].ut1,
+               ut1 - c[i].ut1);
+        worst = fmax(worst, fmax(fabs(ur1 - c[i].ur1), fabs(ut1 - c[i].ut1)));
+        assert_close(ur1, c[i].ur1, 2e-4);
+        assert_close(ut1, c[i].ut1, 2e-4);
+        assert_close(R + T + B + pp_absorbed(s) + spec, 1.0, 1e-10);
+        pp_free(s);
+    }
+    printf("# pp vs adding-doubling: worst |difference| %.2e over %d cases\n", worst, nc);
+}
+
+/* Reads method's bins of S1 and S2 from radiance.csv into v and se ([2 x 64]); returns the count.
+ */
+static int read_bins(const char *path, const char *method, double *v, double *se)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        fail_msg("%s: cannot open", path);
+    char line[512], m[64], surf[8];
+    int n = 0, seg, it, ip;
+    double s0, val, err;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "%63[^,],%7[^,],%d,%lf,%d,%d,%lf,%lf", m, surf, &seg, &s0, &it, &ip, &val,
+                   &err) == 8 &&
+            !strcmp(m, method) && (!strcmp(surf, "S1") || !strcmp(surf, "S2"))) {
+            int k = (surf[1] == '2') * 64 + it * 8 + ip;
+            if (k < 128)
+                v[k] = val, se[k] = err, n++;
+        }
+    fclose(f);
+    return n;
+}
+
+/* ppslab bin by bin against the Monte Carlo in slab mode at n = 1.4, oblique light (30 deg, so
+ * the beam refracts), g = 0.5, tau0 = 2: all 128 bins of S1 and S2 (8 x 8 each, air-side
+ * directions) in one chi-square with the Monte Carlo's own standard errors, and the totals
+ * (ppslab's R and T within 3 standard errors, the same specular). Measured (2e6 photons): chi2
+ * 168 / 128 at 8 x 8 samples per bin and 400 cells, 151 / 128 for the same run at n = 1 (the
+ * solver's and the bin quadrature's own error); the grazing bins of S2 carry most of it. */
+static void test_ppslab_vs_mc_bins(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("fresnel_bins");
+    char ini[1400], out[1200], csv[1300];
+    snprintf(out, sizeof out, "%s/out", dir);
+    snprintf(ini, sizeof ini, "%s/a.ini", dir);
+    char text[2000];
+    snprintf(text, sizeof text,
+             "[experiment]\nname = fresnel_bins\ngeometry = slab\nmethods = mc, ppslab\n"
+             "[tube]\nheight = 2\n[medium]\nalbedo = 0.95\ng = 0.5\nn = 1.4\n"
+             "[light]\ntheta_deg = 30\n[mc]\nphotons = 2e6\n[bins]\nsamples_dir = 8\n"
+             "[pp]\ndirections = 400\n[output]\ndir = %s\n",
+             out);
+    tu_write_file(ini, text);
+    assert_int_equal(tu_sh("%s run %s > %s/log 2>&1", tu_bin(), ini, dir), 0);
+    snprintf(csv, sizeof csv, "%s/radiance.csv", out);
+    double mc[128], mse[128], pp[128], pse[128];
+    assert_int_equal(read_bins(csv, "mc", mc, mse), 128);
+    assert_int_equal(read_bins(csv, "ppslab", pp, pse), 128);
+    double chi2 = 0, worst = 0;
+    for (int k = 0; k < 128; k++) {
+        assert_true(mse[k] > 0);
+        double z = (pp[k] - mc[k]) / mse[k];
+        chi2 += z * z, worst = fmax(worst, fabs(z));
+    }
+    double p = tu_chi2_pvalue(chi2, 128);
+    printf("# ppslab vs mc, 128 bins at n = 1.4: chi2 %.1f (p %.3g), worst |z| %.2f\n", chi2, p,
+           worst);
+    assert_true(p > 1e-3);
+    snprintf(csv, sizeof csv, "%s/totals.csv", out);
+    FILE *f = fopen(csv, "r");
+    assert_non_null(f);
+    char line[512], m[64];
+    double t[2][6];
+    int got = 0;
+    while (fgets(line, sizeof line, f)) {
+        double R, T, sd, ab, ba, sp;
+        if (sscanf(line, "%63[^,],%lf,%lf,%lf,%lf,%lf,%lf", m, &R, &T, &sd, &ab, &ba, &sp) == 7) {
+            int i = !strcmp(m, "mc") ? 0 : (!strcmp(m, "ppslab") ? 1 : -1);
+            if (i >= 0)
+                t[i][0] = R, t[i][1] = T, t[i][5] = sp, got++;
+        }
+    }
+    fclose(f);
+    assert_int_equal(got, 2);
+    assert_close(t[1][5], t[0][5], 1e-12);
+    /* 2e6 photons: the totals' standard errors are ~3e-4 (test_mc_vs_adding_doubling's) */
+    assert_close(t[1][0], t[0][0], 1e-3);
+    assert_close(t[1][1], t[0][1], 1e-3);
+}
+
 /* At n > 1 a photon's path still depends only on the seed and its index: the same tallies
  * whatever the work-group size, the chunking or the split into shards (the reflect-or-leave
  * choice comes from the photon's own Philox stream). The tube, oblique light and a density
@@ -226,14 +351,14 @@ static void test_bit_identical_n(void **state)
 }
 
 /* Methods without refractive boundaries yet are refused at n > 1 (exit 2 from the config),
- * not run as if n were 1; mc alone is accepted. */
+ * not run as if n were 1; mc and ppslab are accepted. */
 static void test_config_refuses_other_methods(void **state)
 {
     (void)state;
     const char *dir = tu_scratch("fresnel_cfg");
     char path[1200];
     snprintf(path, sizeof path, "%s/a.ini", dir);
-    const char *texts[2] = {"[experiment]\nmethods = mc\n[medium]\nn = 1.4\n",
+    const char *texts[2] = {"[experiment]\nmethods = mc, ppslab\n[medium]\nn = 1.4\n",
                             "[experiment]\nmethods = mc, pp\n[medium]\nn = 1.4\n"};
     for (int i = 0; i < 2; i++) {
         FILE *f = fopen(path, "w");
@@ -255,6 +380,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fresnel_closed_forms),
+        cmocka_unit_test(test_ppslab_vs_adding_doubling),
+        cmocka_unit_test(test_ppslab_vs_mc_bins),
         cmocka_unit_test(test_config_refuses_other_methods),
         cmocka_unit_test(test_bit_identical_n),
         cmocka_unit_test(test_mc_vs_adding_doubling),

@@ -19,7 +19,8 @@ static double bin_average(const pp_solution *s, const ppb_scene *sc, int surf, i
             double w[3];
             ppb_bin_direction(surf, itheta, iphi, (a + 0.5) / samples, (b + 0.5) / samples,
                               sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
-            sum += pp_radiance(s, tau, w);
+            /* n > 1: air-side bins, the n^2 law (ppsolver.h); n = 1 as it always was */
+            sum += sc->n > 1.0 ? pp_exit_radiance(s, w) : pp_radiance(s, tau, w);
         }
     return sum / ((double)samples * samples);
 }
@@ -33,7 +34,7 @@ int ppb_method_ppslab(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     double tau0 = sc->height * sc->sigma_t;
     pp_params p = {tau0, sc->albedo, sc->g, ppb_scene_cos_theta_l(sc), cfg->pp.directions};
     pp_solution *s = NULL;
-    if (pp_solve(&p, &s, err) != 0)
+    if (pp_solve_fresnel(&p, sc->n, NULL, &s, NULL, err) != 0)
         return -1;
     int samples = cfg->samples_dir > 0 ? cfg->samples_dir : 1;
     ppb_progress pr; /* the bins take longer than the solve at large directions */
@@ -53,6 +54,8 @@ int ppb_method_ppslab(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     ppb_progress_end(&pr, out->layout.nbins);
     ppb_totals *t = &out->totals;
     pp_totals(s, &t->R, &t->T, &t->ballistic);
+    double ballistic_top;
+    pp_boundary_totals(s, &t->specular, &ballistic_top);
     t->sides = 0.0;
     t->absorbed = pp_absorbed(s);
     t->absorbed_tracked = 1;

@@ -835,11 +835,11 @@ static int validate(const ppb_config *cfg, ppb_err *err)
      * is refused at n > 1 rather than run as if n were 1. */
     if (sc->n > 1.0)
         for (int i = 0; i < cfg->nmethods; i++)
-            if (strcmp(cfg->methods[i], "mc") != 0)
+            if (strcmp(cfg->methods[i], "mc") != 0 && strcmp(cfg->methods[i], "ppslab") != 0)
                 return ppb_config_key_fail(
                     cfg, "medium", "n", err,
-                    "n > 1 is implemented by mc only so far (issue 18); method %s (methods from "
-                    "%s) would ignore it",
+                    "n > 1 is implemented by mc and ppslab only so far (issue 18); method %s "
+                    "(methods from %s) would ignore it",
                     cfg->methods[i], origin_of(cfg, "experiment", "methods", where, sizeof where));
     return 0;
 }

@@ -18,8 +18,37 @@
  * as fit below a one-cell cap at about the side of a square cell (sqrt(2 pi / N)), also under
  * the wedges (with one collar fewer the M = 668 radiance against PythonicDISORT was 8% worse:
  * 0.152% against 0.131% RMS); their counts are rounded cumulatively, in steps of two, so that
- * they sum to N exactly. */
-static int ring_counts(int n, int pole, int *count)
+ * they sum to N exactly. theta_snap > 0 (pp_dirs_make_snap) puts the collar edge nearest it at
+ * theta_snap (the collars above and below it of equal width each), up to that rounding, and cuts
+ * the two collars beside it into SNAP_SPLIT each (ppsolver.h: there the radiance varies like the
+ * Fresnel reflectance within a cell, and the error of a cell average scales with its width). */
+#define SNAP_SPLIT 4
+
+/* Lower edge of coarse collar r: equal widths, or equal on either side of theta_snap. */
+static double coarse_theta(int r, int collars, int r_snap, double theta_cap, double theta_snap)
+{
+    if (r_snap <= 0)
+        return theta_cap + (0.5 * PPB_PI - theta_cap) * r / collars;
+    return r <= r_snap
+               ? theta_cap + (theta_snap - theta_cap) * r / r_snap
+               : theta_snap + (0.5 * PPB_PI - theta_snap) * (r - r_snap) / (collars - r_snap);
+}
+
+/* Lower edge of collar f after the two collars beside theta_snap are cut into `split`. */
+static double fine_theta(int f, int collars, int r_snap, int split, double theta_cap,
+                         double theta_snap)
+{
+    if (f <= r_snap - 1 || split == 1)
+        return coarse_theta(f, collars, r_snap, theta_cap, theta_snap);
+    if (f > r_snap - 1 + 2 * split)
+        return coarse_theta(f - 2 * (split - 1), collars, r_snap, theta_cap, theta_snap);
+    int piece = f - (r_snap - 1), c = r_snap - 1 + (piece - 1) / split + 1;
+    double a = coarse_theta(c - 1, collars, r_snap, theta_cap, theta_snap);
+    double b = coarse_theta(c, collars, r_snap, theta_cap, theta_snap);
+    return a + (b - a) * ((piece - 1) % split + 1) / split;
+}
+
+static int ring_counts(int n, int pole, double theta_snap, int *count)
 {
     count[0] = pole;
     if (n == pole)
@@ -31,9 +60,16 @@ static int ring_counts(int n, int pole, int *count)
         collars = 1;
     if (collars > 1 + (n - pole - first_min) / 2)
         collars = 1 + (n - pole - first_min) / 2;
-    int done = pole;
+    int done = pole, r_snap = 0, split = 1, coarse = collars;
+    if (theta_snap > theta_cap && theta_snap < 0.5 * PPB_PI && collars >= 2) {
+        r_snap = (int)lround((theta_snap - theta_cap) / (0.5 * PPB_PI - theta_cap) * collars);
+        r_snap = r_snap < 1 ? 1 : (r_snap > collars - 1 ? collars - 1 : r_snap);
+        if (collars + 2 * (SNAP_SPLIT - 1) <= 1 + (n - pole - first_min) / 2)
+            split = SNAP_SPLIT, collars += 2 * (SNAP_SPLIT - 1);
+    }
     for (int r = 1; r <= collars; r++) {
-        double theta = theta_cap + (0.5 * PPB_PI - theta_cap) * r / collars;
+        double theta = r_snap > 0 ? fine_theta(r, coarse, r_snap, split, theta_cap, theta_snap)
+                                  : theta_cap + (0.5 * PPB_PI - theta_cap) * r / collars;
         int cum = r == collars ? n : base + 2 * (int)lround(0.5 * (n * (1.0 - cos(theta)) - base));
         int left = collars - r; /* later collars need at least two cells each */
         if (cum > n - 2 * left)
@@ -116,7 +152,7 @@ static void cell_geometry(pp_dirs *d, int i)
                      : fmax(0.5 * (t1 - t0), 0.5 * sin_max * (d->phi_hi[i] - d->phi_lo[i]));
 }
 
-static int make(int n, int antipodal, pp_dirs *d, ppb_err *err)
+static int make(int n, int antipodal, double theta_snap, pp_dirs *d, ppb_err *err)
 {
     memset(d, 0, sizeof *d);
     if (n < 1 || n > PP_DIRS_MAX)
@@ -124,7 +160,7 @@ static int make(int n, int antipodal, pp_dirs *d, ppb_err *err)
     int *count = calloc((size_t)n + 1, sizeof(int));
     if (!count)
         return ppb_fail(err, "pp directions: out of memory");
-    int nrings = ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, count);
+    int nrings = ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, theta_snap, count);
     d->n = n;
     d->nrings = nrings;
     d->solid = 2.0 * PPB_PI / n;
@@ -154,12 +190,17 @@ static int make(int n, int antipodal, pp_dirs *d, ppb_err *err)
 
 int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
 {
-    return make(n, 0, d, err);
+    return make(n, 0, 0.0, d, err);
+}
+
+int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err *err)
+{
+    return make(n, antipodal, acos(mu_snap), d, err);
 }
 
 int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err)
 {
-    return make(n, 1, d, err);
+    return make(n, 1, 0.0, d, err);
 }
 
 void pp_dirs_free(pp_dirs *d)

@@ -55,6 +55,11 @@ int pp_dirs_make(int n, pp_dirs *d, ppb_err *err);
 
 /* The same, closed under w -> -w for every n (a different partition only for even n). */
 int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err);
+
+/* pp_dirs_make (antipodal 0) or pp_dirs_make_antipodal (1) with a collar edge moved to mu_snap in
+ * (0, 1) up to the rounding of the cell counts (|mu error| <= 1/n): the solver's Fresnel
+ * boundaries put it at the critical cosine, where the radiance is discontinuous (ppsolver.h). */
+int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err *err);
 void pp_dirs_free(pp_dirs *d);
 
 /* Cell in [0, 2N) holding direction w (unit vector); w.y = 0 counts as up. */

@@ -10,11 +10,14 @@
 
 #include "base/clock.h"
 #include "base/progress.h"
+#include "base/quadrature.h"
+#include "kernels/ppb_fresnel.h"
 #include "physics/directions.h"
 #include "physics/phase.h"
 
 #define RESONANCE_GAP    1e-7  /* |lambda mu0 - 1| below this moves mu0 */
 #define CONSERVATIVE_EPS 1e-13 /* 1 - alpha below this is alpha = 1 */
+#define FRESNEL_GAUSS    16    /* Gauss order of a cell's mean reflectance */
 
 struct pp_solution {
     pp_params p; /* mu0 as used */
@@ -29,6 +32,15 @@ struct pp_solution {
     double c_lin;             /* alpha = 1: coefficient of tau 1 */
     double wL[3];             /* beam direction of travel */
     double R, T, ballistic, absorbed;
+    /* n > 1 only (fresnel = 0 at n = 1, and none of this is used) */
+    int fresnel;
+    double nrel;   /* n inside / outside */
+    double mu_air; /* cos theta_L in air */
+    double *Rc;    /* [n]: cell-averaged reflectance of up cell i (and its mirror) */
+    double *Zu;    /* [m]: the upward beam's particular solution, times U */
+    double D, U;   /* the beam's downward and upward series sums (ppsolver.h) */
+    double Fb;     /* F of the unscattered beam at either face, from inside */
+    double specular, ballistic_top;
 };
 
 /* Work space of one solve (N x N unless stated). */
@@ -88,6 +100,7 @@ void pp_free(pp_solution *s)
         return;
     pp_dirs_free(&s->dirs);
     free(s->Sa), free(s->Sb), free(s->lambda), free(s->tau_ref), free(s->V), free(s->Z);
+    free(s->Rc), free(s->Zu);
     free(s);
 }
 
@@ -98,6 +111,11 @@ static int solution_alloc(pp_solution *s, ppb_err *err)
     s->lambda = dalloc(m), s->tau_ref = dalloc(m), s->V = dalloc(m * m);
     if (!s->Sa || !s->Sb || !s->Z || !s->lambda || !s->tau_ref || !s->V)
         return ppb_fail(err, "pp solver: out of memory for %d directions", s->n);
+    if (s->fresnel) {
+        s->Rc = dalloc(n), s->Zu = dalloc(m);
+        if (!s->Rc || !s->Zu)
+            return ppb_fail(err, "pp solver: out of memory for %d directions", s->n);
+    }
     return 0;
 }
 
@@ -157,6 +175,66 @@ static int eigen_modes(const pp_solution *s, pp_work *w, ppb_err *err)
         }
     }
     return 0;
+}
+
+/* ---- refractive boundaries, n > 1 (ppsolver.h) ---- */
+
+/* Air-side cosine of the inside cosine mu (>= the critical cosine), clamped at grazing. */
+static double air_cos(double mu, double nrel)
+{
+    return sqrt(fmax(0.0, 1.0 - nrel * nrel * (1.0 - mu * mu)));
+}
+
+/* R_i = int F mu dmu / int mu dmu over the cell's mu range: F = 1 below the critical cosine
+ * mu_c = sqrt(1 - 1/n^2); above it the substitution t = air-side cosine (mu dmu = t dt / n^2)
+ * makes the integrand smooth (F(mu) = ppb_fresnel(t, n) by reciprocity), so Gauss-Legendre of
+ * order FRESNEL_GAUSS is exact to rounding for practical purposes. */
+static void cell_reflectance(pp_solution *s)
+{
+    double nr = s->nrel, mu_c = sqrt(1.0 - 1.0 / (nr * nr)), x[FRESNEL_GAUSS], wq[FRESNEL_GAUSS];
+    ppb_gauss_legendre(FRESNEL_GAUSS, x, wq);
+    for (int i = 0; i < s->n; i++) {
+        double lo, hi, plo, phi;
+        pp_dirs_bounds(&s->dirs, i, &lo, &hi, &plo, &phi);
+        double num = 0.0, den = 0.5 * (hi * hi - lo * lo);
+        if (lo < mu_c) {
+            double top = fmin(hi, mu_c);
+            num += 0.5 * (top * top - lo * lo);
+        }
+        double a = fmax(lo, mu_c);
+        if (hi > a) {
+            double ta = air_cos(a, nr), tb = air_cos(hi, nr), half = 0.5 * (tb - ta);
+            for (int j = 0; j < FRESNEL_GAUSS; j++) {
+                double t = ta + half * (1.0 + x[j]);
+                num += half * wq[j] * ppb_fresnel(t, nr) * t / (nr * nr);
+            }
+        }
+        s->Rc[i] = fmin(1.0, num / den);
+    }
+}
+
+/* The refracted beam and the sums of its internal reflections (after avoid_resonance has
+ * fixed mu0 inside): E_in, D, U and F_b; the specular total. */
+static void beam_series(pp_solution *s)
+{
+    double mu0 = s->p.mu0, e = exp(-s->p.tau0 / mu0);
+    s->specular = ppb_fresnel(s->mu_air, s->nrel);
+    s->Fb = ppb_fresnel(mu0, 1.0 / s->nrel);
+    double e_in = (1.0 - s->specular) * s->mu_air / mu0;
+    s->D = e_in / (1.0 - s->Fb * s->Fb * e * e);
+    s->U = s->D * s->Fb * e;
+}
+
+/* Z (unit beam) -> D Z, and the upward beam's particular solution U x (Z mirrored). */
+static void particular_series(pp_solution *s)
+{
+    int n = s->n;
+    for (int i = 0; i < n; i++) {
+        s->Zu[i] = s->U * s->Z[n + i];
+        s->Zu[n + i] = s->U * s->Z[i];
+    }
+    for (int i = 0; i < s->m; i++)
+        s->Z[i] *= s->D;
 }
 
 /* ---- the beam (paper Sec. 2.2 leaves it out; reference: Methods) ---- */
@@ -232,11 +310,20 @@ static void bc_matrices(const pp_solution *s, const pp_work *w, double *Ms, doub
         for (int i = 0; i < n; i++) {
             size_t ik = (size_t)k * n + i;
             double xp = 0.5 * (w->U[ik] + w->Vd[ik]), xm = 0.5 * (w->U[ik] - w->Vd[ik]);
+            if (s->fresnel) { /* the outgoing cell minus R times its mirror */
+                double R = s->Rc[i], xp0 = xp;
+                xp = xp0 - R * xm, xm = xm - R * xp0;
+            }
             Ms[ik] = xp + xm * e;
             Md[ik] = xp - xm * e;
             if (k == 0 && s->conservative) {
                 Ms[ik] = 2.0;
                 Md[ik] = s->p.tau0 + 2.0 * w->h[i];
+                if (s->fresnel) {
+                    double R = s->Rc[i];
+                    Ms[ik] = 2.0 * (1.0 - R);
+                    Md[ik] = s->p.tau0 * (1.0 - R) + 2.0 * w->h[i] * (1.0 + R);
+                }
             }
         }
     }
@@ -292,6 +379,12 @@ static int boundary(pp_solution *s, pp_work *w, ppb_err *err)
         double beam = exp(-s->p.tau0 / s->p.mu0);
         for (int i = 0; i < n; i++) {
             double r1 = -s->Z[n + i], r2 = -s->Z[i] * beam;
+            if (s->fresnel) { /* down - R up at tau = 0, up - R down at tau0 */
+                double R = s->Rc[i];
+                double up0 = s->Z[i] + s->Zu[i] * beam, dn0 = s->Z[n + i] + s->Zu[n + i] * beam;
+                double up1 = s->Z[i] * beam + s->Zu[i], dn1 = s->Z[n + i] * beam + s->Zu[n + i];
+                r1 = -(dn0 - R * up0), r2 = -(up1 - R * dn1);
+            }
             sig[i] = r1 + r2;
             del[i] = r2 - r1;
         }
@@ -300,7 +393,7 @@ static int boundary(pp_solution *s, pp_work *w, ppb_err *err)
     }
     if (rc == 0 && s->conservative) /* the diffusion mode's tau0 1 also enters the sum */
         for (int i = 0; i < n; i++)
-            sig[i] -= del[0] * s->p.tau0;
+            sig[i] -= del[0] * s->p.tau0 * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
     if (rc == 0 && LAPACKE_dgesv(LAPACK_COL_MAJOR, n, 1, Ms, n, piv, sig, n) != 0)
         rc = ppb_fail(err, "pp solver: singular boundary system (sum part)");
     if (rc == 0)
@@ -356,18 +449,39 @@ void pp_cell_field(const pp_solution *s, double tau, double *field)
     mode_values(s, tau, e);
     for (int i = 0; i < m; i++)
         field[i] = s->Z[i] * beam + s->c_lin * tau;
+    if (s->fresnel) {
+        double up = exp(-(s->p.tau0 - tau) / s->p.mu0);
+        for (int i = 0; i < m; i++)
+            field[i] += s->Zu[i] * up;
+    }
     cblas_dgemv(CblasColMajor, CblasNoTrans, m, s->nmodes, 1.0, s->V, m, e, 1, 1.0, field, 1);
     free(e);
 }
 
-void pp_source_coeffs(const pp_solution *s, const double w[3], double *a, double *b)
+/* pp_source_coeffs plus, at n > 1, bu: the coefficient of exp(-(tau0 - tau)/mu0) (the
+ * upward beam's diffuse part; 0 at n = 1). */
+static void source_coeffs(const pp_solution *s, const double w[3], double *a, double *b, double *bu)
 {
     int m = s->m;
     double *F = dalloc(m);
     pp_phase_row((pp_dirs *)&s->dirs, s->p.g, w, F, NULL);
     cblas_dgemv(CblasColMajor, CblasTrans, m, s->nmodes, s->p.albedo, s->V, m, F, 1, 0.0, a, 1);
     *b = s->p.albedo * cblas_ddot(m, F, 1, s->Z, 1);
+    *bu = s->fresnel ? s->p.albedo * cblas_ddot(m, F, 1, s->Zu, 1) : 0.0;
     free(F);
+}
+
+void pp_source_coeffs(const pp_solution *s, const double w[3], double *a, double *b)
+{
+    double bu;
+    source_coeffs(s, w, a, b, &bu);
+}
+
+/* The upward beam's single-scattering coefficient alpha U p(w . w_L mirrored) (n > 1). */
+static double direct_up(const pp_solution *s, const double w[3])
+{
+    double c = w[0] * s->wL[0] - w[1] * s->wL[1] + w[2] * s->wL[2];
+    return s->p.albedo * s->U * pp_hg(s->p.g, c);
 }
 
 double pp_source_linear(const pp_solution *s)
@@ -378,37 +492,75 @@ double pp_source_linear(const pp_solution *s)
 double pp_source_direct(const pp_solution *s, double tau, const double w[3])
 {
     double c = w[0] * s->wL[0] + w[1] * s->wL[1] + w[2] * s->wL[2];
+    if (s->fresnel)
+        return s->p.albedo * s->D * pp_hg(s->p.g, c) * exp(-tau / s->p.mu0) +
+               direct_up(s, w) * exp(-(s->p.tau0 - tau) / s->p.mu0);
     return s->p.albedo * pp_hg(s->p.g, c) * exp(-tau / s->p.mu0);
 }
 
 double pp_source(const pp_solution *s, double tau, const double w[3])
 {
-    double *a = dalloc(s->nmodes), *e = dalloc(s->nmodes), b;
-    pp_source_coeffs(s, w, a, &b);
+    double *a = dalloc(s->nmodes), *e = dalloc(s->nmodes), b, bu;
+    source_coeffs(s, w, a, &b, &bu);
     mode_values(s, tau, e);
     double J = b * exp(-tau / s->p.mu0) + pp_source_linear(s) * tau + pp_source_direct(s, tau, w);
+    if (s->fresnel)
+        J += bu * exp(-(s->p.tau0 - tau) / s->p.mu0);
     for (int k = 0; k < s->nmodes; k++)
         J += a[k] * e[k];
     free(a), free(e);
     return J;
 }
 
-double pp_radiance(const pp_solution *s, double tau, const double w[3])
+/* J integrated along w back to the face it comes from, without what that face reflects. */
+static double ray_radiance(const pp_solution *s, double tau, const double w[3])
 {
     double mu = w[1];
     if ((mu > 0 && tau >= s->p.tau0) || (mu < 0 && tau <= 0))
         return 0.0; /* the ray starts on the face it would come from */
-    double *a = dalloc(s->nmodes), b;
-    pp_source_coeffs(s, w, a, &b);
+    double *a = dalloc(s->nmodes), b, bu;
+    source_coeffs(s, w, a, &b, &bu);
     double c = w[0] * s->wL[0] + w[1] * s->wL[1] + w[2] * s->wL[2];
-    double beam = b + s->p.albedo * pp_hg(s->p.g, c);
+    double beam = b + s->p.albedo * (s->fresnel ? s->D : 1.0) * pp_hg(s->p.g, c);
     double L = beam * ray_term(s, tau, mu, -1.0 / s->p.mu0, 0.0);
+    if (s->fresnel)
+        L += (bu + direct_up(s, w)) * ray_term(s, tau, mu, 1.0 / s->p.mu0, s->p.tau0);
     for (int k = 0; k < s->nmodes; k++)
         L += a[k] * ray_term(s, tau, mu, s->lambda[k], s->tau_ref[k]);
     if (s->conservative)
         L += pp_source_linear(s) * ray_linear(s, tau, mu);
     free(a);
     return L;
+}
+
+/* n > 1: the ray from a face also carries what the face reflects from the mirror direction
+ * w_m (w.y -> -w.y). With A, B the face-to-face integrals along the up one of (w, w_m) to
+ * tau = 0 and along the down one to tau0, e = exp(-tau0/|mu|) and F = F(|mu|) from inside:
+ * L0 = A + e F L1, L1 = B + e F L0 (L0 up at tau = 0, L1 down at tau0), solved in closed
+ * form; then L(tau, w) = ray(tau, w) + exp(-path/|mu|) F L(face, w_m). */
+double pp_radiance(const pp_solution *s, double tau, const double w[3])
+{
+    double mu = w[1];
+    if (!s->fresnel || mu == 0.0)
+        return ray_radiance(s, tau, w);
+    double wm[3] = {w[0], -w[1], w[2]}, amu = fabs(mu);
+    const double *wu = mu > 0 ? w : wm, *wd = mu > 0 ? wm : w;
+    double F = ppb_fresnel(amu, 1.0 / s->nrel), e = exp(-s->p.tau0 / amu);
+    double A = ray_radiance(s, 0.0, wu), B = ray_radiance(s, s->p.tau0, wd);
+    double L0 = (A + e * F * B) / (1.0 - e * e * F * F), L1 = B + e * F * L0;
+    double path = mu > 0 ? s->p.tau0 - tau : tau;
+    return ray_radiance(s, tau, w) + exp(-path / amu) * F * (mu > 0 ? L1 : L0);
+}
+
+double pp_exit_radiance(const pp_solution *s, const double w[3])
+{
+    double tau = w[1] > 0 ? 0.0 : s->p.tau0;
+    if (!s->fresnel)
+        return pp_radiance(s, tau, w);
+    double nr = s->nrel, mu_a = fabs(w[1]);
+    double mu_in = sqrt(1.0 - (1.0 - mu_a * mu_a) / (nr * nr));
+    double wi[3] = {w[0] / nr, w[1] > 0 ? mu_in : -mu_in, w[2] / nr};
+    return (1.0 - ppb_fresnel(mu_a, nr)) / (nr * nr) * pp_radiance(s, tau, wi);
 }
 
 /* integral_0^tau0 of exp(lambda (t - tref)) dt. */
@@ -428,10 +580,29 @@ static void compute_totals(pp_solution *s)
     double *field = dalloc(m), mu0 = s->p.mu0, solid = s->dirs.solid, up = 0.0, down = 0.0;
     pp_cell_field(s, 0.0, field);
     for (int i = 0; i < n; i++)
-        up += solid * s->dirs.k[i] * field[i];
+        up += solid * s->dirs.k[i] * field[i] * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
     pp_cell_field(s, s->p.tau0, field);
     for (int i = 0; i < n; i++)
-        down += solid * s->dirs.k[i] * field[n + i];
+        down += solid * s->dirs.k[i] * field[n + i] * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
+    if (s->fresnel) { /* fractions of the power mu_air incident from air (ppsolver.h) */
+        double e = exp(-s->p.tau0 / mu0), depth = mu0 * -expm1(-s->p.tau0 / mu0);
+        double fluence = (s->D + s->U) * depth;
+        for (int i = 0; i < m; i++)
+            fluence += solid * (s->Z[i] + s->Zu[i]) * depth;
+        for (int k = 0; k < s->nmodes; k++) {
+            double sum = 0.0;
+            for (int i = 0; i < m; i++)
+                sum += solid * s->V[(size_t)k * m + i];
+            fluence += sum * depth_integral(s->lambda[k], s->tau_ref[k], s->p.tau0);
+        }
+        double out = (1.0 - s->Fb) * mu0 / s->mu_air;
+        s->ballistic_top = s->U * e * out;
+        s->ballistic = s->D * e * out + s->ballistic_top;
+        s->R = up / s->mu_air, s->T = down / s->mu_air;
+        s->absorbed = s->conservative ? 0.0 : (1.0 - s->p.albedo) * fluence / s->mu_air;
+        free(field);
+        return;
+    }
     s->ballistic = exp(-s->p.tau0 / mu0);
     double fluence = mu0 * -expm1(-s->p.tau0 / mu0); /* direct beam */
     for (int i = 0; i < m; i++)
@@ -477,10 +648,14 @@ static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp
     if (ppb_interrupted())
         return ppb_fail(err, "pp solver: interrupted");
     avoid_resonance(s, w);
+    if (s->fresnel)
+        cell_reflectance(s), beam_series(s);
     double t2 = ppb_now();
     if (pp_phase_row(&s->dirs, s->p.g, s->wL, w->F, err) != 0)
         return -1;
     particular(s, w);
+    if (s->fresnel)
+        particular_series(s);
     if (boundary(s, w, err) != 0)
         return -1;
     compute_totals(s);
@@ -490,18 +665,24 @@ static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp
     return 0;
 }
 
-int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out, pp_timing *t,
-                ppb_err *err)
+int pp_solve_fresnel(const pp_params *p, double nrel, const pp_solution *share, pp_solution **out,
+                     pp_timing *t, ppb_err *err)
 {
     *out = NULL;
     if (check_params(p, err) != 0)
         return -1;
+    if (!(nrel >= 1 && nrel <= 10))
+        return ppb_fail(err, "pp solver: n = %g, need 1 <= n <= 10", nrel);
     pp_solution *s = calloc(1, sizeof *s);
     if (!s)
         return ppb_fail(err, "pp solver: out of memory");
     s->p = *p;
     s->n = p->directions, s->m = 2 * p->directions;
     s->conservative = 1.0 - p->albedo < CONSERVATIVE_EPS;
+    if (nrel > 1.0) { /* the beam refracts; mu0 inside from here on */
+        s->fresnel = 1, s->nrel = nrel, s->mu_air = p->mu0;
+        s->p.mu0 = ppb_refract_cos(p->mu0, nrel);
+    }
     if (s->conservative)
         s->p.albedo = 1.0;
     s->nmodes = s->conservative ? s->m - 1 : s->m;
@@ -510,6 +691,10 @@ int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out,
      * forward one (phase.h); the same partition as the default for odd N */
     int rc =
         p->g < 0 ? pp_dirs_make_antipodal(s->n, &s->dirs, err) : pp_dirs_make(s->n, &s->dirs, err);
+    if (rc == 0 && s->fresnel) { /* a collar edge at the critical cosine (ppsolver.h) */
+        pp_dirs_free(&s->dirs);
+        rc = pp_dirs_make_snap(s->n, p->g < 0, sqrt(1.0 - 1.0 / (nrel * nrel)), &s->dirs, err);
+    }
     if (rc == 0)
         rc = solution_alloc(s, err);
     if (rc == 0 && work_alloc(&w, (size_t)s->n) != 0)
@@ -524,6 +709,12 @@ int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out,
     }
     *out = s;
     return 0;
+}
+
+int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out, pp_timing *t,
+                ppb_err *err)
+{
+    return pp_solve_fresnel(p, 1.0, share, out, t, err);
 }
 
 int pp_solve(const pp_params *p, pp_solution **out, ppb_err *err)
@@ -549,6 +740,12 @@ void pp_modes(const pp_solution *s, double *lambda, double *tau_ref)
 void pp_totals(const pp_solution *s, double *R, double *T, double *ballistic)
 {
     *R = s->R, *T = s->T, *ballistic = s->ballistic;
+}
+
+void pp_boundary_totals(const pp_solution *s, double *specular, double *ballistic_top)
+{
+    *specular = s->fresnel ? s->specular : 0.0;
+    *ballistic_top = s->fresnel ? s->ballistic_top : 0.0;
 }
 
 double pp_absorbed(const pp_solution *s)

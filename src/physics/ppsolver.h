@@ -28,7 +28,30 @@
  *   (the discrete-ordinates "source-function integration"), not by looking up a cell, so
  *   angular detail finer than a cell (single scattering, the HG peak) is kept.
  * - Energy: rows of P conserve exactly (phase.h), so R + T + absorbed + ballistic = 1 holds to
- *   rounding for the cell field; the totals come from the cell field at the faces. */
+ *   rounding for the cell field; the totals come from the cell field at the faces.
+ * - Refractive boundaries, n > 1 (issue 18; reference: Keys): every Fresnel path is skipped at
+ *   n = 1, which stays the code above bit for bit. At n > 1:
+ *   - Boundary conditions (paper Sec. 3.2's smooth faces): at each face the light of an
+ *     outgoing cell reflects into its mirror cell with the cell-averaged reflectance
+ *     R_i = int F mu dOmega / int mu dOmega (F depends on mu alone, so a 1-D integral over the
+ *     cell's mu range: the totally reflected part exactly, the rest by 16-point Gauss-Legendre
+ *     in the air-side cosine, in which F is smooth); cells wholly beyond the critical angle
+ *     have R_i = 1. The up/down symmetry of the slab survives (both faces are alike), so the
+ *     sum and difference systems keep their form with X+- replaced by X+- - R X-+.
+ *   - The beam enters refracted, mu0 = cos theta_t (sin theta_t = sin theta_L / n), with
+ *     E_perp inside (1 - F(theta_L)) cos theta_L / mu0 per unit E_perp in air. Its unscattered
+ *     part reflects at S2 and S1 with F_b = F(mu0 inside) each time: a geometric series of
+ *     collimated sources, summed: downward D exp(-tau/mu0), D = E_in / (1 - F_b^2
+ *     exp(-2 tau0/mu0)), and upward U exp(-(tau0 - tau)/mu0), U = D F_b exp(-tau0/mu0). (They
+ *     are not negligible: at n = 1.5, tau0 = 1 the first return is 1.5 % of the beam.) The
+ *     upward source's particular solution is Z mirrored (cells i <-> N + i, tau <-> tau0 -
+ *     tau), so one solve serves both.
+ *   - Radiance along a continuous direction includes the boundary's reflections: the ray from
+ *     a face reflects there from its mirror direction, a 2 x 2 system per direction pair
+ *     solved in closed form (pp_radiance). Exits into air follow the n^2 law (pp_exit_radiance).
+ *   - Totals are fractions of the power cos theta_L incident from air: R and T leave through
+ *     1 - R_i, the ballistic through 1 - F_b at both faces, `specular` = F(theta_L), so R + T +
+ *     absorbed + ballistic + specular = 1 still holds to rounding. */
 #ifndef PPB_PPSOLVER_H
 #define PPB_PPSOLVER_H
 
@@ -59,9 +82,14 @@ int pp_solve(const pp_params *p, pp_solution **out, ppb_err *err);
  * reporting stage times when t is not NULL. share and t may be NULL. */
 int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out, pp_timing *t,
                 ppb_err *err);
+
+/* pp_solve_ex with refractive index n inside (outside 1; 1 <= n <= 10): p->mu0 is cos theta_L in
+ * air, and n = 1 is pp_solve_ex itself. */
+int pp_solve_fresnel(const pp_params *p, double n, const pp_solution *share, pp_solution **out,
+                     pp_timing *t, ppb_err *err);
 void pp_free(pp_solution *s);
 
-/* mu0 as used (see the resonance note above). */
+/* mu0 as used inside (see the resonance note above; the refracted cosine at n > 1). */
 double pp_mu0(const pp_solution *s);
 
 /* Homogeneous modes (M of them: 2N, or 2N - 1 at alpha = 1), sorted by |lambda| ascending;
@@ -72,7 +100,9 @@ void pp_modes(const pp_solution *s, double *lambda, double *tau_ref);
 /* Source function for scattering into the continuous direction w (unit vector, tube frame),
  * per unit optical depth, E_perp = 1:
  *   J(tau, w) = alpha integral p(w.w') I_diffuse(tau, w') dw' + alpha p(w.w_L) exp(-tau/mu0).
- * Diffuse part in modal form: sum_k a_k(w) e_k(tau) + b(w) exp(-tau/mu0) + a_lin tau. */
+ * Diffuse part in modal form: sum_k a_k(w) e_k(tau) + b(w) exp(-tau/mu0) + a_lin tau.
+ * At n > 1 b is the downward beam's part only (the upward reflected beam's is not in it; the
+ * marcher, its user, does not run at n > 1 yet); pp_source and pp_radiance hold both. */
 void pp_source_coeffs(const pp_solution *s, const double w[3], double *a, double *b);
 double pp_source_linear(const pp_solution *s); /* a_lin: 0 unless alpha = 1 */
 double pp_source_direct(const pp_solution *s, double tau, const double w[3]);
@@ -83,6 +113,11 @@ double pp_source(const pp_solution *s, double tau, const double w[3]);
  * transmitted. Horizontal w (w.y = 0) gives J(tau, w), the infinite-slab limit. */
 double pp_radiance(const pp_solution *s, double tau, const double w[3]);
 
+/* Radiance leaving the slab into air at the face tau = 0 (w.y > 0) or tau0 (w.y < 0) along the
+ * air-side direction w: at n = 1 exactly pp_radiance; at n > 1 the n^2 law, (1 - F) / n^2 times
+ * the inside radiance along the refracted direction (same azimuth, sin_in = sin_air / n). */
+double pp_exit_radiance(const pp_solution *s, const double w[3]);
+
 /* Cell averages I_i(tau), i in [0, 2N) (up cells first, then their mirrors). */
 void pp_cell_field(const pp_solution *s, double tau, double *field);
 
@@ -90,5 +125,9 @@ void pp_cell_field(const pp_solution *s, double tau, double *field);
  * light, and the unscattered beam exp(-tau0/mu0); pp_absorbed the rest, computed. */
 void pp_totals(const pp_solution *s, double *R, double *T, double *ballistic);
 double pp_absorbed(const pp_solution *s);
+
+/* n > 1: the entry's specular reflection F(theta_L), and the part of pp_totals' ballistic that
+ * leaves through S1 (the beam reflected at S2); both 0 at n = 1. */
+void pp_boundary_totals(const pp_solution *s, double *specular, double *ballistic_top);
 
 #endif
