@@ -26,6 +26,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
 prov() { awk -F' = ' -v k="$1" '$1 == k {print $2; exit}' "$dir/provenance.txt" 2> /dev/null; }
+# A CSV with data rows, not only its header (an interrupted or failed method writes none).
+has_rows() { [ -f "$1" ] && [ "$(awk 'NR > 1 {n++} END {print n + 0}' "$1")" -gt 0 ]; }
 name=$(prov experiment.name)
 name=${name:-$(basename "$dir")}
 theta_l=${2:-$(prov light.theta_deg)}
@@ -61,7 +63,7 @@ render() {
 }
 
 # ---- rms_vs_x: four panels, one key beside them ----
-if [ -s "$dir/rms.csv" ] && [ "$(prov experiment.geometry)" != slab ]; then
+if has_rows "$dir/rms.csv" && [ "$(prov experiment.geometry)" != slab ]; then
   mapfile -t methods < <(awk -F, 'NR > 1 {print $1}' "$dir/rms.csv" | awk '!seen[$0]++')
   for m in "${methods[@]}"; do
     for s in S1 S2 S3 S4; do
@@ -130,7 +132,7 @@ if [ -s "$dir/rms.csv" ] && [ "$(prov experiment.geometry)" != slab ]; then
 fi
 
 # ---- angular_x0: the in-plane cut at x = 0 from angular.csv ----
-if [ -s "$dir/angular.csv" ]; then
+if has_rows "$dir/angular.csv"; then
   mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/angular.csv" | awk '!seen[$0]++')
   for m in "${all_methods[@]}"; do
     for s in S1 S2; do
@@ -196,7 +198,7 @@ fi
 
 # ---- images: all (labelled) and error figures (titled, numbered colour bar) ----
 img=$dir/images
-if [ -d "$img" ] && [ -s "$dir/angular.csv" ]; then
+if [ -d "$img" ] && has_rows "$dir/angular.csv"; then
   mapfile -t all_methods < <(awk -F, 'NR > 1 {print $1}' "$dir/angular.csv" | awk '!seen[$0]++')
   present=()
   for m in "${all_methods[@]}"; do [ -s "$img/$m.png" ] && present+=("$m"); done

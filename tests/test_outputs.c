@@ -259,10 +259,13 @@ static void test_report_replaces_only_its_own_files(void **state)
 static void test_interrupted_pp_writes_no_rows(void **state)
 {
     (void)state;
-    /* A march of about 10 s at this machine's speed (a small step), SIGINT once it is under
-     * way: its progress line ("rows/s") appears after 0.5 s of marching. */
-    const char *cfg = cli_config("outputs-pp-cfg", "[experiment]\nname = ppint\nmethods = mp, pp\n"
-                                                   "[pp]\ndirections = 16\nstep = 0.005\n");
+    /* A march far longer than the first progress line takes to appear (0.5 s on a terminal,
+     * PPB_PROGRESS_LOG_SECONDS = 5 s in a log, as here): the R table steps every ray (the S
+     * table's closed form makes the march take 0.5 s whatever the step), at step 0.002 tens of
+     * seconds; SIGINT once that line shows the march under way. */
+    const char *cfg =
+        cli_config("outputs-pp-cfg", "[experiment]\nname = ppint\nmethods = mp, pp\n"
+                                     "[pp]\ndirections = 16\ntable = R\nstep = 0.002\n");
     const char *s = tu_scratch("outputs-pp");
     const char *b = getenv("PPBENCH") ? getenv("PPBENCH") : "./ppbench";
     int rc = tu_sh("%s run --out %s/o %s 2> %s/err & pid=$!; i=0; "

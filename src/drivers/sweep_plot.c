@@ -263,6 +263,11 @@ int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *
 {
     if (grid->naxes < 1)
         return 0;
+    int has_reference = 0;
+    for (int m = 0; m < cfg->nmethods; m++)
+        has_reference |= ppb_method_find(cfg->methods[m])->reference == 1;
+    if (!has_reference)
+        return 0; /* no Monte Carlo: sweep.csv holds no RMS to draw, only totals */
     if (grid->naxes == 1)
         return draw(cfg, grid, dir, "sweep_rms", NULL, err);
     for (int m = 0; m < cfg->nmethods; m++) {
