@@ -10,7 +10,8 @@ sets=()
 while [ $# -gt 0 ]; do
   case $1 in
     --quick) out=build/bench-quick
-             sets+=(--set mc.photons=2e6 --set pp.directions=128 --set bins.samples_dir=2) ;;
+             sets+=(--set mc.photons=2e6 --set pp.directions=128 --set bins.samples_dir=2
+                   --set rte2d.spacing=0.25 --set rte2d.directions=48) ;;
     --out) out=$2; shift ;;
     --set) sets+=(--set "$2"); shift ;;
     *) echo "bench.sh: unknown argument $1" >&2; exit 2 ;;
