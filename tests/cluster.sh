@@ -34,12 +34,20 @@ fails=0
 same() { # same A B: cmp, said either way
   if cmp "$1" "$2"; then echo "cmp: identical: $1 $2"; else echo "cmp: DIFFERENT: $1 $2"; fails=1; fi
 }
-same_outputs() { # every file of a whole run but its timings and provenance (wall times, paths)
+# Every file of a whole run but its timings and provenance (wall times, paths) and the PDFs
+# (cairo stamps each with its creation time; the PNGs of the same figures are compared);
+# config.ini without its [output] dir line, the one setting that names where a run went.
+same_outputs() {
   local f n=0
   while IFS= read -r f; do
-    same "$1/$f" "$2/$f"
+    if [ "$f" = ./config.ini ]; then
+      same <(grep -v '^dir = ' "$1/$f") <(grep -v '^dir = ' "$2/$f")
+    else
+      same "$1/$f" "$2/$f"
+    fi
     n=$((n + 1))
-  done < <(cd "$1" && find . -type f ! -name timings.csv ! -name provenance.txt | sort)
+  done < <(cd "$1" && find . -type f ! -name timings.csv ! -name provenance.txt ! -name '*.pdf' |
+    sort)
   [ "$n" -gt 0 ] || { echo "cmp: no files in $1"; fails=1; }
 }
 
