@@ -205,17 +205,7 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
                             double wx, double wy)
 {
     double mx = -wx, my = -wy; /* the march direction, per unit length along the 3-D ray */
-    double lfar = INFINITY;
-    if (my > 0.0)
-        lfar = -py / my;
-    else if (my < 0.0)
-        lfar = (-P->height - py) / my;
-    if (P->tube) {
-        if (mx > 0.0)
-            lfar = fmin(lfar, (0.5 * P->width - px) / mx);
-        else if (mx < 0.0)
-            lfar = fmin(lfar, (-0.5 * P->width - px) / mx);
-    }
+    double lfar = ppb_exit_length(P->tube, P->width, P->height, px, py, mx, my);
     /* Beyond optical distance d_cap nothing counts (e^-d_cap is below double resolution of the
      * sum); capping l keeps grazing rays finite. */
     double sig_min =

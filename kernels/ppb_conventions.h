@@ -175,6 +175,26 @@ PPB_FN void ppb_segment_sample(int tube, int surf, int seg, int nseg, double wid
     *py = cy + (along_x ? 0.0 : o);
 }
 
+/* Length of the ray from (px, py) along the in-plane direction (mx, my) (per unit 3-D length)
+ * to where it leaves the cross-section: through S1 or S2, or a side wall in the tube. INFINITY
+ * for a ray parallel to a slab's faces. */
+PPB_FN double ppb_exit_length(int tube, double width, double height, double px, double py,
+                              double mx, double my)
+{
+    double l = INFINITY;
+    if (my > 0.0)
+        l = -py / my;
+    else if (my < 0.0)
+        l = (-height - py) / my;
+    if (tube) {
+        if (mx > 0.0)
+            l = fmin(l, (0.5 * width - px) / mx);
+        else if (mx < 0.0)
+            l = fmin(l, (-0.5 * width - px) / mx);
+    }
+    return l;
+}
+
 /* Segment holding coordinate s along a surface of length len starting at s0. */
 PPB_FN int ppb_segment_of(double s, double s0, double len, int nseg)
 {

@@ -60,17 +60,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         mx = 0.0;
     if (fabs(my) < 1e-12)
         my = 0.0;
-    double lfar = INFINITY;
-    if (my > 0.0)
-        lfar = -py / my;
-    else if (my < 0.0)
-        lfar = (-P->height - py) / my;
-    if (P->tube) {
-        if (mx > 0.0)
-            lfar = fmin(lfar, (0.5 * P->width - px) / mx);
-        else if (mx < 0.0)
-            lfar = fmin(lfar, (-0.5 * P->width - px) / mx);
-    }
+    double lfar = ppb_exit_length(P->tube, P->width, P->height, px, py, mx, my);
     double sig_min =
         P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
     lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
