@@ -12,6 +12,7 @@
 #include "base/csv_read.h"
 #include "base/hash.h"
 #include "base/quadrature.h"
+#include "base/file_read.h"
 #include "kernels/ppb_sort.h"
 
 static const char *write_text(const char *dir, const char *name, const char *text)
@@ -307,6 +308,31 @@ static void test_clock_seconds(void **state)
     assert_close(dt, 2.51, 2.49); /* in [0.02, 5] */
 }
 
+/* A file of more than one read block (200000 bytes, NULs and all) comes back whole and
+ * NUL-terminated; a missing file is NULL. Expected bytes: the ones written. */
+static void test_read_file(void **state)
+{
+    (void)state;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/blob", tu_scratch("read-file"));
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    for (int i = 0; i < 200000; i++)
+        fputc(i % 251, f);
+    fclose(f);
+    size_t n = 0;
+    char *b = ppb_read_file(path, &n);
+    assert_non_null(b);
+    assert_int_equal(n, 200000);
+    for (int i = 0; i < 200000; i++)
+        if ((unsigned char)b[i] != i % 251)
+            fail_msg("byte %d is %d, wrote %d", i, (unsigned char)b[i], i % 251);
+    assert_int_equal(b[n], '\0');
+    free(b);
+    strcat(path, ".missing");
+    assert_null(ppb_read_file(path, NULL));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -319,6 +345,7 @@ int main(void)
         cmocka_unit_test(test_hash_xxh3_values),
         cmocka_unit_test(test_gauss_legendre_closed_forms),
         cmocka_unit_test(test_sort_doubles),
+        cmocka_unit_test(test_read_file),
         cmocka_unit_test(test_clock_seconds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

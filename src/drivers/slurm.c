@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "base/file_read.h"
 #include "base/atomic_file.h"
 #include "base/hash.h"
 #include "drivers/sweep.h"
@@ -372,38 +373,6 @@ int ppb_slurm_parse_squeue(const char *text, const char *name, int shards, unsig
 
 /* ---- the job directory ---- */
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    char *buf = NULL;
-    size_t cap = 0, n = 0, got;
-    do {
-        if (cap - n < 65536) {
-            char *nb = realloc(buf, cap = 2 * cap + 65536);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return NULL;
-            }
-            buf = nb;
-        }
-        got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-    } while (got > 0);
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return NULL;
-    }
-    buf[n] = '\0';
-    if (len)
-        *len = n;
-    return buf;
-}
-
 static int write_file(const char *path, const char *data, size_t len, int exec, ppb_err *err)
 {
     ppb_afile af;
@@ -668,7 +637,7 @@ out:
 /* The running binary's bytes (every task runs a copy of them) and their hash. */
 static char *self_binary(size_t *len, ppb_err *err)
 {
-    char *bin = slurp("/proc/self/exe", len);
+    char *bin = ppb_read_file("/proc/self/exe", len);
     if (!bin)
         ppb_fail(err, "slurm: cannot read the ppbench binary (/proc/self/exe): %s",
                  strerror(errno));

@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "base/file_read.h"
 #include "base/atomic_file.h"
 #include "base/csv_read.h"
 #include "base/hash.h"
@@ -207,35 +208,6 @@ static int find_point(const char *const *dirs, int ndirs, const char *hash, cons
     return -1;
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    char *buf = NULL;
-    size_t cap = 0, n = 0, got;
-    do {
-        if (cap - n < 65536) {
-            char *nb = realloc(buf, cap = 2 * cap + 65536);
-            if (!nb) {
-                free(buf), fclose(f);
-                return NULL;
-            }
-            buf = nb;
-        }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-    } while (got > 0);
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return NULL;
-    }
-    *len = n;
-    return buf;
-}
-
 /* Shards of one sweep have the same grid.txt: the same swept keys in the same order (its
  * header), the same values in the same order, the same settings at every point (the hashes).
  * Refuses any other, saying which part differs. */
@@ -244,14 +216,14 @@ static int same_grids(const char *const *dirs, int ndirs, ppb_err *err)
     char path[1200];
     snprintf(path, sizeof path, "%s/grid.txt", dirs[0]);
     size_t n0 = 0;
-    char *g0 = slurp(path, &n0);
+    char *g0 = ppb_read_file(path, &n0);
     if (!g0)
         return ppb_fail(err, "%s: cannot read: %s (not a sweep directory?)", path, strerror(errno));
     int rc = 0;
     for (int d = 1; d < ndirs && rc == 0; d++) {
         size_t n = 0;
         snprintf(path, sizeof path, "%s/grid.txt", dirs[d]);
-        char *g = slurp(path, &n);
+        char *g = ppb_read_file(path, &n);
         if (!g) {
             rc = ppb_fail(err, "%s: cannot read: %s (not a sweep directory?)", path,
                           strerror(errno));
