@@ -12,6 +12,7 @@
 #include "kernels/ppb_fresnel.h"
 #include "methods/mc_tally.h"
 #include "methods/method_mc.h"
+#include "methods/registry.h"
 #include "model/config.h"
 #include "physics/ppsolver.h"
 
@@ -350,16 +351,18 @@ static void test_bit_identical_n(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
-/* Methods without refractive boundaries yet are refused at n > 1 (exit 2 from the config),
- * not run as if n were 1; mc and ppslab are accepted. */
+/* Methods without refractive boundaries yet are refused at n > 1 (exit 2, before any work, by
+ * the method's check hook in the registry), not run as if n were 1; mc and ppslab are
+ * accepted. */
 static void test_config_refuses_other_methods(void **state)
 {
     (void)state;
     const char *dir = tu_scratch("fresnel_cfg");
     char path[1200];
     snprintf(path, sizeof path, "%s/a.ini", dir);
-    const char *texts[2] = {"[experiment]\nmethods = mc, ppslab\n[medium]\nn = 1.4\n",
-                            "[experiment]\nmethods = mc, pp\n[medium]\nn = 1.4\n"};
+    const char *texts[2] = {
+        "[experiment]\ngeometry = slab\nmethods = mc, ppslab\n[medium]\nn = 1.4\n",
+        "[experiment]\ngeometry = slab\nmethods = mc, pp\n[medium]\nn = 1.4\n"};
     for (int i = 0; i < 2; i++) {
         FILE *f = fopen(path, "w");
         assert_non_null(f);
@@ -367,12 +370,14 @@ static void test_config_refuses_other_methods(void **state)
         fclose(f);
         ppb_config cfg;
         ppb_err err;
-        int rc = ppb_config_load(&cfg, path, &err);
+        assert_int_equal(ppb_config_load(&cfg, path, &err), 0);
+        assert_close(cfg.scene.n, 1.4, 0);
+        int rc = ppb_methods_check(&cfg, &err);
         assert_int_equal(rc, i == 0 ? 0 : -1);
-        if (i == 0)
-            assert_close(cfg.scene.n, 1.4, 0);
-        else
+        if (i == 1) {
             assert_non_null(strstr(err.msg, "n > 1"));
+            assert_non_null(strstr(err.msg, "method pp"));
+        }
     }
 }
 

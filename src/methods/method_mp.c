@@ -197,7 +197,12 @@ int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "albedo_right", err,
             "mp, mp+ss: albedo = 1 gives sigma_tr = 0, where the multipole's image series of a "
             "finite slab converges only conditionally; use albedo < 1 or leave mp out");
-    return 0;
+    return ppb_method_refuse_refractive(cfg, "mp", err);
+}
+
+int ppb_mp_ss_check(const ppb_config *cfg, ppb_err *err)
+{
+    return ppb_mp_check(cfg, err) || ppb_ss_check(cfg, err) ? -1 : 0;
 }
 
 /* mp + ss, cell by cell. The parts are this experiment's mp and ss results when they ran before

@@ -13,6 +13,9 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
  * with the key and the reason; called at config time (ppb_methods_check) and by the method. */
 int ppb_mp_check(const ppb_config *cfg, ppb_err *err);
 
+/* mp+ss's check: mp's and ss's together. */
+int ppb_mp_ss_check(const ppb_config *cfg, ppb_err *err);
+
 /* `mp+ss`: `mp` plus ppb_method_ss's radiance, cell by cell. */
 int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 

@@ -78,3 +78,8 @@ int ppb_method_pp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     return ppb_pp_pipeline(ctx, out, 1, err);
 }
+
+int ppb_pp_check(const ppb_config *cfg, ppb_err *err)
+{
+    return ppb_method_refuse_refractive(cfg, "pp", err);
+}

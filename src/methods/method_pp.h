@@ -9,6 +9,9 @@
 /* Fills out[0] with the bin-averaged exit radiance and the totals (reference: Bins). */
 int ppb_method_pp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
+/* Whether pp has a meaning at cfg's point (the registry's check hook). */
+int ppb_pp_check(const ppb_config *cfg, ppb_err *err);
+
 /* The pipeline itself: maps, tables, march, totals. with_modes = 0 keeps only the attenuated
  * direct beam's single scattering in the tables: that is `ss` (method_ss.h). */
 int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err);

@@ -315,3 +315,8 @@ int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     return ppb_rte2d_run(ctx, out, NULL, err);
 }
+
+int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
+{
+    return ppb_method_refuse_refractive(cfg, "rte2d", err);
+}

@@ -7,3 +7,8 @@ int ppb_method_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     return ppb_pp_pipeline(ctx, out, 0, err);
 }
+
+int ppb_ss_check(const ppb_config *cfg, ppb_err *err)
+{
+    return ppb_method_refuse_refractive(cfg, "ss", err);
+}

@@ -20,13 +20,17 @@ static const ppb_method methods[] = {
      .run = ppb_method_mc},
     {.id = "pp",
      .summary = "plane-parallel ray marching, the paper's method",
-     .run = ppb_method_pp},
-    {.id = "ss", .summary = "single scattering by ray marching", .run = ppb_method_ss},
+     .run = ppb_method_pp,
+     .check = ppb_pp_check},
+    {.id = "ss",
+     .summary = "single scattering by ray marching",
+     .run = ppb_method_ss,
+     .check = ppb_ss_check},
     {.id = "mp", .summary = "multipole diffusion", .run = ppb_method_mp, .check = ppb_mp_check},
     {.id = "mp+ss",
      .summary = "multipole diffusion plus single scattering",
      .run = ppb_method_mp_ss,
-     .check = ppb_mp_check},
+     .check = ppb_mp_ss_check},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,
@@ -35,7 +39,8 @@ static const ppb_method methods[] = {
     {.id = "rte2d",
      .reference = 2, /* noise-free in the tube: summary_rte2d.csv (issue 19) */
      .summary = "the tube's transfer solved: the paper's refinement iterated",
-     .run = ppb_method_rte2d},
+     .run = ppb_method_rte2d,
+     .check = ppb_rte2d_check},
 };
 
 /* Methods a config defines ([method.NAME], model/config.h), entered by ppb_methods_check when

@@ -831,16 +831,6 @@ static int validate(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "step_x", err,
             "the step must lie inside the tube (|step_x| < width / 2 = %g, width from %s)",
             0.5 * sc->width, origin_of(cfg, "tube", "width", where, sizeof where));
-    /* Refractive boundaries (issue 18) are built method by method; until a method has them it
-     * is refused at n > 1 rather than run as if n were 1. */
-    if (sc->n > 1.0)
-        for (int i = 0; i < cfg->nmethods; i++)
-            if (strcmp(cfg->methods[i], "mc") != 0 && strcmp(cfg->methods[i], "ppslab") != 0)
-                return ppb_config_key_fail(
-                    cfg, "medium", "n", err,
-                    "n > 1 is implemented by mc and ppslab only so far (issue 18); method %s "
-                    "(methods from %s) would ignore it",
-                    cfg->methods[i], origin_of(cfg, "experiment", "methods", where, sizeof where));
     return 0;
 }
 
