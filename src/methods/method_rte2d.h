@@ -27,6 +27,9 @@ typedef struct ppb_rte2d_stats {
     double t_exit;        /* seconds in the exit march and its source */
     double absorbed_beam; /* fractions of the power entering (totals.absorbed = their sum) */
     double absorbed_scattered;
+    int record_rungs;  /* K = 0: rungs of the refinement study (rte2d_refinements.csv) */
+    int record_sweeps; /* its sweeps (not in sweeps) */
+    double t_record;   /* seconds it took (in t_total) */
 } ppb_rte2d_stats;
 
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
@@ -34,7 +37,13 @@ int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 /* Whether rte2d has a meaning at cfg's point (the registry's check hook). */
 int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err);
 
-/* The same, reporting what it took (stats may be NULL). */
+/* The same without the refinement study (tests, `make perf`), reporting what it took (stats may
+ * be NULL). */
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
+
+/* Writes dir/rte2d_refinements.csv (reference: Outputs) from the refinement study of the last
+ * converged rte2d run of cfg (the same experiment name and output directory); nothing when there
+ * was none. */
+int ppb_rte2d_write_refinements(const ppb_config *cfg, const char *dir, ppb_err *err);
 
 #endif
