@@ -1,13 +1,16 @@
 /* test_images.c: the shaded tube images (images.c, render_tube.c, image_exr.c, image_png.c):
  * EXR and PNG round trips through the libraries' own readers, the camera's analytic
  * projection, uniform and per-segment radiance fields end to end, one exposure per view shared
- * by the methods, the light arrow on the top view only, and atomic outputs (no temporary left,
- * a failure leaves no file). */
+ * by the methods, the light arrow on the top view only, atomic outputs (no temporary left,
+ * a failure leaves no file), and the EXR header's string attributes (method, case, seed,
+ * photons, version, what the image shows), read back through the OpenEXR C API itself. */
 #include "testutil.h"
 
 #include <dirent.h>
 #include <math.h>
 #include <sys/stat.h>
+
+#include <OpenEXR/openexr.h>
 
 #include "drivers/experiment.h"
 #include "io/image_exr.h"
@@ -54,7 +57,7 @@ static void test_exr_roundtrip(void **state)
     char path[1200];
     snprintf(path, sizeof path, "%s/a.exr", tu_scratch("exr"));
     ppb_err err;
-    assert_int_equal(ppb_exr_write_rgb(path, W, H, rgb, &err), 0);
+    assert_int_equal(ppb_exr_write_rgb(path, W, H, rgb, NULL, 0, &err), 0);
     int w = 0, h = 0;
     float *back = NULL;
     if (ppb_exr_read_rgb(path, &w, &h, &back, &err))
@@ -62,6 +65,53 @@ static void test_exr_roundtrip(void **state)
     assert_int_equal(w, W);
     assert_int_equal(h, H);
     /* Lossless 32-bit float: the values written, bit for bit. */
+    assert_memory_equal(back, rgb, sizeof rgb);
+    free(back);
+}
+
+/* The string attribute `name` of path's header, read by the OpenEXR C API (not by
+ * image_exr.c), copied into out; fails the test if the file or the attribute is missing or
+ * not a string. */
+static void exr_string_attr(const char *path, const char *name, char *out, size_t cap)
+{
+    exr_context_t ctxt = NULL;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_result_t rv = exr_start_read(&ctxt, path, &init);
+    if (rv != EXR_ERR_SUCCESS)
+        fail_msg("%s: cannot read: %s", path, exr_get_default_error_message(rv));
+    int32_t len = 0;
+    const char *v = NULL;
+    rv = exr_attr_get_string(ctxt, 0, name, &len, &v);
+    if (rv == EXR_ERR_SUCCESS)
+        snprintf(out, cap, "%.*s", (int)len, v);
+    exr_finish(&ctxt);
+    if (rv != EXR_ERR_SUCCESS)
+        fail_msg("%s: no string attribute %s: %s", path, name, exr_get_default_error_message(rv));
+}
+
+/* Attributes given to the writer come back by name with their values, pixels unchanged. */
+static void test_exr_string_attributes(void **state)
+{
+    (void)state;
+    enum { W = 3, H = 2 };
+    float rgb[W * H * 3];
+    for (int k = 0; k < W * H * 3; k++)
+        rgb[k] = 0.25f * (float)k;
+    char path[1200], got[512];
+    snprintf(path, sizeof path, "%s/meta.exr", tu_scratch("exrattr"));
+    const ppb_exr_attr attrs[] = {
+        {"ppbench.method", "pp"}, {"ppbench.case", "density_step"}, {"ppbench.seed", "42"}};
+    ppb_err err;
+    if (ppb_exr_write_rgb(path, W, H, rgb, attrs, 3, &err))
+        fail_msg("%s", err.msg);
+    for (int a = 0; a < 3; a++) {
+        exr_string_attr(path, attrs[a].name, got, sizeof got);
+        assert_string_equal(got, attrs[a].value);
+    }
+    int w, h;
+    float *back = NULL;
+    if (ppb_exr_read_rgb(path, &w, &h, &back, &err))
+        fail_msg("%s", err.msg);
     assert_memory_equal(back, rgb, sizeof rgb);
     free(back);
 }
@@ -99,13 +149,13 @@ static void test_writers_atomic_on_failure(void **state)
     ppb_err err;
     snprintf(blocked, sizeof blocked, "%s/blocked.exr", dir);
     assert_int_equal(mkdir(blocked, 0777), 0);
-    assert_int_equal(ppb_exr_write_rgb(blocked, 1, 1, f, &err), -1);
+    assert_int_equal(ppb_exr_write_rgb(blocked, 1, 1, f, NULL, 0, &err), -1);
     snprintf(blocked, sizeof blocked, "%s/blocked.png", dir);
     assert_int_equal(mkdir(blocked, 0777), 0);
     assert_int_equal(ppb_png_write_rgb(blocked, 1, 1, b, &err), -1);
     assert_int_equal(count_named(dir, ".tmp"), 0);
     snprintf(missing, sizeof missing, "%s/no/such/dir/a.exr", dir);
-    assert_int_equal(ppb_exr_write_rgb(missing, 1, 1, f, &err), -1);
+    assert_int_equal(ppb_exr_write_rgb(missing, 1, 1, f, NULL, 0, &err), -1);
     assert_non_null(strstr(err.msg, "a.exr"));
     snprintf(missing, sizeof missing, "%s/no/such/dir/a.png", dir);
     assert_int_equal(ppb_png_write_rgb(missing, 1, 1, b, &err), -1);
@@ -271,7 +321,7 @@ static unsigned char *read_png(const fake *f, const char *name, int *w, int *h)
 static void write_images(fake *f)
 {
     ppb_err err;
-    if (ppb_images_write(f->cfg.out_dir, &f->cfg.scene, f->ex.res, f->ex.n, 0, &err))
+    if (ppb_images_write(f->cfg.out_dir, &f->cfg.scene, NULL, f->ex.res, f->ex.n, 0, &err))
         fail_msg("%s", err.msg);
 }
 
@@ -468,6 +518,52 @@ static void test_slab_writes_nothing(void **state)
     fake_free(f);
 }
 
+/* Every EXR of an experiment names its method, case, seed, photon budget, version and what it
+ * shows (issue 16: pbrt-v4 writes its settings into its EXRs); without a meta, "unknown". */
+static void test_image_exr_metadata(void **state)
+{
+    (void)state;
+    fake *f = fake_new("exrmeta", PPB_GEOM_TUBE);
+    fake_fill(f, 0, 0.5);
+    fake_fill(f, 1, 0.6);
+    const ppb_image_meta meta = {"uniform_g0_normal", "v1.2-3-gabc", 123456789012345LL, 400000000};
+    ppb_err err;
+    if (ppb_images_write(f->cfg.out_dir, &f->cfg.scene, &meta, f->ex.res, f->ex.n, 0, &err))
+        fail_msg("%s", err.msg);
+    char path[1300], got[1024];
+    const char *methods[2] = {"mc", "pp"};
+    for (int i = 0; i < 2; i++) {
+        char file[64];
+        snprintf(file, sizeof file, "%s.exr", methods[i]);
+        image_file(f, file, path, sizeof path);
+        exr_string_attr(path, "ppbench.method", got, sizeof got);
+        assert_string_equal(got, methods[i]);
+        exr_string_attr(path, "ppbench.case", got, sizeof got);
+        assert_string_equal(got, "uniform_g0_normal");
+        exr_string_attr(path, "ppbench.seed", got, sizeof got);
+        assert_string_equal(got, "123456789012345"); /* every digit: a seed is an integer */
+        exr_string_attr(path, "ppbench.photons", got, sizeof got);
+        assert_string_equal(got, "400000000");
+        exr_string_attr(path, "ppbench.version", got, sizeof got);
+        assert_string_equal(got, "v1.2-3-gabc");
+        exr_string_attr(path, "ppbench.shows", got, sizeof got);
+        if (!strstr(got, "radiance") || !strstr(got, "1/sr") || !strstr(got, "S1") ||
+            !strstr(got, "S2") || !strstr(got, "S3"))
+            fail_msg("ppbench.shows does not say what the image shows: '%s'", got);
+    }
+    /* No meta: the method is still known, the rest says so. */
+    if (ppb_images_write(f->cfg.out_dir, &f->cfg.scene, NULL, f->ex.res, f->ex.n, 0, &err))
+        fail_msg("%s", err.msg);
+    image_file(f, "pp.exr", path, sizeof path);
+    exr_string_attr(path, "ppbench.method", got, sizeof got);
+    assert_string_equal(got, "pp");
+    exr_string_attr(path, "ppbench.case", got, sizeof got);
+    assert_string_equal(got, "unknown");
+    exr_string_attr(path, "ppbench.seed", got, sizeof got);
+    assert_string_equal(got, "unknown");
+    fake_free(f);
+}
+
 /* An output directory that cannot be made fails cleanly with a message. */
 static void test_unwritable_dir_fails(void **state)
 {
@@ -477,8 +573,8 @@ static void test_unwritable_dir_fails(void **state)
     assert_non_null(blocker);
     fclose(blocker);
     ppb_err err = {{0}};
-    assert_int_equal(ppb_images_write(f->cfg.out_dir, &f->cfg.scene, f->ex.res, f->ex.n, 0, &err),
-                     -1);
+    assert_int_equal(
+        ppb_images_write(f->cfg.out_dir, &f->cfg.scene, NULL, f->ex.res, f->ex.n, 0, &err), -1);
     assert_true(strlen(err.msg) > 0);
     fake_free(f);
 }
@@ -487,6 +583,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exr_roundtrip),
+        cmocka_unit_test(test_exr_string_attributes),
         cmocka_unit_test(test_png_roundtrip),
         cmocka_unit_test(test_writers_atomic_on_failure),
         cmocka_unit_test(test_camera_projection_analytic),
@@ -497,6 +594,7 @@ int main(void)
         cmocka_unit_test(test_exposure_per_view),
         cmocka_unit_test(test_error_image),
         cmocka_unit_test(test_slab_writes_nothing),
+        cmocka_unit_test(test_image_exr_metadata),
         cmocka_unit_test(test_unwritable_dir_fails),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -324,8 +324,9 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
         write_provenance(ex, dir, err) || write_config_ini(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
-    if (ppb_images_write(dir, &ex->cfg->scene, ex->res, ex->n, ref ? (int)(ref - ex->res) : -1,
-                         err))
+    const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
+    if (ppb_images_write(dir, &ex->cfg->scene, &meta, ex->res, ex->n,
+                         ref ? (int)(ref - ex->res) : -1, err))
         return -1;
     return ppb_plots_write(dir, err); /* last: the figures read the files above */
 }

@@ -46,7 +46,8 @@ static exr_context_initializer_t quiet_init(void)
     return init;
 }
 
-static exr_result_t define_part(exr_context_t ctxt, int width, int height)
+static exr_result_t define_part(exr_context_t ctxt, int width, int height,
+                                const ppb_exr_attr *attrs, int nattrs)
 {
     int part = 0;
     exr_result_t rv = exr_add_part(ctxt, "rgb", EXR_STORAGE_SCANLINE, &part);
@@ -56,19 +57,38 @@ static exr_result_t define_part(exr_context_t ctxt, int width, int height)
     for (int c = 0; c < RGB && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_add_channel(ctxt, part, names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1,
                              1);
+    for (int a = 0; a < nattrs && rv == EXR_ERR_SUCCESS; a++)
+        rv = exr_attr_set_string(ctxt, part, attrs[a].name, attrs[a].value);
     return rv;
 }
 
+/* The channel layout both pipelines share: every channel read or written as 32-bit floats
+ * in interleaved RGB rows of `width` pixels. Returns the byte offset of the channel's slot in
+ * a pixel, -1 for channels other than R, G, B (skipped: a NULL pointer). */
+static long set_layout(exr_coding_channel_info_t *ch, int width)
+{
+    int slot = channel_slot(ch->channel_name);
+    ch->user_data_type = EXR_PIXEL_FLOAT;
+    ch->user_bytes_per_element = (int16_t)sizeof(float);
+    ch->user_pixel_stride = (int32_t)(RGB * sizeof(float));
+    ch->user_line_stride = (int32_t)((size_t)width * RGB * sizeof(float));
+    return slot < 0 ? -1 : (long)(slot * sizeof(float));
+}
+
 /* Points every channel of the pipeline at its slot of the chunk's first row. */
-static void point_channels(exr_coding_channel_info_t *ch, int nch, const uint8_t *row, int width)
+static void point_encode(exr_coding_channel_info_t *ch, int nch, const uint8_t *row, int width)
 {
     for (int c = 0; c < nch; c++) {
-        int slot = channel_slot(ch[c].channel_name);
-        ch[c].user_data_type = EXR_PIXEL_FLOAT;
-        ch[c].user_bytes_per_element = (int16_t)sizeof(float);
-        ch[c].user_pixel_stride = (int32_t)(RGB * sizeof(float));
-        ch[c].user_line_stride = (int32_t)((size_t)width * RGB * sizeof(float));
-        ch[c].encode_from_ptr = slot < 0 ? NULL : row + (size_t)slot * sizeof(float);
+        long off = set_layout(&ch[c], width);
+        ch[c].encode_from_ptr = off < 0 ? NULL : row + off;
+    }
+}
+
+static void point_decode(exr_coding_channel_info_t *ch, int nch, uint8_t *row, int width)
+{
+    for (int c = 0; c < nch; c++) {
+        long off = set_layout(&ch[c], width);
+        ch[c].decode_to_ptr = off < 0 ? NULL : row + off;
     }
 }
 
@@ -88,7 +108,7 @@ static exr_result_t write_chunks(exr_context_t ctxt, int width, int height, cons
         if (rv != EXR_ERR_SUCCESS)
             break;
         const uint8_t *row = (const uint8_t *)(rgb + (size_t)y * (size_t)width * RGB);
-        point_channels(enc.channels, enc.channel_count, row, width);
+        point_encode(enc.channels, enc.channel_count, row, width);
         if (!started)
             rv = exr_encoding_choose_default_routines(ctxt, 0, &enc);
         started = 1;
@@ -100,7 +120,8 @@ static exr_result_t write_chunks(exr_context_t ctxt, int width, int height, cons
     return rv;
 }
 
-int ppb_exr_write_rgb(const char *path, int width, int height, const float *rgb, ppb_err *err)
+int ppb_exr_write_rgb(const char *path, int width, int height, const float *rgb,
+                      const ppb_exr_attr *attrs, int nattrs, ppb_err *err)
 {
     if (width <= 0 || height <= 0)
         return ppb_fail(err, "%s: empty image %dx%d", path, width, height);
@@ -114,7 +135,7 @@ int ppb_exr_write_rgb(const char *path, int width, int height, const float *rgb,
     exr_result_t rv = exr_start_write(&ctxt, ap.tmp, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv == EXR_ERR_SUCCESS) {
         stage = "cannot define the image";
-        rv = define_part(ctxt, width, height);
+        rv = define_part(ctxt, width, height, attrs, nattrs);
     }
     if (rv == EXR_ERR_SUCCESS) {
         stage = "cannot write the header";
@@ -137,18 +158,6 @@ int ppb_exr_write_rgb(const char *path, int width, int height, const float *rgb,
 }
 
 /* Decoding mirrors write_chunks; channels other than R, G, B are skipped (NULL pointer). */
-static void point_decode(exr_coding_channel_info_t *ch, int nch, uint8_t *row, int width)
-{
-    for (int c = 0; c < nch; c++) {
-        int slot = channel_slot(ch[c].channel_name);
-        ch[c].user_data_type = EXR_PIXEL_FLOAT;
-        ch[c].user_bytes_per_element = (int16_t)sizeof(float);
-        ch[c].user_pixel_stride = (int32_t)(RGB * sizeof(float));
-        ch[c].user_line_stride = (int32_t)((size_t)width * RGB * sizeof(float));
-        ch[c].decode_to_ptr = slot < 0 ? NULL : row + (size_t)slot * sizeof(float);
-    }
-}
-
 static exr_result_t read_chunks(exr_context_t ctxt, int y0, int width, int height, float *rgb)
 {
     int32_t lines = 0;

@@ -6,7 +6,11 @@
  * <out_dir>/images/, every file atomically:
  *   <method>.exr        linear 32-bit float RGB, R = G = B = the radiance toward the camera
  *                       (1/sr per unit E_perp); 0 on the background and on the cut caps. No
- *                       arrow, no labels: the data.
+ *                       arrow, no labels: the data. Its header carries string attributes
+ *                       (as pbrt-v4 writes its settings into its EXRs): ppbench.method,
+ *                       ppbench.case, ppbench.seed, ppbench.photons (mc.photons),
+ *                       ppbench.version and ppbench.shows (what the pixels are: quantity,
+ *                       unit, the two views and their surfaces).
  *   <method>.png        tone-mapped: x = L / L_white through a shoulder curve, then
  *                       sRGB-encoded. L_white is set PER VIEW and shared by all methods: the
  *                       99th percentile of the reference's (Monte Carlo's, else the first
@@ -63,6 +67,7 @@ static const rgb8 cool = {59, 76, 192}, neutral = {221, 221, 221}, warm = {180, 
 /* Everything rendered once and shared by the writers. */
 typedef struct img_ctx {
     const ppb_scene *scene;
+    const ppb_image_meta *meta; /* NULL: attributes "unknown" */
     const ppb_result *res;
     int n;
     char dir[1100];
@@ -212,6 +217,12 @@ static void image_path(const img_ctx *c, const char *prefix, const char *method,
     snprintf(path, cap, "%s/%s%s.%s", c->dir, prefix, method, ext);
 }
 
+/* What every EXR shows, in its ppbench.shows attribute (the header comment above). */
+static const char exr_shows[] =
+    "radiance toward the camera, 1/sr per unit E_perp (scattered light only), R = G = B; "
+    "top half: view from above-left (S1 and S3), bottom half: view from below-left (S2 and "
+    "S3), tube clipped to |z| <= 0.4 W; 0 on the background and the cut caps";
+
 static int write_exr(const img_ctx *c, int i, ppb_err *err)
 {
     float *rgb = malloc(3 * PANEL_PIXELS * sizeof *rgb);
@@ -219,9 +230,24 @@ static int write_exr(const img_ctx *c, int i, ppb_err *err)
         return ppb_fail(err, "images: out of memory");
     for (size_t k = 0; k < PANEL_PIXELS; k++)
         rgb[3 * k] = rgb[3 * k + 1] = rgb[3 * k + 2] = c->value[i][k];
+    const ppb_image_meta *m = c->meta;
+    char seed[32] = "unknown", photons[32] = "unknown";
+    if (m) {
+        snprintf(seed, sizeof seed, "%lld", m->seed);
+        snprintf(photons, sizeof photons, "%lld", m->photons);
+    }
+    const ppb_exr_attr attrs[] = {
+        {"ppbench.method", c->res[i].method},
+        {"ppbench.case", m && m->case_name ? m->case_name : "unknown"},
+        {"ppbench.seed", seed},
+        {"ppbench.photons", photons},
+        {"ppbench.version", m && m->version ? m->version : "unknown"},
+        {"ppbench.shows", exr_shows},
+    };
     char path[1300];
     image_path(c, "", c->res[i].method, "exr", path, sizeof path);
-    int rc = ppb_exr_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
+    int rc = ppb_exr_write_rgb(path, VIEW_NX, PANEL_NY, rgb, attrs,
+                               (int)(sizeof attrs / sizeof attrs[0]), err);
     free(rgb);
     return rc;
 }
@@ -284,12 +310,13 @@ static int write_all(const img_ctx *c, ppb_err *err)
     return 0;
 }
 
-int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_result *res, int n,
-                     int ref, ppb_err *err)
+int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_image_meta *meta,
+                     const ppb_result *res, int n, int ref, ppb_err *err)
 {
     if (sc->geometry != PPB_GEOM_TUBE || n <= 0)
         return 0;
-    img_ctx c = {.scene = sc, .res = res, .n = n, .ref = (ref >= 0 && ref < n) ? ref : -1};
+    img_ctx c = {
+        .scene = sc, .meta = meta, .res = res, .n = n, .ref = (ref >= 0 && ref < n) ? ref : -1};
     snprintf(c.dir, sizeof c.dir, "%s/images", out_dir);
     if (ppb_mkdirs(c.dir, err))
         return -1;

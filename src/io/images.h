@@ -11,10 +11,19 @@
 #include "model/result.h"
 #include "model/scene.h"
 
+/* What the run was, written into every EXR's header (issue 16; reference: Outputs) with the
+ * method and what the image shows. NULL strings are written as "unknown". */
+typedef struct ppb_image_meta {
+    const char *case_name; /* experiment.name */
+    const char *version;   /* ppbench's version (provenance.txt's ppbench.version) */
+    long long seed;        /* mc.seed */
+    long long photons;     /* mc.photons, the Monte Carlo's budget */
+} ppb_image_meta;
+
 /* Writes the images of n results of one scene under <out_dir>/images/; nothing in slab mode.
  * res[ref] is the reference (exposure and error images); ref < 0: none, the exposure follows
- * res[0] and no error images are written. */
-int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_result *res, int n,
-                     int ref, ppb_err *err);
+ * res[0] and no error images are written. meta may be NULL (every attribute "unknown"). */
+int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_image_meta *meta,
+                     const ppb_result *res, int n, int ref, ppb_err *err);
 
 #endif
