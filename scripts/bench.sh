@@ -7,9 +7,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=results
 sets=()
+quick=0
 while [ $# -gt 0 ]; do
   case $1 in
-    --quick) out=build/bench-quick
+    --quick) out=build/bench-quick quick=1
              sets+=(--set mc.photons=2e6 --set pp.directions=128 --set bins.samples_dir=2
                    --set rte2d.spacing=0.25 --set rte2d.directions=48) ;;
     --out) out=$2; shift ;;
@@ -31,5 +32,19 @@ for i in "${!cases[@]}"; do
   theta=$(awk -F' *= *' '$1 == "theta_deg" {print $2}' "configs/$c.ini")
   bash scripts/plots.sh "$out/$c" "${theta:-0}"
 done
+# The quick study's README says what it is: ppbench report copies notes.md into it (and states
+# the photon budget itself, from the cases' provenance.txt).
+if [ $quick = 1 ]; then
+  settings=$(printf '%s ' "${sets[@]}" | sed 's/--set //g; s/ $//; s/ /, /g')
+  cat > "$out/notes.md" <<EOF
+
+## The quick study
+
+This is the quick study (\`QUICK=1 make bench\`, \`scripts/bench.sh --quick\`), a look in a few
+minutes, run with $settings instead of the configs' own settings. Its noise floor (above) is
+far higher than that of the full study in results/ (\`make bench\`): its numbers are not the
+study's.
+EOF
+fi
 ./ppbench report "$out" "${cases[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2

@@ -9,7 +9,11 @@
  * - progress lines when stderr is not a terminal: no \r, at most one line per
  *   PPB_PROGRESS_LOG_SECONDS; on a terminal (a pty) the line is still rewritten with \r;
  *   a count of one takes the singular ("1 point");
- * - run --quiet prints one line, where the results went.
+ * - run --quiet prints one line, where the results went; mc-merge and report end with that
+ *   line too;
+ * - the study README (report): Table 2 wide (cases x methods), the noise floor from the
+ *   Monte Carlo's own standard errors, the photon budget, a footer naming only files that
+ *   exist and are committed (not radiance.csv).
  * Photon budgets and grids are tiny. */
 #define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "cliutil.h"
@@ -257,6 +261,137 @@ static void test_quiet_says_where(void **state)
         fail_msg("run --quiet: exit %d, want exactly '%s', got:\n%s", rc, want, cli_out);
 }
 
+/* The last line of the output: where cli_out's text ends, back to the line before. */
+static const char *last_line(const char *s)
+{
+    size_t n = strlen(s);
+    if (n > 0 && s[n - 1] == '\n')
+        n--;
+    while (n > 0 && s[n - 1] != '\n')
+        n--;
+    return s + n;
+}
+
+/* mc-merge (and mc-shard before it) end, like run, with the one line saying where the results
+ * went: "NAME: wrote DIR". */
+static void test_mc_merge_says_where(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxmerge", tiny);
+    const char *s = tu_scratch("uxmerge_out");
+    char args[5000], want[1400];
+    for (int i = 1; i <= 2; i++) {
+        snprintf(args, sizeof args,
+                 "mc-shard --quiet --set experiment.name=m --shard %d/2 --out %s/p%d %s", i, s, i,
+                 cfg);
+        cli_expect(args, 0, "");
+    }
+    snprintf(args, sizeof args, "mc-merge --set experiment.name=m --out %s/merged %s %s/p1 %s/p2",
+             s, cfg, s, s);
+    snprintf(want, sizeof want, "m: wrote %s/merged\n", s);
+    int rc = cli_run_env("", args, cli_out, sizeof cli_out);
+    if (rc != 0 || strcmp(last_line(cli_out), want))
+        fail_msg("mc-merge: exit %d, want its last line '%s', got:\n%s", rc, want, cli_out);
+}
+
+/* A study of two small cases for the report tests: mc, ss and mp (cheap), 2e4 and 3e4
+ * photons. */
+static const char *small_study(void)
+{
+    static char s[1200];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxreport"));
+    const char *cfg = cli_config("uxreport", tiny);
+    char args[5000];
+    const char *cases[2] = {"a", "b"};
+    const char *photons[2] = {"2e4", "3e4"};
+    for (int i = 0; i < 2; i++) {
+        snprintf(args, sizeof args,
+                 "run --quiet --set experiment.methods=mc,ss,mp --set mc.photons=%s --out %s/%s "
+                 "%s",
+                 photons[i], s, cases[i], cfg);
+        cli_expect(args, 0, "wrote");
+    }
+    return s;
+}
+
+/* report ends with "ppbench report: wrote DIR (3 files)"; its README gives Table 2 wide (a
+ * column per method, the paper's methods in its order: MP before S), the noise floor from the
+ * Monte Carlo's own standard errors (summary.csv's noise_rel at x = 0), the photon budget from
+ * provenance.txt, and a footer naming only files that exist and never radiance.csv (not
+ * committed: .gitignore). */
+static void test_report_readme(void **state)
+{
+    (void)state;
+    const char *s = small_study();
+    char args[3000], want[1400], path[1400];
+    snprintf(args, sizeof args, "report %s a b", s);
+    snprintf(want, sizeof want, "ppbench report: wrote %s (3 files)\n", s);
+    int rc = cli_run_env("", args, cli_out, sizeof cli_out);
+    if (rc != 0 || strcmp(last_line(cli_out), want))
+        fail_msg("report: exit %d, want its last line '%s', got:\n%s", rc, want, cli_out);
+    snprintf(path, sizeof path, "%s/README.md", s);
+    const char *readme = slurp(path, NULL);
+    const char *lines[] = {"\n| case | cell | mp | ss | MC noise |\n|---|---|---|---|---|\n",
+                           "\n| a | R_x0 | ",
+                           "\n| a | T_x0 | ",
+                           "\n| b | R_x0 | ",
+                           "\n| b | T_x0 | ",
+                           "\nMonte Carlo budget (mc.photons in each case's provenance.txt): "
+                           "2e4 photons per case, 3e4 for b.\n",
+                           "\n## Noise floor\n"};
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++)
+        if (!strstr(readme, lines[i]))
+            fail_msg("README.md lacks '%s':\n%s", lines[i], readme);
+    /* The MC noise column at a's R_x0 is summary.csv's noise_rel there, in percent. */
+    snprintf(path, sizeof path, "%s/a/summary.csv", s);
+    const char *summary = slurp(path, NULL);
+    const char *row = strstr(summary, "\nss,R_x0,");
+    assert_non_null(row);
+    double rms, noise;
+    assert_int_equal(sscanf(row, "\nss,R_x0,%lf,%lf", &rms, &noise), 2);
+    char cell[200];
+    snprintf(cell, sizeof cell, "\n| a | R_x0 | ");
+    readme = slurp(strcat(strcpy(path, s), "/README.md"), NULL);
+    const char *r = strstr(readme, cell);
+    assert_non_null(r);
+    char ss_cell[64], noise_cell[64];
+    snprintf(ss_cell, sizeof ss_cell, " %.1f |", 100 * rms);
+    snprintf(noise_cell, sizeof noise_cell, " %.1f |\n", 100 * noise);
+    const char *eol = strchr(r + 1, '\n');
+    if (!strstr(r, ss_cell) || strstr(r, ss_cell) > eol || !strstr(r, noise_cell) ||
+        strstr(r, noise_cell) > eol)
+        fail_msg("row '%.*s' lacks ss's RMS%s or the noise%s of summary.csv", (int)(eol - r - 1),
+                 r + 1, ss_cell, noise_cell);
+    /* The footer: each file it names exists in both cases; radiance.csv (present) is not
+     * named as one of them. */
+    const char *foot = strstr(readme, "\nEach case's directory holds plots/ and images/");
+    assert_non_null(foot);
+    const char *list = strstr(foot, "version) and ");
+    const char *end = strstr(foot, " (docs/reference.md, Outputs");
+    assert_true(list && end && list < end);
+    list += strlen("version) and ");
+    char names[2000];
+    snprintf(names, sizeof names, "%.*s", (int)(end - list), list);
+    int named = 0;
+    for (char *tok = strtok(names, ", "); tok; tok = strtok(NULL, ", ")) {
+        if (!strcmp(tok, "and"))
+            continue;
+        named++;
+        if (!strcmp(tok, "radiance.csv"))
+            fail_msg("the footer names radiance.csv, which is not committed:\n%s", foot);
+        for (int c = 0; c < 2; c++) {
+            snprintf(path, sizeof path, "%s/%s/%s", s, c ? "b" : "a", tok);
+            if (access(path, R_OK))
+                fail_msg("the footer names %s, which %s lacks:\n%s", tok, c ? "b" : "a", foot);
+        }
+    }
+    snprintf(path, sizeof path, "%s/a/radiance.csv", s);
+    assert_int_equal(access(path, R_OK), 0);
+    if (named < 5 || !strstr(foot, "summary.csv") || !strstr(foot, "provenance.txt"))
+        fail_msg("the footer names %d files, want summary.csv and provenance.txt among them:\n%s",
+                 named, foot);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -267,6 +402,8 @@ int main(void)
         cmocka_unit_test(test_progress_rewrites_on_terminal),
         cmocka_unit_test(test_run_log_has_no_cr),
         cmocka_unit_test(test_quiet_says_where),
+        cmocka_unit_test(test_mc_merge_says_where),
+        cmocka_unit_test(test_report_readme),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

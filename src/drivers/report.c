@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "base/atomic_file.h"
 #include "base/csv_read.h"
@@ -80,6 +81,118 @@ static int read_summary(const char *dir, const char *name, summary_row *rows, in
     return rc < 0 ? -1 : n;
 }
 
+/* What the report reads of one case: its summary rows, the Monte Carlo's own noise per
+ * segment (rms.csv) and its photon budget (provenance.txt). */
+enum { MAX_ROWS = 512, MAX_SEGS = 1024 };
+
+typedef struct case_data {
+    summary_row *rows;
+    int n;
+    double seg_lo[4], seg_hi[4]; /* noise_rel per segment of S1..S4, min and max; NAN: none */
+    long long photons;           /* mc.photons; -1 when provenance.txt does not say */
+} case_data;
+
+/* The noise floor per segment: rms.csv's noise_rel combines the reference's standard errors
+ * with the method's (reference: Metrics), which are 0 for deterministic methods, so the
+ * smallest over the methods of a segment is the Monte Carlo's own. A case without rms.csv
+ * (no reference) leaves NAN. */
+static void read_segment_noise(const char *dir, const char *name, case_data *cd)
+{
+    for (int s = 0; s < 4; s++)
+        cd->seg_lo[s] = cd->seg_hi[s] = NAN;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s/rms.csv", dir, name);
+    ppb_csv c;
+    ppb_err e;
+    if (ppb_csv_open(&c, path, &e))
+        return;
+    int cs = ppb_csv_need(&c, "surface", &e), cg = ppb_csv_need(&c, "segment", &e),
+        cn = ppb_csv_need(&c, "noise_rel", &e);
+    double(*floor)[MAX_SEGS] = malloc(4 * sizeof *floor);
+    if (cs < 0 || cg < 0 || cn < 0 || !floor) {
+        free(floor);
+        ppb_csv_close(&c);
+        return;
+    }
+    for (int s = 0; s < 4; s++)
+        for (int k = 0; k < MAX_SEGS; k++)
+            floor[s][k] = INFINITY;
+    while (ppb_csv_next(&c, &e) == 1) {
+        const char *surf = ppb_csv_get(&c, cs);
+        double seg, noise;
+        if (surf[0] != 'S' || surf[1] < '1' || surf[1] > '4' || surf[2] ||
+            !ppb_csv_double(&c, cg, &seg) || !ppb_csv_double(&c, cn, &noise) || !(seg >= 0) ||
+            seg >= MAX_SEGS || !isfinite(noise))
+            continue;
+        double *f = &floor[surf[1] - '1'][(int)seg];
+        if (noise < *f)
+            *f = noise;
+    }
+    ppb_csv_close(&c);
+    for (int s = 0; s < 4; s++)
+        for (int k = 0; k < MAX_SEGS; k++) {
+            double v = floor[s][k];
+            if (!isfinite(v))
+                continue;
+            if (isnan(cd->seg_lo[s]) || v < cd->seg_lo[s])
+                cd->seg_lo[s] = v;
+            if (isnan(cd->seg_hi[s]) || v > cd->seg_hi[s])
+                cd->seg_hi[s] = v;
+        }
+    free(floor);
+}
+
+/* mc.photons from the case's provenance.txt (reference: Outputs), -1 when absent. */
+static long long read_photons(const char *dir, const char *name)
+{
+    char path[1200], line[512];
+    snprintf(path, sizeof path, "%s/%s/provenance.txt", dir, name);
+    FILE *f = fopen(path, "r");
+    long long n = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "mc.photons = %lld", &n) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return n;
+}
+
+static void free_cases(case_data *cd, int ncases)
+{
+    for (int c = 0; cd && c < ncases; c++)
+        free(cd[c].rows);
+    free(cd);
+}
+
+static case_data *load_cases(const char *dir, const char *const *cases, int ncases, ppb_err *err)
+{
+    case_data *cd = calloc((size_t)ncases, sizeof *cd);
+    if (!cd) {
+        ppb_fail(err, "report: out of memory");
+        return NULL;
+    }
+    for (int c = 0; c < ncases; c++) {
+        cd[c].rows = malloc(MAX_ROWS * sizeof *cd[c].rows);
+        if (!cd[c].rows) {
+            ppb_fail(err, "report: out of memory");
+            free_cases(cd, ncases);
+            return NULL;
+        }
+        if ((cd[c].n = read_summary(dir, cases[c], cd[c].rows, MAX_ROWS, err)) < 0) {
+            free_cases(cd, ncases);
+            return NULL;
+        }
+        read_segment_noise(dir, cases[c], &cd[c]);
+        cd[c].photons = read_photons(dir, cases[c]);
+    }
+    return cd;
+}
+
+static int is_table2_cell(const char *cell)
+{
+    return !strcmp(cell, "R_x0") || !strcmp(cell, "T_x0");
+}
+
 /* The first line of each file report writes, by which it knows its own (issue 14). table2.csv
  * and table2.md start with their header rows, which no other file has; README.md with an HTML
  * comment (invisible on the rendered page). A README.md an earlier ppbench report wrote starts
@@ -127,7 +240,8 @@ static void md_cell(FILE *f, double v)
     fprintf(f, isnan(v) ? " - |" : " %.1f |", v);
 }
 
-static int write_tables(const char *dir, const char *const *cases, int ncases, ppb_err *err)
+static int write_tables(const char *dir, const char *const *cases, const case_data *cd, int ncases,
+                        ppb_err *err)
 {
     char path[1200];
     ppb_afile csv, md;
@@ -142,17 +256,10 @@ static int write_tables(const char *dir, const char *const *cases, int ncases, p
     fprintf(csv.f, "%s\n", csv_header);
     fprintf(md.f, "%s\n", md_header);
     fprintf(md.f, "|---|---|---|---|---|---|---|\n");
-    summary_row rows[512]; /* 36 KB */
-    for (int c = 0; c < ncases; c++) {
-        int n = read_summary(dir, cases[c], rows, 512, err);
-        if (n < 0) {
-            ppb_afile_abort(&csv);
-            ppb_afile_abort(&md);
-            return -1;
-        }
-        for (int i = 0; i < n; i++) {
-            const summary_row *r = &rows[i];
-            if (strcmp(r->cell, "R_x0") && strcmp(r->cell, "T_x0"))
+    for (int c = 0; c < ncases; c++)
+        for (int i = 0; i < cd[c].n; i++) {
+            const summary_row *r = &cd[c].rows[i];
+            if (!is_table2_cell(r->cell))
                 continue;
             double pv = paper_value(cases[c], r->cell, r->method);
             fprintf(csv.f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g\n", cases[c], r->cell, r->method, r->rms,
@@ -164,7 +271,6 @@ static int write_tables(const char *dir, const char *const *cases, int ncases, p
             md_cell(md.f, pv);
             fputc('\n', md.f);
         }
-    }
     if (commit_said(&csv, err)) {
         ppb_afile_abort(&md);
         return -1;
@@ -219,7 +325,267 @@ static void link_error_images(FILE *f, const char *dir, const char *name)
         fprintf(f, "\n");
 }
 
-static int write_readme(const char *dir, const char *const *cases, int ncases, ppb_err *err)
+/* The wide table's columns: the paper's methods in its order (proposed, MP, MP+S, S), then
+ * every other method in the order the cases list them. */
+enum { MAX_COLS = 32 };
+
+static int table_methods(const case_data *cd, int ncases, char cols[][32])
+{
+    static const char *const paper_order[] = {"pp", "mp", "mp+ss", "ss"};
+    int n = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (int c = 0; c < ncases; c++)
+            for (int i = 0; i < cd[c].n && n < MAX_COLS; i++) {
+                const char *m = cd[c].rows[i].method;
+                int in_paper = 0, seen = 0;
+                for (size_t k = 0; k < sizeof paper_order / sizeof paper_order[0]; k++)
+                    in_paper |= !strcmp(m, paper_order[k]);
+                for (int k = 0; k < n; k++)
+                    seen |= !strcmp(m, cols[k]);
+                if (seen || !is_table2_cell(cd[c].rows[i].cell) || in_paper != (pass == 0))
+                    continue;
+                snprintf(cols[n++], 32, "%s", m);
+            }
+    /* The paper's methods found in the first pass came in case order: put them in its order. */
+    int np = 0;
+    char sorted[MAX_COLS][32];
+    for (size_t k = 0; k < sizeof paper_order / sizeof paper_order[0]; k++)
+        for (int j = 0; j < n; j++)
+            if (!strcmp(cols[j], paper_order[k]))
+                memcpy(sorted[np++], cols[j], sizeof sorted[0]);
+    for (int j = 0; j < n; j++) {
+        int in_paper = 0;
+        for (size_t k = 0; k < sizeof paper_order / sizeof paper_order[0]; k++)
+            in_paper |= !strcmp(cols[j], paper_order[k]);
+        if (!in_paper)
+            memcpy(sorted[np++], cols[j], sizeof sorted[0]);
+    }
+    memcpy(cols, sorted, (size_t)n * sizeof sorted[0]);
+    return n;
+}
+
+static const summary_row *find_row(const case_data *cd, const char *method, const char *cell)
+{
+    for (int i = 0; i < cd->n; i++)
+        if (!strcmp(cd->rows[i].method, method) && !strcmp(cd->rows[i].cell, cell))
+            return &cd->rows[i];
+    return NULL;
+}
+
+/* Table 2 as the paper gives it: a row per case and cell, a column per method, RMS % with the
+ * paper's value in parentheses, and the Monte Carlo's noise floor at that cell. */
+static void write_wide_table(FILE *f, const char *const *cases, const case_data *cd, int ncases)
+{
+    char cols[MAX_COLS][32];
+    int ncols = table_methods(cd, ncases, cols);
+    fprintf(f, "| case | cell |");
+    for (int j = 0; j < ncols; j++)
+        fprintf(f, " %s |", cols[j]);
+    fprintf(f, " MC noise |\n|---|---|");
+    for (int j = 0; j <= ncols; j++)
+        fprintf(f, "---|");
+    fputc('\n', f);
+    static const char *const cells[2] = {"R_x0", "T_x0"};
+    for (int c = 0; c < ncases; c++)
+        for (int k = 0; k < 2; k++) {
+            fprintf(f, "| %s | %s |", cases[c], cells[k]);
+            double noise = NAN;
+            for (int j = 0; j < ncols; j++) {
+                const summary_row *r = find_row(&cd[c], cols[j], cells[k]);
+                double pv = paper_value(cases[c], cells[k], cols[j]);
+                if (!r)
+                    fprintf(f, " - |");
+                else if (isnan(pv))
+                    fprintf(f, " %.1f |", 100 * r->rms);
+                else
+                    fprintf(f, " %.1f (%g) |", 100 * r->rms, pv);
+                if (r && !(r->noise >= noise)) /* the smallest: the Monte Carlo's own */
+                    noise = r->noise;
+            }
+            md_cell(f, 100 * noise);
+            fputc('\n', f);
+        }
+}
+
+static void range_pct(FILE *f, double lo, double hi)
+{
+    if (isnan(lo))
+        fprintf(f, " - |");
+    else
+        fprintf(f, " %.1f-%.1f |", 100 * lo, 100 * hi);
+}
+
+/* The Monte Carlo's noise floor: at the Table 2 cells (summary.csv) and per segment of each
+ * surface (rms.csv), with one sentence giving the ranges over all cases. */
+static void write_noise(FILE *f, const char *const *cases, const case_data *cd, int ncases)
+{
+    double x0_lo = INFINITY, x0_hi = -INFINITY;
+    for (int c = 0; c < ncases; c++)
+        for (int i = 0; i < cd[c].n; i++)
+            if (is_table2_cell(cd[c].rows[i].cell) && isfinite(cd[c].rows[i].noise)) {
+                double v = cd[c].rows[i].noise;
+                x0_lo = v < x0_lo ? v : x0_lo;
+                x0_hi = v > x0_hi ? v : x0_hi;
+            }
+    /* Per segment: the range over the cases whose segments stay within twice the x = 0
+     * floor, and each case beyond it named with its own range. */
+    double lo = INFINITY, hi = -INFINITY, limit = 2 * x0_hi;
+    int nseg = 0, nout = 0;
+    for (int c = 0; c < ncases; c++) {
+        double clo = INFINITY, chi = -INFINITY;
+        for (int s = 0; s < 4; s++)
+            if (!isnan(cd[c].seg_lo[s])) {
+                clo = cd[c].seg_lo[s] < clo ? cd[c].seg_lo[s] : clo;
+                chi = cd[c].seg_hi[s] > chi ? cd[c].seg_hi[s] : chi;
+            }
+        if (!isfinite(clo))
+            continue;
+        nseg++;
+        if (isfinite(limit) && chi > limit) {
+            nout++;
+            continue;
+        }
+        lo = clo < lo ? clo : lo;
+        hi = chi > hi ? chi : hi;
+    }
+    fprintf(f, "\n## Noise floor\n\n");
+    fprintf(f, "The Monte Carlo's own relative standard error (noise_rel, from its batches; "
+               "docs/reference.md, Metrics)");
+    if (isfinite(x0_lo))
+        fprintf(f, ": %.1f-%.1f%% at the Table 2 cells (x = 0)", 100 * x0_lo, 100 * x0_hi);
+    if (nseg > 0) {
+        fprintf(f, "; per segment of S1-S4 (rms.csv)");
+        if (isfinite(lo))
+            fprintf(f, " %.1f-%.1f%%%s", 100 * lo, 100 * hi,
+                    nout ? " in every case but" : (nseg > 1 ? " in every case" : ""));
+        for (int c = 0, k = 0; c < ncases && nout; c++) {
+            double clo = INFINITY, chi = -INFINITY;
+            for (int s = 0; s < 4; s++)
+                if (!isnan(cd[c].seg_lo[s])) {
+                    clo = cd[c].seg_lo[s] < clo ? cd[c].seg_lo[s] : clo;
+                    chi = cd[c].seg_hi[s] > chi ? cd[c].seg_hi[s] : chi;
+                }
+            if (!isfinite(clo) || !(chi > limit))
+                continue;
+            fprintf(f, "%s %s (%.1f-%.1f%%)", k++ ? "," : "", cases[c], 100 * clo, 100 * chi);
+        }
+    }
+    fprintf(f, ". An RMS error well above it is the method's; `excess` in table2.csv removes "
+               "it. In percent:\n\n");
+    fprintf(f, "| case | R_x0 | T_x0 | S1 per segment | S2 per segment | S3 per segment | S4 per "
+               "segment |\n|---|---|---|---|---|---|---|\n");
+    for (int c = 0; c < ncases; c++) {
+        fprintf(f, "| %s |", cases[c]);
+        static const char *const cells[2] = {"R_x0", "T_x0"};
+        for (int k = 0; k < 2; k++) {
+            double v = NAN;
+            for (int i = 0; i < cd[c].n; i++)
+                if (!strcmp(cd[c].rows[i].cell, cells[k]) && !(cd[c].rows[i].noise >= v))
+                    v = cd[c].rows[i].noise;
+            md_cell(f, 100 * v);
+        }
+        for (int s = 0; s < 4; s++)
+            range_pct(f, cd[c].seg_lo[s], cd[c].seg_hi[s]);
+        fputc('\n', f);
+    }
+}
+
+/* A photon count as the configs write it when it is a round number (4e8), else in full. */
+static void photons_text(char *buf, size_t cap, long long n)
+{
+    long long m = n;
+    int e = 0;
+    while (m >= 10 && m % 10 == 0) {
+        m /= 10;
+        e++;
+    }
+    if (e >= 3 && m < 1000)
+        snprintf(buf, cap, "%llde%d", m, e);
+    else
+        snprintf(buf, cap, "%lld", n);
+}
+
+/* One sentence: the budget most cases share, "per case", and the cases that differ. */
+static void write_budget(FILE *f, const char *const *cases, const case_data *cd, int ncases)
+{
+    int best = -1, best_count = 0;
+    for (int c = 0; c < ncases; c++) {
+        int count = 0;
+        for (int d = 0; d < ncases; d++)
+            count += cd[d].photons == cd[c].photons;
+        if (cd[c].photons > 0 && count > best_count) {
+            best = c;
+            best_count = count;
+        }
+    }
+    if (best < 0)
+        return;
+    char t[64];
+    photons_text(t, sizeof t, cd[best].photons);
+    fprintf(f, "Monte Carlo budget (mc.photons in each case's provenance.txt): %s photons per case",
+            t);
+    for (int c = 0; c < ncases; c++)
+        if (cd[c].photons != cd[best].photons) {
+            if (cd[c].photons > 0)
+                photons_text(t, sizeof t, cd[c].photons);
+            else
+                snprintf(t, sizeof t, "unknown");
+            fprintf(f, ", %s for %s", t, cases[c]);
+        }
+    fprintf(f, ".\n\n");
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp((const char *)a, (const char *)b);
+}
+
+/* The footer: the top-level files of the case directories (their union, sorted) but
+ * radiance.csv, which .gitignore keeps out of results/ (reference: Outputs). */
+static void write_footer(FILE *f, const char *dir, const char *const *cases, int ncases)
+{
+    enum { MAX_FILES = 64 };
+    char names[MAX_FILES][128];
+    int n = 0, radiance = 0;
+    for (int c = 0; c < ncases; c++) {
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s", dir, cases[c]);
+        DIR *d = opendir(path);
+        for (struct dirent *e = d ? readdir(d) : NULL; e; e = readdir(d)) {
+            char file[1500];
+            snprintf(file, sizeof file, "%s/%s", path, e->d_name);
+            struct stat st;
+            if (e->d_name[0] == '.' || stat(file, &st) || !S_ISREG(st.st_mode) ||
+                strlen(e->d_name) >= sizeof names[0])
+                continue;
+            if (!strcmp(e->d_name, "radiance.csv")) {
+                radiance = 1;
+                continue;
+            }
+            int seen = 0;
+            for (int k = 0; k < n; k++)
+                seen |= !strcmp(names[k], e->d_name);
+            if (!seen && n < MAX_FILES)
+                memcpy(names[n++], e->d_name, strlen(e->d_name) + 1); /* length checked above */
+        }
+        if (d)
+            closedir(d);
+    }
+    qsort(names, (size_t)n, sizeof names[0], cmp_str);
+    fprintf(f, "\nEach case's directory holds plots/ and images/ (above; `images/<method>.exr` is "
+               "the linear radiance, its header naming the method, case, seed, photons and "
+               "version)");
+    for (int k = 0; k < n; k++)
+        fprintf(f, "%s%s", k == 0 ? " and " : (k == n - 1 ? " and " : ", "), names[k]);
+    fprintf(f, " (docs/reference.md, Outputs, says what each holds).");
+    if (radiance)
+        fprintf(f, " radiance.csv, every bin's radiance (megabytes per case), is written by "
+                   "`ppbench run` but not kept in the repository (.gitignore).");
+    fprintf(f, "\n");
+}
+
+static int write_readme(const char *dir, const char *const *cases, const case_data *cd, int ncases,
+                        ppb_err *err)
 {
     char path[1200];
     ppb_afile af;
@@ -228,11 +594,15 @@ static int write_readme(const char *dir, const char *const *cases, int ncases, p
         return -1;
     FILE *f = af.f;
     fprintf(f, "%s\n%s\n\n", readme_mark, readme_mark_v1);
-    fprintf(f, "RMS error against the Monte Carlo (docs/reference.md) at the two segments next "
-               "to x = 0 on S1 (R) and S2 (T), beside the paper's Table 2 and the Monte "
-               "Carlo's own noise floor. `excess` removes the noise: sqrt(rms^2 - noise^2).\n\n");
-    snprintf(path, sizeof path, "%s/table2.md", dir);
-    copy_file(f, path);
+    write_budget(f, cases, cd, ncases);
+    fprintf(f, "## Table 2\n\n");
+    fprintf(f, "RMS error against the Monte Carlo (docs/reference.md) in percent at the two "
+               "segments next to x = 0 on S1 (R_x0) and S2 (T_x0), the paper's Table 2 value "
+               "in parentheses, and the Monte Carlo's own noise floor there. table2.csv (and "
+               "table2.md) give the same rows one per method, with `excess` = "
+               "sqrt(rms^2 - noise^2), the RMS with the noise removed.\n\n");
+    write_wide_table(f, cases, cd, ncases);
+    write_noise(f, cases, cd, ncases);
     snprintf(path, sizeof path, "%s/notes.md", dir);
     copy_file(f, path);
     fprintf(f, "\n## Plots\n\n");
@@ -248,9 +618,7 @@ static int write_readme(const char *dir, const char *const *cases, int ncases, p
         fprintf(f, "- %s: ![all methods](%s/images/all.png)\n", cases[c], cases[c]);
         link_error_images(f, dir, cases[c]);
     }
-    fprintf(f, "\nEach case's directory holds radiance.csv, rms.csv, summary.csv, totals.csv, "
-               "summary_mc1.csv, timings.csv and provenance.txt (config, seed, photons, "
-               "device, version, timings).\n");
+    write_footer(f, dir, cases, ncases);
     return commit_said(&af, err);
 }
 
@@ -270,7 +638,15 @@ int ppb_report_write(const char *dir, const char *const *cases, int ncases, ppb_
         if (check_own(path, outs[i].marks, err))
             return PPB_REPORT_REFUSED;
     }
-    if (write_tables(dir, cases, ncases, err))
+    case_data *cd = load_cases(dir, cases, ncases, err);
+    if (!cd)
         return -1;
-    return write_readme(dir, cases, ncases, err);
+    int rc = write_tables(dir, cases, cd, ncases, err);
+    if (rc == 0)
+        rc = write_readme(dir, cases, cd, ncases, err);
+    free_cases(cd, ncases);
+    if (rc == 0) /* issue 16: the last line says where the results went, as `run` does */
+        fprintf(stderr, "ppbench report: wrote %s (%d files)\n", dir,
+                (int)(sizeof outs / sizeof outs[0]));
+    return rc;
 }

@@ -1,12 +1,16 @@
 /* report.h: `ppbench report`: the study's summary pages from the cases' output directories.
  *
- * Reads each case's summary.csv and totals.csv and writes table2.csv and table2.md (every
- * method's RMS beside the paper's Table 2 value, with the noise floor) and README.md with the
- * tables, the plots and the images, so a reader sees the study at a glance.
+ * Reads each case's summary.csv, rms.csv and provenance.txt and writes table2.csv and
+ * table2.md (every method's RMS beside the paper's Table 2 value, with the noise floor, one
+ * row per case, cell and method) and README.md: the photon budget, Table 2 as the paper gives
+ * it (cases x methods), the Monte Carlo's noise floor at x = 0 and per segment, the plots and
+ * the images, and the case files kept in the repository, so a reader sees the study at a
+ * glance (reference: Outputs).
  *
  * It replaces only files it wrote (issue 14: `ppbench report . CASE` overwrote the repository's
  * README.md): each file it writes starts with a line saying so, checked before anything is
- * written, and it says on stderr what it wrote, one line per file. */
+ * written. It says on stderr what it wrote, one line per file, and ends with the line
+ * `ppbench report: wrote STUDY_DIR (3 files)` (issue 16: as `run` says where results went). */
 #ifndef PPB_REPORT_H
 #define PPB_REPORT_H
 
