@@ -25,6 +25,7 @@
  * (P.telescope) and steps only through irregular pieces. Where a step's slope differs from the
  * slab's, the S formula does not hold and that step uses the R rule. */
 #include "march_params.h"
+#include "ppb_fresnel.h"
 #include "ppb_sort.h"
 
 /* (e^z - 1) / z, stable at z = 0. */
@@ -259,6 +260,218 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
     return L;
 }
 
+/* ---- refractive boundaries (n > 1, issue 18; reference: Methods, `ss`) ----
+ * `ss` only (with_modes = 0). Inside, the once-scattered source is the refracted beam and its
+ * unscattered reflections: down the beam D (direction w_t, optical depth D from the maps), up
+ * the beam reflected at S2 (direction w_t mirrored in y, optical depth 2 D_b - D with D_b the
+ * beam's depth at S2), and every further round trip S2 -> S1 -> S2 multiplies both by
+ * F_b^2 e^{-2 D_b}: the geometric series 1 / (1 - F_b^2 e^{-2 D_b}). So per unit length
+ *     J(q, v) = alpha sigma_t E_in / (1 - F_b^2 e^{-2 D_b})
+ *               [p(v . w_t) e^{-D(q)} + F_b p(v . w_u) e^{-(2 D_b - D(q))}] lit(q),
+ * E_in = beam_in, F_b = beam_fb. D_b = sigma_t H / cos theta_t: the slab, or the tube at normal
+ * incidence, where a vertical beam stays in its column (its D_b that column's). Oblique light in
+ * the tube also meets the side walls: ppb_piece_images below. */
+
+/* The once-scattered beam over one piece [la, lb] of constant sigma_t, alpha, marched along
+ * (mx, my) with the light travelling along v; advances *d. As ppb_piece's direct beam: one
+ * closed form over a regular piece (D linear, lit constant), else step by step. */
+inline double ppb_piece_fresnel(const ppb_march_params *P, __global const double *map, double px,
+                                double py, double mx, double my, double la, double lb,
+                                double sigma_t, double alpha, double c_down, double c_up,
+                                double db2, double *d)
+{
+    double len = lb - la, eps = 1e-9 * len, tau0 = P->tau0[0];
+    ppb_msample a = ppb_sample(P, map, tau0, px, py, mx, my, la + eps);
+    ppb_msample b = ppb_sample(P, map, tau0, px, py, mx, my, lb - eps);
+    ppb_msample m = ppb_sample(P, map, tau0, px, py, mx, my, 0.5 * (la + lb));
+    double tolD = 1e-9 * (1.0 + a.D + b.D);
+    int regular = fabs(a.lit - b.lit) <= 1e-12 && fabs(a.lit - m.lit) <= 1e-12 &&
+                  fabs(m.D - 0.5 * (a.D + b.D)) <= tolD;
+    double d0 = *d;
+    *d = d0 + sigma_t * len;
+    if (regular) {
+        if (a.lit <= 0.0)
+            return 0.0;
+        double zl = sigma_t * len;
+        double v = ppb_beam_step(c_down, sigma_t, len, -(d0 + a.D), -(zl + b.D - a.D)) +
+                   ppb_beam_step(c_up, sigma_t, len, -(d0 + db2 - a.D), -(zl - b.D + a.D));
+        return alpha * a.lit * v;
+    }
+    int n = max(1, (int)ceil(len / P->step));
+    double h = len / n, sum = 0.0;
+    ppb_msample s1 = a;
+    for (int i = 0; i < n; i++) {
+        double d1 = d0 + sigma_t * h * i;
+        if (d1 > P->d_cap)
+            break;
+        double l1 = la + h * i;
+        ppb_msample s2 = i + 1 == n ? b : ppb_sample(P, map, tau0, px, py, mx, my, l1 + h);
+        ppb_msample sm = ppb_sample(P, map, tau0, px, py, mx, my, l1 + 0.5 * h);
+        if (sm.lit > 0.0) {
+            double zl = sigma_t * h;
+            double v = ppb_beam_step(c_down, sigma_t, h, -(d1 + s1.D), -(zl + s2.D - s1.D)) +
+                       ppb_beam_step(c_up, sigma_t, h, -(d1 + db2 - s1.D), -(zl - s2.D + s1.D));
+            sum += sm.lit * v;
+        }
+        s1 = s2;
+    }
+    return alpha * sum;
+}
+
+/* The tube at oblique incidence (n > 1): the beam meets the side walls too. Unfolded by the
+ * cross-section's mirror images (tile (k, j), k >= 0 along x, j >= 0 in depth, mirrored when k
+ * or j is odd: x' = kW +- x, depth' = jH + d or jH + H - d), every beam is a straight line from
+ * its entry point x_e on S1 along (sin theta_t, down), and the beam reaching q through image
+ * (k, j) has crossed j horizontal and k vertical tile edges: weight F_b^j F_s^k, optical depth
+ * sigma_t depth' / cos theta_t, entry point x_e = x' - depth' tan theta_t, which must lie on S1's
+ * lit part, and direction (+-sin theta_t, -+cos theta_t) in the real tube. Along a piece x' and
+ * depth' are linear in l, so each image's lit part is one interval and its integral one closed
+ * form (ppb_beam_step). Uniform sigma_t only (ss's check refuses a density step here). */
+inline double ppb_piece_images(const ppb_march_params *P, double px, double py, double mx,
+                               double my, double vx, double vy, double la, double lb,
+                               double sigma_t, double alpha, double *d)
+{
+    double d0 = *d;
+    *d = d0 + sigma_t * (lb - la);
+    double W = P->width, H = P->height, ct = P->cos_theta_l, st = P->light_x, tn = P->tan_theta_l;
+    double lo = -0.5 * W, hi = P->step_kind == PPB_STEP_SHADOW ? fmin(0.5 * W, P->step_x) : 0.5 * W;
+    if (!(hi > lo))
+        return 0.0;
+    double pdn[2] = {ppb_hg_phase(P->g, vx * st - vy * ct), ppb_hg_phase(P->g, -vx * st - vy * ct)};
+    double pup[2] = {ppb_hg_phase(P->g, vx * st + vy * ct), ppb_hg_phase(P->g, -vx * st + vy * ct)};
+    /* Image j's beam has come at least j H / cos theta_t; with the ray's own d0 beyond d_cap
+     * it counts for nothing. */
+    int jmax = (int)ceil((P->d_cap - d0) * ct / (sigma_t * H));
+    double sum = 0.0, fj = 1.0;
+    for (int j = 0; j <= jmax; j++, fj *= P->beam_fb) {
+        int jodd = j & 1;
+        /* depth'(l) = dp0 + l dpl */
+        double dp0 = jodd ? (j + 1) * H + py : j * H - py, dpl = jodd ? my : -my;
+        int kmin = max(0, (int)ceil((j * H * tn - W) / W));
+        int kmax = (int)floor(1.0 + (j + 1) * H * tn / W);
+        double fk = pown(P->beam_fs, kmin);
+        for (int k = kmin; k <= kmax; k++, fk *= P->beam_fs) {
+            int kodd = k & 1;
+            double xe0 = k * W + (kodd ? -px : px) - dp0 * tn, xel = (kodd ? -mx : mx) - dpl * tn;
+            double l1 = la, l2 = lb;
+            if (xel == 0.0) {
+                if (xe0 < lo || xe0 >= hi)
+                    continue;
+            } else {
+                double a = (lo - xe0) / xel, b = (hi - xe0) / xel;
+                l1 = fmax(l1, fmin(a, b));
+                l2 = fmin(l2, fmax(a, b));
+            }
+            if (!(l2 > l1))
+                continue;
+            double C = P->beam_in * fj * fk * (jodd ? pup[kodd] : pdn[kodd]);
+            double D1 = sigma_t * (dp0 + l1 * dpl) / ct, D2 = sigma_t * (dp0 + l2 * dpl) / ct;
+            double e_a = -(d0 + sigma_t * (l1 - la) + D1), z = -(sigma_t * (l2 - l1) + D2 - D1);
+            sum += ppb_beam_step(C, sigma_t, l2 - l1, e_a, z);
+        }
+    }
+    return alpha * sum;
+}
+
+/* One straight leg of the viewing ray inside, from (px, py) along (mx, my) for length lfar,
+ * with the light travelling along v = -(mx, my, mz): the pieces of ppb_march_ray (cut at the step
+ * plane and the light lines), each with the source J above; advances *d. */
+inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *map, double px,
+                              double py, double vx, double vy, double vz, double lfar, double *d)
+{
+    double mx = -vx, my = -vy;
+    double brk[4];
+    int nb = 0;
+    brk[nb++] = 0.0;
+    if (P->tube) {
+        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
+        double cand[3] = {-1.0, -1.0, -1.0};
+        if ((P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO) && mx != 0.0)
+            cand[0] = (P->step_x - px) / mx;
+        if (P->step_kind != PPB_STEP_NONE && dxp != 0.0)
+            cand[1] = (P->step_x - xp) / dxp;
+        if (P->tan_theta_l > 0.0 && dxp != 0.0)
+            cand[2] = (-0.5 * P->width - xp) / dxp;
+        for (int k = 0; k < 3; k++)
+            if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
+                brk[nb++] = cand[k];
+    }
+    ppb_sort_doubles(brk + 1, nb - 1);
+    brk[nb++] = lfar;
+    double ct = P->cos_theta_l, st = P->light_x;
+    double p_down = ppb_hg_phase(P->g, vx * st - vy * ct);
+    double p_up = ppb_hg_phase(P->g, vx * st + vy * ct);
+    double L = 0.0;
+    for (int k = 0; k + 1 < nb && *d < P->d_cap; k++) {
+        double la = brk[k], lb = brk[k + 1];
+        if (lb <= la)
+            continue;
+        double xm = px + 0.5 * (la + lb) * mx;
+        double sigma_t =
+            P->tube ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
+                    : P->sigma_t;
+        double alpha = P->tube
+                           ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
+                           : P->albedo;
+        double db = sigma_t * P->height / ct;
+        double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
+        if (P->tube && P->tan_theta_l > 0.0)
+            L += ppb_piece_images(P, px, py, mx, my, vx, vy, la, lb, sigma_t, alpha, d);
+        else
+            L += ppb_piece_fresnel(P, map, px, py, mx, my, la, lb, sigma_t, alpha, e * p_down,
+                                   e * P->beam_fb * p_up, 2.0 * db, d);
+    }
+    return L;
+}
+
+/* Air-side radiance leaving p on surface surf along the air-side direction w (n > 1): the
+ * direction inside by Snell (tangential part / n, normal part the refracted cosine), the n^2 law
+ * (1 - F) / n^2 times the inside radiance, which is the viewing ray's legs summed: at each face
+ * it meets the ray continues mirrored (the cross-section's mirror images), weighted by F of its
+ * cosine to that face (1 under total internal reflection). The legs stop where the optical
+ * distance reaches d_cap or the weight times e^{-d} falls below 1e-15 (below the sum's
+ * resolution), and after 4096 legs (a ray so close to the tube's axis that its legs are
+ * shorter than d_cap / 4096 in total: e^{-d} decides long before). */
+inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const double *map, int surf,
+                                    double px, double py, double wx, double wy, double wz)
+{
+    double n = P->n, nx = ppb_normal_x(surf), ny = ppb_normal_y(surf);
+    double ca = wx * nx + wy * ny, ci = ppb_refract_cos(ca, n);
+    double vx = (wx - ca * nx) / n + ci * nx, vy = (wy - ca * ny) / n + ci * ny, vz = wz / n;
+    double wt = (1.0 - ppb_fresnel(ca, n)) / (n * n);
+    double sig_min =
+        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
+    double W = 1.0, d = 0.0, L = 0.0;
+    for (int leg = 0; leg < 4096 && d < P->d_cap && W * exp(-d) > 1e-15; leg++) {
+        double mx = -vx, my = -vy;
+        double ly = my > 0.0 ? -py / my : (my < 0.0 ? (-P->height - py) / my : INFINITY);
+        double lx = INFINITY;
+        if (P->tube)
+            lx = mx > 0.0 ? (0.5 * P->width - px) / mx
+                          : (mx < 0.0 ? (-0.5 * P->width - px) / mx : INFINITY);
+        int side = lx < ly;
+        double lfar = fmax(0.0, fmin(lx, ly)), lcap = (P->d_cap - d) / sig_min;
+        if (!(lfar <= lcap)) {
+            L += W * ppb_leg_fresnel(P, map, px, py, vx, vy, vz, lcap, &d);
+            break;
+        }
+        L += W * ppb_leg_fresnel(P, map, px, py, vx, vy, vz, lfar, &d);
+        /* Onto the face exactly, then mirrored. */
+        if (side) {
+            px = mx > 0.0 ? 0.5 * P->width : -0.5 * P->width;
+            py += lfar * my;
+            W *= ppb_fresnel(fabs(vx), 1.0 / n);
+            vx = -vx;
+        } else {
+            px += lfar * mx;
+            py = my > 0.0 ? 0.0 : -P->height;
+            W *= ppb_fresnel(fabs(vy), 1.0 / n);
+            vy = -vy;
+        }
+    }
+    return wt * L;
+}
+
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
  * and the bin's direction samples (reference: Bins). */
 __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *map,
@@ -282,7 +495,10 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
                 double wx, wy, wz;
                 ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
                 int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
-                sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, wx, wy);
+                if (P.n > 1.0)
+                    sum += ppb_march_ray_fresnel(&P, map, surf, px, py, wx, wy, wz);
+                else
+                    sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, wx, wy);
             }
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);

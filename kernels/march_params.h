@@ -68,7 +68,14 @@ typedef struct ppb_march_params {
     /* march */
     double step;  /* ray-march step length, mfp */
     double d_cap; /* optical distance from the exit point beyond which the march stops */
-    int tube;     /* 1 tube, 0 slab */
+    /* refractive boundaries (issue 18; reference: Keys, `medium.n`): n <= 1 skips them all.
+     * At n > 1 the light fields above (tan/cos_theta_l, light_x/y) are the refracted beam's
+     * inside; beam_in is its perpendicular irradiance inside per unit E_perp in air,
+     * (1 - F(cos theta_L)) cos theta_L / cos theta_t, and beam_fb = F(cos theta_t, 1/n) the
+     * reflectance it meets at S2 and S1, beam_fs = F(sin theta_t, 1/n) the one at a side wall
+     * (1 under total internal reflection). */
+    double n, g, beam_in, beam_fb, beam_fs;
+    int tube; /* 1 tube, 0 slab */
     int step_kind;
     int map_nx, map_ny; /* cells stored */
     int map_i0;         /* grid column of the first stored cell column (maps.h) */

@@ -35,4 +35,26 @@ PPB_FN double ppb_fresnel(double cos_i, double n_rel)
     return 0.5 * (rs * rs + rp * rp);
 }
 
+/* The collimated beam at S1 (E_perp = 1 in air at cos theta_L): the refracted direction inside
+ * (cos_t, sin_t, in the plane of incidence), the specular fraction F(cos theta_L), the
+ * perpendicular irradiance of the transmitted beam inside, (1 - F) cos theta_L / cos theta_t (the
+ * power (1 - F) cos theta_L per unit length of S1 spread over a beam cross-section shrunk by
+ * cos theta_t / cos theta_L), and the reflectance f_inside = F(cos theta_t, 1/n) that the beam
+ * meets at every internal reflection off S2 or S1 (equal to F(cos theta_L, n) by Stokes'
+ * relations, computed from inside as the bounces see it). */
+typedef struct ppb_fresnel_beam {
+    double cos_t, sin_t, specular, irradiance, f_inside;
+} ppb_fresnel_beam;
+
+PPB_FN ppb_fresnel_beam ppb_fresnel_beam_in(double cos_l, double n)
+{
+    ppb_fresnel_beam b;
+    b.cos_t = ppb_refract_cos(cos_l, n);
+    b.sin_t = sqrt(fmax(0.0, 1.0 - b.cos_t * b.cos_t));
+    b.specular = ppb_fresnel(cos_l, n);
+    b.irradiance = (1.0 - b.specular) * cos_l / b.cos_t;
+    b.f_inside = ppb_fresnel(b.cos_t, 1.0 / n);
+    return b;
+}
+
 #endif

@@ -299,6 +299,110 @@ static void test_ppslab_vs_mc_bins(void **state)
     assert_close(t[1][1], t[0][1], 1e-3);
 }
 
+/* ---- ss at n > 1: against mc1, the Monte Carlo's once-scattered exits ----
+ * mc1 counts any number of Fresnel reflections before and after the one scattering, as ss's
+ * series of beam reflections and mirrored viewing-ray legs do; the two agree to the Monte
+ * Carlo's noise only if the beam's refraction and 1 - F entry, its bounces, the n^2 law at exit,
+ * Snell's map of the bins and the legs' F weights are all right. */
+
+/* Sums over segments, per (surface, bin), of method's radiance and its variance from a
+ * radiance.csv: v and var [4 x 64]; returns the rows read. */
+static int read_surface_bins(const char *path, const char *method, double *v, double *var)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        fail_msg("%s: cannot open", path);
+    char line[512], m[64], surf[8];
+    int n = 0, seg, it, ip;
+    double s0, val, err;
+    memset(v, 0, 256 * sizeof *v);
+    memset(var, 0, 256 * sizeof *var);
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "%63[^,],%7[^,],%d,%lf,%d,%d,%lf,%lf", m, surf, &seg, &s0, &it, &ip, &val,
+                   &err) == 8 &&
+            !strcmp(m, method) && surf[0] == 'S' && surf[1] >= '1' && surf[1] <= '4' && it < 8 &&
+            ip < 8) {
+            int k = (surf[1] - '1') * 64 + it * 8 + ip;
+            v[k] += val, var[k] += err * err, n++;
+        }
+    fclose(f);
+    return n;
+}
+
+/* Runs mc and ss on the config text (output dir appended), then one chi-square of ss against
+ * mc1 over every (surface, bin) with mc1's noise (its batch standard errors, summed over the
+ * segments in quadrature: the segments' tallies are independent photons); returns the p-value. */
+static double ss_vs_mc1(const char *name, const char *body, int nsurf, double *chi2_out)
+{
+    const char *dir = tu_scratch(name);
+    char ini[1400], csv[1300], text[2400];
+    snprintf(ini, sizeof ini, "%s/a.ini", dir);
+    snprintf(text, sizeof text, "%s[output]\ndir = %s/out\n", body, dir);
+    tu_write_file(ini, text);
+    assert_int_equal(tu_sh("%s run %s > %s/log 2>&1", tu_bin(), ini, dir), 0);
+    snprintf(csv, sizeof csv, "%s/out/radiance.csv", dir);
+    double mc[256], mvar[256], ss[256], svar[256];
+    assert_true(read_surface_bins(csv, "mc1", mc, mvar) > 0);
+    assert_true(read_surface_bins(csv, "ss", ss, svar) > 0);
+    double chi2 = 0, worst = 0;
+    int nb = 0;
+    for (int k = 0; k < 64 * nsurf; k++) {
+        assert_true(mvar[k] > 0);
+        double z = (ss[k] - mc[k]) / sqrt(mvar[k]);
+        chi2 += z * z, worst = fmax(worst, fabs(z)), nb++;
+    }
+    double p = tu_chi2_pvalue(chi2, nb);
+    printf("# %s: ss vs mc1, %d (surface, bin) sums: chi2 %.1f (p %.3g), worst |z| %.2f\n", name,
+           nb, chi2, p, worst);
+    *chi2_out = chi2;
+    return p;
+}
+
+/* Slab, n = 1.4, oblique light (30 deg: the beam refracts to 20.9 deg), g = 0.5, tau0 = 2, all
+ * 128 bins of S1 and S2 (8 x 8 air-side samples each). Measured: chi2 129 / 128 at 4e6 photons,
+ * 130 / 128 at 2e7 (no bias shows at 5 x the test's statistics); the same run at n = 1 (2e6)
+ * gives 137 / 128. Sensitivity, from the same outputs with ss scaled: x 1.01 gives chi2 199
+ * (p 1e-4), x 1.03 gives 697; the tube cases below give 287-331 and 505-635 of 256. */
+static void test_ss_vs_mc1_slab(void **state)
+{
+    (void)state;
+    double chi2;
+    double p = ss_vs_mc1("fresnel_ss_slab",
+                         "[experiment]\nname = fresnel_ss\ngeometry = slab\nmethods = mc, ss\n"
+                         "[tube]\nheight = 2\n[medium]\nalbedo = 0.95\ng = 0.5\nn = 1.4\n"
+                         "[light]\ntheta_deg = 30\n[mc]\nphotons = 4e6\n[bins]\nsamples_dir = 8\n",
+                         2, &chi2);
+    assert_true(p > 1e-3);
+}
+
+/* The tube (the study's W = 10, H = 3) at n = 1.4: normal incidence, where the beam bounces
+ * between S2 and S1 only, and 45 deg, where it meets the side walls too (total internal
+ * reflection there: cos theta_t = 0.863 > 1/n) and ss sums the cross-section's mirror images;
+ * g = 0 and 0.5. The viewing rays reflect off all four faces. 256 sums (4 surfaces x 64 bins,
+ * each over a surface's segments; 32 + 12 segments to keep the march short). Measured at 3e6
+ * photons: chi2 (g, theta) = (0, 0) 274 / 256 at the default 128 + 36 segments; the three cases
+ * below as printed. */
+static void test_ss_vs_mc1_tube(void **state)
+{
+    (void)state;
+    const struct {
+        double g, theta;
+    } cases[3] = {{0.0, 0.0}, {0.0, 45.0}, {0.5, 0.0}};
+    for (int i = 0; i < 3; i++) {
+        char name[64], body[1024];
+        snprintf(name, sizeof name, "fresnel_ss_tube%d", i);
+        snprintf(body, sizeof body,
+                 "[experiment]\nname = %s\ngeometry = tube\nmethods = mc, ss\n[tube]\n"
+                 "width = 10\nheight = 3\nsegments_top = 32\nsegments_side = 12\n[medium]\n"
+                 "albedo = 0.95\ng = %g\nn = 1.4\n[light]\ntheta_deg = %g\n[mc]\n"
+                 "photons = 3e6\n",
+                 name, cases[i].g, cases[i].theta);
+        double chi2;
+        double p = ss_vs_mc1(name, body, 4, &chi2);
+        assert_true(p > 1e-3);
+    }
+}
+
 /* At n > 1 a photon's path still depends only on the seed and its index: the same tallies
  * whatever the work-group size, the chunking or the split into shards (the reflect-or-leave
  * choice comes from the photon's own Philox stream). The tube, oblique light and a density
@@ -352,7 +456,7 @@ static void test_bit_identical_n(void **state)
 }
 
 /* Methods without refractive boundaries yet are refused at n > 1 (exit 2, before any work, by
- * the method's check hook in the registry), not run as if n were 1; mc and ppslab are
+ * the method's check hook in the registry), not run as if n were 1; mc, ppslab and ss are
  * accepted. */
 static void test_config_refuses_other_methods(void **state)
 {
@@ -360,10 +464,14 @@ static void test_config_refuses_other_methods(void **state)
     const char *dir = tu_scratch("fresnel_cfg");
     char path[1200];
     snprintf(path, sizeof path, "%s/a.ini", dir);
-    const char *texts[2] = {
-        "[experiment]\ngeometry = slab\nmethods = mc, ppslab\n[medium]\nn = 1.4\n",
-        "[experiment]\ngeometry = slab\nmethods = mc, pp\n[medium]\nn = 1.4\n"};
-    for (int i = 0; i < 2; i++) {
+    const char *texts[3] = {
+        "[experiment]\ngeometry = slab\nmethods = mc, ppslab, ss\n[medium]\nn = 1.4\n",
+        "[experiment]\ngeometry = slab\nmethods = mc, pp\n[medium]\nn = 1.4\n",
+        /* ss's mirror images assume one sigma_t: oblique light with a density step is refused */
+        "[experiment]\ngeometry = tube\nmethods = ss\n[medium]\nn = 1.4\nstep = density\n"
+        "sigma_t_right = 2\n[light]\ntheta_deg = 30\n"};
+    const char *refused[3] = {NULL, "method pp", "method ss"};
+    for (int i = 0; i < 3; i++) {
         FILE *f = fopen(path, "w");
         assert_non_null(f);
         fputs(texts[i], f);
@@ -373,10 +481,10 @@ static void test_config_refuses_other_methods(void **state)
         assert_int_equal(ppb_config_load(&cfg, path, &err), 0);
         assert_close(cfg.scene.n, 1.4, 0);
         int rc = ppb_methods_check(&cfg, &err);
-        assert_int_equal(rc, i == 0 ? 0 : -1);
-        if (i == 1) {
+        assert_int_equal(rc, refused[i] ? -1 : 0);
+        if (refused[i]) {
             assert_non_null(strstr(err.msg, "n > 1"));
-            assert_non_null(strstr(err.msg, "method pp"));
+            assert_non_null(strstr(err.msg, refused[i]));
         }
     }
 }
@@ -387,6 +495,8 @@ int main(void)
         cmocka_unit_test(test_fresnel_closed_forms),
         cmocka_unit_test(test_ppslab_vs_adding_doubling),
         cmocka_unit_test(test_ppslab_vs_mc_bins),
+        cmocka_unit_test(test_ss_vs_mc1_slab),
+        cmocka_unit_test(test_ss_vs_mc1_tube),
         cmocka_unit_test(test_config_refuses_other_methods),
         cmocka_unit_test(test_bit_identical_n),
         cmocka_unit_test(test_mc_vs_adding_doubling),

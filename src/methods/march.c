@@ -6,8 +6,9 @@
 #include <string.h>
 
 #include "base/progress.h"
+#include "kernels/ppb_fresnel.h"
 
-_Static_assert(sizeof(ppb_march_params) == 21 * sizeof(double) + 26 * sizeof(int),
+_Static_assert(sizeof(ppb_march_params) == 26 * sizeof(double) + 26 * sizeof(int),
                "ppb_march_params: doubles first, an even number of ints, no padding");
 
 static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
@@ -33,7 +34,7 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
     double wl[3];
     ppb_scene_light_dir(sc, wl);
     int tube = sc->geometry == PPB_GEOM_TUBE;
-    return (ppb_march_params){
+    ppb_march_params P = {
         .width = sc->width,
         .height = sc->height,
         .sigma_t = sc->sigma_t,
@@ -66,7 +67,21 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
         .npts = opts->npts < 1 ? 1 : opts->npts,
         .ntheta = sc->ntheta,
         .nphi = sc->nphi,
+        .n = sc->n,
+        .g = sc->g,
     };
+    if (sc->n > 1.0) {
+        /* Inside, the beam runs along the refracted direction (the maps follow it, maps.c). */
+        ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
+        P.cos_theta_l = b.cos_t;
+        P.tan_theta_l = b.sin_t / b.cos_t;
+        P.light_x = b.sin_t;
+        P.light_y = -b.cos_t;
+        P.beam_in = b.irradiance;
+        P.beam_fb = b.f_inside;
+        P.beam_fs = ppb_fresnel(b.sin_t, 1.0 / sc->n);
+    }
+    return P;
 }
 
 /* The arrays of the parameters: where each surface's cells start in the layout, and the tau
@@ -220,6 +235,65 @@ int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
     return rc;
 }
 
+/* At n > 1: the fraction of the entering beam's power that leaves unscattered. From the beam
+ * of optical depth tau between S1 and S2, (1 - F_b) e^{-tau} leaves at S2, F_b (1 - F_b)
+ * e^{-2 tau} at S1 after one reflection, and so on: (1 - F_b) e^{-tau} / (1 - F_b e^{-tau}).
+ * Slab, and the tube at normal incidence (a vertical beam meets only S2 and S1; the column's
+ * tau is ppb_beam_depth's). */
+static double fresnel_unscattered(const ppb_scene *sc, double x_entry, void *arg)
+{
+    double fb = *(const double *)arg, e = exp(-ppb_beam_depth(sc, x_entry));
+    return (1.0 - fb) * e / (1.0 - fb * e);
+}
+
+/* The tube at oblique incidence: the beam from x_e followed through its reflections off all four
+ * faces (one sigma_t: ss refuses a density step there), adding at each face the part that
+ * leaves, (1 - F) of what arrives, until what is left is below 1e-16. */
+static double fresnel_walk(const ppb_scene *sc, const ppb_fresnel_beam *b, double x_e)
+{
+    double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
+    double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, tau = 0.0, out = 0.0;
+    for (int hit = 0; hit < 100000 && w * exp(-tau) > 1e-16; hit++) {
+        double ly = dy > 0.0 ? -y / dy : (-H - y) / dy;
+        double lx = dx > 0.0 ? (0.5 * W - x) / dx : (-0.5 * W - x) / dx;
+        double l = fmin(lx, ly), f = lx < ly ? fs : b->f_inside;
+        tau += sc->sigma_t * l;
+        x += l * dx, y += l * dy;
+        out += w * (1.0 - f) * exp(-tau);
+        w *= f;
+        if (lx < ly)
+            dx = -dx, x = dx < 0.0 ? 0.5 * W : -0.5 * W;
+        else
+            dy = -dy, y = dy > 0.0 ? -H : 0.0;
+    }
+    return out;
+}
+
+static double fresnel_ballistic(const ppb_scene *sc, const ppb_fresnel_beam *b)
+{
+    double fb = b->f_inside, width;
+    if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
+        /* Midpoints over the lit part of S1: the integrand is piecewise smooth (it kinks or
+         * jumps where the walk's first faces change), so 2e4 points put it within ~1e-5. */
+        double a = -0.5 * sc->width, hi = 0.5 * sc->width;
+        if (sc->step == PPB_STEP_SHADOW)
+            hi = fmin(hi, sc->step_x);
+        if (!(hi > a))
+            return 0.0;
+        const int np = 20000;
+        double sum = 0.0;
+        for (int i = 0; i < np; i++)
+            sum += fresnel_walk(sc, b, a + (i + 0.5) * (hi - a) / np);
+        return (1.0 - b->specular) * sum / np;
+    }
+    if (sc->geometry == PPB_GEOM_SLAB) {
+        double e = exp(-sc->sigma_t * sc->height / b->cos_t);
+        return (1.0 - b->specular) * (1.0 - fb) * e / (1.0 - fb * e);
+    }
+    double sum = ppb_lit_integral(sc, fresnel_unscattered, &fb, &width);
+    return width > 0.0 ? (1.0 - b->specular) * sum / width : 0.0;
+}
+
 void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
                       ppb_totals *t)
 {
@@ -239,6 +313,11 @@ void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *r
         t->sides = (flux[PPB_S3] + flux[PPB_S4]) / entering;
     }
     t->ballistic = ppb_ballistic_fraction(sc);
+    if (sc->n > 1.0) {
+        ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
+        t->ballistic = fresnel_ballistic(sc, &b);
+        t->specular = b.specular;
+    }
     t->absorbed_tracked = 0;
     ppb_totals_complete(t);
 }

@@ -7,6 +7,7 @@
 #include "kernels/march_params.h"
 
 #include "base/quadrature.h"
+#include "kernels/ppb_fresnel.h"
 #include "kernels/ppb_sort.h"
 
 /* Fraction of a straight path whose x runs from x0 to x1 that lies right of the step
@@ -30,18 +31,33 @@ double ppb_segment_optical_depth(const ppb_scene *sc, double x0, double y0, doub
     return len * sc->sigma_t;
 }
 
+/* The beam's direction inside: the light's at n = 1 (the scene's own functions, bit for bit),
+ * the refracted one at n > 1 (reference: Light and Keys, `medium.n`: shadowing follows it). */
+static double beam_cos(const ppb_scene *sc)
+{
+    return sc->n > 1.0 ? ppb_refract_cos(ppb_scene_cos_theta_l(sc), sc->n)
+                       : ppb_scene_cos_theta_l(sc);
+}
+static double beam_tan(const ppb_scene *sc)
+{
+    if (!(sc->n > 1.0))
+        return ppb_scene_tan_theta_l(sc);
+    double c = beam_cos(sc);
+    return sqrt(fmax(0.0, 1.0 - c * c)) / c;
+}
+
 void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, double *abar,
                           int *lit)
 {
     double depth = y < 0.0 ? -y : 0.0;
     if (sc->geometry == PPB_GEOM_SLAB) {
-        *D = sc->sigma_t * depth / ppb_scene_cos_theta_l(sc);
+        *D = sc->sigma_t * depth / beam_cos(sc);
         *abar = sc->albedo;
         *lit = 1;
         return;
     }
     /* The path runs from (x, y) along -w_L to S1 at x' = x + y tan(theta_L). */
-    double xp = x - depth * ppb_scene_tan_theta_l(sc);
+    double xp = x - depth * beam_tan(sc);
     *D = ppb_segment_optical_depth(sc, x, -depth, xp, 0.0);
     *abar = sc->albedo;
     if (sc->step == PPB_STEP_ALBEDO) {
@@ -59,7 +75,7 @@ void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, do
 static void maps_grid(const ppb_scene *sc, int map_res, ppb_maps *m)
 {
     m->tube = sc->geometry == PPB_GEOM_TUBE;
-    m->tan_theta_l = ppb_scene_tan_theta_l(sc);
+    m->tan_theta_l = beam_tan(sc);
     m->h = 1.0 / map_res;
     double ny = ceil(sc->height * map_res - 1e-9);
     m->ny = ny < 1 ? 1 : (int)ny;

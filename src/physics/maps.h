@@ -7,7 +7,12 @@
  * column and every shadow edge is a column edge; each cell keeps its corners as limits from
  * inside (kernels/march_params.h). Node values are exact for the piecewise-constant media, so
  * the only map error is bilinear interpolation across a kink or jump that cuts a cell (oblique
- * light with a density or albedo step), and it vanishes as map_res grows. */
+ * light with a density or albedo step), and it vanishes as map_res grows.
+ *
+ * At n > 1 (issue 18) the maps and ppb_light_path_exact follow the refracted beam inside
+ * (sin theta_t = sin theta_L / n); ppb_beam_depth, ppb_lit_integral and ppb_ballistic_fraction
+ * keep theta_L and no Fresnel factor (the marcher's totals at n > 1 use them at normal
+ * incidence only, where theta_t = theta_L, and add the factors themselves: march.c). */
 #ifndef PPB_MAPS_H
 #define PPB_MAPS_H
 
