@@ -67,9 +67,16 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
     if (lfar <= 0.0)
         return 0.0;
 
-    double brk[5];
+    double brk[7];
     int nb = 0;
     brk[nb++] = 0.0;
+    /* The boundary layers' lines: inside them the march steps shrink with the rows. */
+    if (P->nyl > 0 && my != 0.0) {
+        double ly[2] = {(-P->dlay - py) / my, (-(P->height - P->dlay) - py) / my};
+        for (int k = 0; k < 2; k++)
+            if (ly[k] > 1e-12 && ly[k] < lfar - 1e-12)
+                brk[nb++] = ly[k];
+    }
     if (P->tube) {
         double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
         double cand[3] = {-1.0, -1.0, -1.0};
@@ -125,7 +132,13 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
             }
         }
         if (P->diffuse) {
-            int n = max(1, (int)ceil(len * sperp / P->hstep));
+            /* Steps of at most hstep in the plane and hstep dy / hy across the rows, dy the
+             * piece's finest row spacing (a layer piece: hyf), so a step crosses no more of a
+             * fine row than of a middle one. */
+            double dy =
+                (P->nyl > 0 && (-ym < P->dlay || -ym > P->height - P->dlay)) ? P->hyf : P->hy;
+            double ns = fmax(len * sperp / P->hstep, len * fabs(my) * P->hy / (P->hstep * dy));
+            int n = max(1, (int)ceil(ns));
             double h = len / n, x = sigma_t * h, a = -expm1(-x), w1 = rte_w1(x, a);
             double att = exp(-x), e = exp(-d);
             double J1 = ppb_rte_lookup(P, plane, px + la * mx, py + la * my);
@@ -167,7 +180,7 @@ __kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
     if (cell >= P.ncell)
         return;
     int i = node % P.nx, j = node / P.nx;
-    double px = ppb_rte_node_x(&P, i), py = -j * P.hy;
+    double px = ppb_rte_node_x(&P, i), py = ppb_rte_node_y(&P, j);
     __global const double *dc = dirs + 4 * cell;
     out[gid] = rte_ray(&P, src + (long)cell * nn, dc[3], px, py, dc[0], dc[1]);
 }

@@ -8,7 +8,13 @@
  * whether S1's lit part is seen, reference: Light), which both the grid's first-scattering
  * source and the exit march use, so the beam's first scattering is exact (as in `ss`).
  *
- * Grid: nodes x_i, y_j = -j hy (j = 0 on S1, ny - 1 on S2). In x the nodes are uniform on
+ * Grid: nodes x_i, y_j (j = 0 on S1, ny - 1 on S2, y_j = -j hy without layers). In y, a
+ * boundary layer under S1 and over S2 has nyl rows whose spacings double away from the face,
+ * hyf, 2 hyf, .., 2^(nyl-1) hyf (depth dlay = hyf (2^nyl - 1)), the middle nym rows of hy
+ * (nyl = 0: uniform; ppb_rte_node_y): the scattered light of a direction rises from 0 at a face
+ * within about |mu| mfp, so the source has a boundary layer as thin as the most grazing cell's
+ * |mu| that linear interpolation underestimates (issue 19: halving hy everywhere took the
+ * balance from -4.7e-3 to -2.0e-3, halving hx alone only to -4.2e-3). In x the nodes are uniform on
  * [-W/2, step_x] (nl cells) and on [step_x, W/2] (nr cells), sharing the node at step_x, so the
  * step is a grid line (the source per unit scattering coefficient, J = sum_j P_ij I_j, is
  * continuous across it but kinked; sigma_s, which jumps, is applied at the exact position).
@@ -43,6 +49,7 @@ typedef struct ppb_rte_params {
     double g;                                     /* HG asymmetry (the exit march's beam term) */
     double sin_theta_l, cos_theta_l, tan_theta_l; /* light incidence */
     double hxl, hxr, hy;                          /* node spacings left/right of the step, in y */
+    double hyf, dlay;                             /* y: boundary-layer spacing and depth */
     double hstep;                                 /* march step length in the x-y plane, mfp */
     double d_cap;                                 /* optical distance where a march stops */
     int tube, step_kind;
@@ -52,6 +59,7 @@ typedef struct ppb_rte_params {
     int diffuse;    /* 1: add the grid source J */
     int ntheta, nphi, nsamp, npts;
     int row0;      /* exit: first segment row of this launch */
+    int nyl, nym;  /* y: rows per boundary layer (0: uniform), rows between the layers */
     int pad;       /* unused: keeps the count of ints even */
     int nseg[4];   /* exit: segments per surface (slab: 1, 1, 0, 0) */
     int offset[4]; /* exit: first row of each surface */
@@ -70,6 +78,51 @@ PPB_FN double ppb_rte_node_x(const ppb_rte_params *P, int i)
     return i <= P->nl ? -0.5 * P->width + i * P->hxl : P->step_x + (i - P->nl) * P->hxr;
 }
 
+/* Depth below S1 (or above S2) of a boundary-layer node k rows from the face: hyf (2^k - 1). */
+PPB_FN double ppb_rte_layer_t(const ppb_rte_params *P, int k)
+{
+    return P->hyf * (ldexp(1.0, k) - 1.0);
+}
+
+/* y of node row j (<= 0). */
+PPB_FN double ppb_rte_node_y(const ppb_rte_params *P, int j)
+{
+    if (j <= P->nyl)
+        return -ppb_rte_layer_t(P, j);
+    if (j <= P->nyl + P->nym)
+        return -(P->dlay + (j - P->nyl) * P->hy);
+    return -(P->height - ppb_rte_layer_t(P, P->ny - 1 - j));
+}
+
+/* The grid row [j, j + 1] holding y and the fraction ty of the way from row j to j + 1 (linear
+ * in y), both clamped to the grid. In a layer the row is k = floor(log2(t / hyf + 1)). */
+PPB_FN void ppb_rte_row(const ppb_rte_params *P, double y, int *j, double *ty)
+{
+    double t = -y;
+    t = t < 0.0 ? 0.0 : (t > P->height ? P->height : t);
+    if (P->nyl > 0 && t < P->dlay) {
+        int k = (int)floor(log2(t / P->hyf + 1.0));
+        k = k < 0 ? 0 : (k > P->nyl - 1 ? P->nyl - 1 : k);
+        double t0 = ppb_rte_layer_t(P, k);
+        *j = k;
+        *ty = (t - t0) / (P->hyf * ldexp(1.0, k));
+    } else if (P->nyl > 0 && t > P->height - P->dlay) {
+        double u = P->height - t; /* height above S2 */
+        int k = (int)floor(log2(u / P->hyf + 1.0));
+        k = k < 0 ? 0 : (k > P->nyl - 1 ? P->nyl - 1 : k);
+        double u1 = ppb_rte_layer_t(P, k + 1);
+        *j = P->ny - 2 - k;
+        *ty = (u1 - u) / (P->hyf * ldexp(1.0, k));
+    } else {
+        double f = (t - P->dlay) / P->hy;
+        int m = (int)f;
+        m = m < 0 ? 0 : (m > P->nym - 1 ? P->nym - 1 : m);
+        *j = P->nyl + m;
+        *ty = f - m;
+    }
+    *ty = *ty < 0.0 ? 0.0 : (*ty > 1.0 ? 1.0 : *ty);
+}
+
 /* Fractional node column of x (tube), clamped to the grid. */
 PPB_FN double ppb_rte_fx(const ppb_rte_params *P, double x)
 {
@@ -82,12 +135,9 @@ PPB_FN double ppb_rte_fx(const ppb_rte_params *P, double x)
 PPB_FN double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM double *plane, double x,
                              double y)
 {
-    double fy = -y / P->hy;
-    fy = fy < 0.0 ? 0.0 : (fy > P->ny - 1 ? P->ny - 1 : fy);
-    int j = (int)fy;
-    if (j > P->ny - 2)
-        j = P->ny - 2;
-    double ty = fy - j;
+    int j;
+    double ty;
+    ppb_rte_row(P, y, &j, &ty);
     if (P->nx == 1)
         return plane[j] + ty * (plane[j + 1] - plane[j]);
     double fx = ppb_rte_fx(P, x);

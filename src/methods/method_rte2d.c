@@ -18,7 +18,7 @@
 #include "physics/gmres.h"
 #include "physics/rte2d_grid.h"
 
-_Static_assert(sizeof(ppb_rte_params) == 16 * sizeof(double) + 22 * sizeof(int),
+_Static_assert(sizeof(ppb_rte_params) == 18 * sizeof(double) + 24 * sizeof(int),
                "ppb_rte_params: doubles first, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
