@@ -76,11 +76,14 @@ $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
 	  $(TEST_LIBS)
 
 # Unit tests: every tests/test_*.c is a cmocka suite; each prints cmocka's own summary.
+# PPBENCH_CACHE set empty: no Monte Carlo reference cache (the user's default one included), so
+# every suite traces what it runs: a changed Monte Carlo shows, whatever was cached before;
+# the cache's own tests give their directories explicitly.
 unit: $(BIN) $(TESTS)
 	@mkdir -p $(BUILD)/tmp
 	@fail=0; for t in $(TESTS); do \
 	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) PPB_VERSION_FILE=$(CURDIR)/$(BUILD)/version.txt \
-	    TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
+	    PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
 	done; exit $$fail
 
 # The layer check first: it reads includes only and fails in a second. Then the reference's
@@ -93,7 +96,7 @@ layers:
 
 docs: $(BIN)
 	@mkdir -p $(BUILD)/tmp
-	@PPBENCH=$(CURDIR)/$(BIN) TMPDIR=$(CURDIR)/$(BUILD)/tmp bash scripts/check_docs.sh
+	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp bash scripts/check_docs.sh
 
 asan:
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
@@ -112,7 +115,7 @@ perf: $(BIN)
 .PHONY: test-cluster
 test: test-cluster
 test-cluster: $(BIN)
-	@PPBENCH=$(CURDIR)/$(BIN) BUILD_DIR=$(CURDIR)/$(BUILD) timeout 900 bash tests/cluster.sh
+	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= BUILD_DIR=$(CURDIR)/$(BUILD) timeout 900 bash tests/cluster.sh
 
 format:
 	clang-format -i src/*/*.c src/*/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h

@@ -8,6 +8,10 @@ cd "$(dirname "$0")/.."
 out=${REGRESS_OUT:-build/regress}
 photons=${REGRESS_PHOTONS:-3e6}
 ppbench=${PPBENCH:-./ppbench}
+# No Monte Carlo reference cache (PPBENCH_CACHE empty turns off the default one): the gate
+# traces every reference, so a changed Monte Carlo is measured, never answered from an old
+# cache.
+export PPBENCH_CACHE=
 mkdir -p "$out"
 t0=$(date +%s)
 mapfile -t cases < configs/study.list

@@ -504,6 +504,180 @@ static void test_ref_cache(void **state)
     assert_true(file_has(c, "provenance.txt", "mc.photons_traced = 20000\n"));
 }
 
+/* [method.NAME] keys through --set: a config without the section gets one (and the method
+ * list names it), a file's command is overridden (the last wins, as for any key), and each
+ * malformed --set is refused before any work with a message naming --set and the key. The
+ * expected rows are mp's own, which the command copies under the new name. */
+static void test_set_method(void **state)
+{
+    (void)state;
+    char rad[2400], args[8192], out[1200], text[4096];
+    copy_script(rad, sizeof rad, "ext_set_r", "radiance.csv", "mp", "mine", "", "");
+    snprintf(out, sizeof out, "%s/out", tu_scratch("ext_set"));
+    snprintf(text, sizeof text, "[experiment]\nmethods = mc, mp\n%s", tiny);
+    const char *cfg = cli_config("ext_set", text);
+    snprintf(args, sizeof args,
+             "run --quiet --set 'method.mine.command=sh %s {out}' --set method.mine.timeout=60 "
+             "--set experiment.methods=mc,mp,mine --out %s %s",
+             rad, out, cfg);
+    cli_expect(args, 0, "");
+    assert_same_rows(out, "summary.csv", "mine", "mp");
+    assert_true(file_has(out, "config.ini", "[method.mine]\ncommand = sh "));
+    assert_true(file_has(out, "provenance.txt", "method.mine.timeout = 60\n"));
+    /* Overriding the file's command: the file's would fail (exit 3). */
+    snprintf(text, sizeof text,
+             "[experiment]\nmethods = mp, mine\n%s[method.mine]\ncommand = exit 3 {out}\n", tiny);
+    cfg = cli_config("ext_set2", text);
+    snprintf(args, sizeof args, "run --quiet --set 'method.mine.command=sh %s {out}' --out %s2 %s",
+             rad, out, cfg);
+    cli_expect(args, 0, "");
+    char out2[1300];
+    snprintf(out2, sizeof out2, "%s2", out);
+    assert_same_rows(out2, "radiance.csv", "mine", "mp"); /* no mc: no summary.csv */
+    struct {
+        const char *set, *needle;
+    } bad[] = {
+        {"method.mine=x", "--set method.mine=x: expected method.NAME.KEY=VALUE"},
+        {"method.mine.cmd=x", "--set method.mine.cmd: unknown key"},
+        {"'method.a b.command=x {out}'", "--set method.a b.command: a method name may hold"},
+        {"method.mine.timeout=-1", "--set method.mine.timeout: seconds, a number in (0, 1e6]"},
+        {"method.mine.command=true", "--set method.mine.command: holds no {out}"},
+        {"method.mc.command={out}", "--set method.mc: 'mc' is a built-in method's id"},
+        {"method.other.timeout=5", "--set method.other: no command given"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(args, sizeof args, "run --quiet --set %s --out %s3 %s", bad[i].set, out, cfg);
+        cli_expect(args, 2, bad[i].needle);
+        assert_int_equal(tu_sh("test ! -e %s3", out), 0);
+    }
+}
+
+/* One run of tiny's mc (env: "" or "VAR=value ..."; opts: extra options) into out: 1 when it
+ * traced its 20000 photons (provenance.txt's mc.photons_traced, written only for a traced
+ * reference), 0 when it said it took them from a cache and traced none. Counted, not timed. */
+static int traced(const char *env, const char *opts, const char *out)
+{
+    char args[4096];
+    snprintf(args, sizeof args, "run %s --out %s %s", opts, out,
+             cli_config("ext_cache_env", "[experiment]\nmethods = mc\n[tube]\nsegments_top = 8\n"
+                                         "segments_side = 3\n[bins]\ntheta = 2\nphi = 2\n[mc]\n"
+                                         "photons = 20000\n"));
+    int rc = cli_run_env(env, args, cli_out, sizeof cli_out);
+    if (rc != 0)
+        fail_msg("%s ppbench %s: exit %d:\n%s", env, args, rc, cli_out);
+    int from_cache = strstr(cli_out, "20000 photons from the reference cache") != NULL &&
+                     strstr(cli_out, ", 0 traced") != NULL;
+    int was_traced = file_has(out, "provenance.txt", "mc.photons_traced = 20000\n");
+    if (from_cache == was_traced)
+        fail_msg("%s ppbench %s: traced %d, from the cache %d:\n%s", env, args, was_traced,
+                 from_cache, cli_out);
+    return was_traced;
+}
+
+/* How many cache files dir holds (mc-<key>.bin). */
+static int cache_files(const char *dir)
+{
+    char cmd[1400];
+    snprintf(cmd, sizeof cmd, "ls %s/mc-*.bin 2>/dev/null | wc -l", dir);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    int n = -1;
+    if (fscanf(p, "%d", &n) != 1)
+        n = -1;
+    pclose(p);
+    return n;
+}
+
+/* The default cache of a plain run (no --ref-cache): $PPBENCH_CACHE, else
+ * $XDG_CACHE_HOME/ppbench/ref, else ~/.cache/ppbench/ref; --no-ref-cache and an empty
+ * $PPBENCH_CACHE trace and store nothing. PoCL keeps its own cache under the same variables:
+ * POCL_CACHE_DIR pins it to a scratch directory, so only ppbench's cache moves. */
+static void test_default_cache(void **state)
+{
+    (void)state;
+    char dir[1024], env[4096], out[1100], pocl[1100];
+    snprintf(dir, sizeof dir, "%s", tu_scratch("ext_defcache"));
+    snprintf(pocl, sizeof pocl, "%s/pocl", dir);
+    char c1[1100], c2[1100], c3[1100];
+    snprintf(c1, sizeof c1, "%s/env", dir);
+    snprintf(c2, sizeof c2, "%s/xdg/ppbench/ref", dir);
+    snprintf(c3, sizeof c3, "%s/home/.cache/ppbench/ref", dir);
+    /* $PPBENCH_CACHE: the first run traces and stores, the second reads it. */
+    snprintf(env, sizeof env, "POCL_CACHE_DIR=%s PPBENCH_CACHE=%s", pocl, c1);
+    snprintf(out, sizeof out, "%s/a", dir);
+    assert_true(traced(env, "--quiet", out));
+    assert_int_equal(cache_files(c1), 1);
+    snprintf(out, sizeof out, "%s/b", dir);
+    assert_false(traced(env, "", out));
+    /* --no-ref-cache: traced, though the cache holds it. */
+    snprintf(out, sizeof out, "%s/c", dir);
+    assert_true(traced(env, "--quiet --no-ref-cache", out));
+    /* No $PPBENCH_CACHE: $XDG_CACHE_HOME/ppbench/ref, then ~/.cache/ppbench/ref. */
+    snprintf(env, sizeof env, "env -u PPBENCH_CACHE POCL_CACHE_DIR=%s XDG_CACHE_HOME=%s/xdg", pocl,
+             dir);
+    snprintf(out, sizeof out, "%s/d", dir);
+    assert_true(traced(env, "--quiet", out));
+    assert_int_equal(cache_files(c2), 1);
+    snprintf(out, sizeof out, "%s/e", dir);
+    assert_false(traced(env, "--quiet", out));
+    snprintf(env, sizeof env,
+             "env -u PPBENCH_CACHE -u XDG_CACHE_HOME POCL_CACHE_DIR=%s HOME=%s/home", pocl, dir);
+    snprintf(out, sizeof out, "%s/f", dir);
+    assert_true(traced(env, "--quiet", out));
+    assert_int_equal(cache_files(c3), 1);
+    /* $PPBENCH_CACHE set empty: no cache at all (what make test runs under). */
+    snprintf(env, sizeof env, "POCL_CACHE_DIR=%s HOME=%s/home PPBENCH_CACHE=", pocl, dir);
+    snprintf(out, sizeof out, "%s/g", dir);
+    assert_true(traced(env, "--quiet", out));
+    /* --ref-cache DIR wins over $PPBENCH_CACHE. */
+    snprintf(env, sizeof env, "POCL_CACHE_DIR=%s PPBENCH_CACHE=%s/unused", pocl, dir);
+    char opts[1200];
+    snprintf(opts, sizeof opts, "--quiet --ref-cache %s", c1);
+    snprintf(out, sizeof out, "%s/h", dir);
+    assert_false(traced(env, opts, out));
+    assert_int_equal(tu_sh("test ! -e %s/unused", dir), 0);
+    cli_expect("run --ref-cache x --no-ref-cache configs/uniform_g0_normal.ini", 2,
+               "--ref-cache and --no-ref-cache: give one of them");
+}
+
+/* A changed kernel is another reference: the key holds the hash of mc.cl's source text and of
+ * every header it includes. A copy of kernels/ in another directory (PPBENCH_KERNELS) serves
+ * the cached tallies (the text is the same, its place does not count); a comment added to
+ * mc.cl, or to a header it includes (ppb_sampling.h), makes the run trace again. */
+static void test_cache_kernel_change(void **state)
+{
+    (void)state;
+    char dir[1024], env[4096], out[1100], cache[1100];
+    snprintf(dir, sizeof dir, "%s", tu_scratch("ext_kcache"));
+    snprintf(cache, sizeof cache, "%s/cache", dir);
+    assert_int_equal(tu_sh("rm -rf %s/k && cp -r %s %s/k", dir, PPB_KERNEL_DIR, dir), 0);
+    snprintf(env, sizeof env, "PPBENCH_CACHE=%s", cache);
+    snprintf(out, sizeof out, "%s/a", dir);
+    assert_true(traced(env, "--quiet", out));
+    snprintf(env, sizeof env, "PPBENCH_CACHE=%s PPBENCH_KERNELS=%s/k", cache, dir);
+    snprintf(out, sizeof out, "%s/b", dir);
+    assert_false(traced(env, "--quiet", out));
+    const char *edits[] = {"mc.cl", "ppb_sampling.h"};
+    for (int i = 0; i < 2; i++) {
+        /* mc.cl restored from kernels/ each time: the second edit is the header's alone. */
+        assert_int_equal(tu_sh("cp %s/%s %s/k/%s && printf '\\n/* changed */\\n' >> %s/k/%s",
+                               PPB_KERNEL_DIR, edits[0], dir, edits[0], dir, edits[i]),
+                         0);
+        snprintf(out, sizeof out, "%s/c%d", dir, i);
+        if (!traced(env, "--quiet", out))
+            fail_msg("%s edited: the cached tallies were used", edits[i]);
+    }
+    /* The edit is a comment: the tallies traced again are the same (the key is the text, the
+     * tallies a function of seed and index). */
+    char *ra = rows_of(out, "radiance.csv", "mc");
+    snprintf(out, sizeof out, "%s/a", dir);
+    char *rb = rows_of(out, "radiance.csv", "mc");
+    assert_true(*ra);
+    assert_string_equal(ra, rb);
+    free(ra);
+    free(rb);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -513,6 +687,9 @@ int main(void)
         cmocka_unit_test(test_score),
         cmocka_unit_test(test_python),
         cmocka_unit_test(test_ref_cache),
+        cmocka_unit_test(test_set_method),
+        cmocka_unit_test(test_default_cache),
+        cmocka_unit_test(test_cache_kernel_change),
     };
     return cmocka_run_group_tests(tests, make_ref, NULL);
 }

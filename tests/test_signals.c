@@ -2,7 +2,8 @@
  * ($PPBENCH): SIGINT during the plane-parallel setup and during a large ppslab solve is honoured
  * within seconds; a second SIGINT or SIGTERM exits at once; an interrupt skips the methods not
  * yet started, says so and writes what was done, marked partial; mp+ss reuses the experiment's
- * mp and ss; mp prints a completion line like every method.
+ * mp and ss; mp prints a completion line like every method; an interrupted sweep counts only
+ * the points it finished.
  *
  * The bounds on how long an interrupted run takes to exit ("within 5 s of the signal") are
  * behaviour, not speed targets: each run interrupted here had, on the code before the fix,
@@ -348,6 +349,45 @@ static void test_mp_ss_reuses_mp_and_ss(void **state)
     }
 }
 
+/* Issue 16: an interrupted sweep counted the point it was computing as done. Two points of an
+ * endless Monte Carlo, interrupted in the first: the completion line and the summary both say
+ * 0 points done (before: "1 point in ... (interrupted)" beside "0 of 2 points done"), and no
+ * point's rows are written (the expected count: the files, which the summary counts). */
+static void test_interrupted_sweep_counts(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("sig-sweep");
+    char cfg[1200], args[3000], grid[1300];
+    snprintf(cfg, sizeof cfg, "%s",
+             cli_config("sig-sweep", "[experiment]\nname = t\nmethods = mc\n[medium]\n"
+                                     "g = 0, 0.5\n[mc]\nphotons = 1e10\n"));
+    snprintf(args, sizeof args, "sweep --no-ref-cache --out '%s/out' '%s'", dir, cfg);
+    snprintf(grid, sizeof grid, "%s/out/grid.txt", dir);
+    child c;
+    start(&c, dir, args);
+    /* grid.txt is written just before the first point starts. */
+    double t0 = now_s();
+    while (access(grid, F_OK) != 0) {
+        int st;
+        if (waitpid(c.pid, &st, WNOHANG) == c.pid)
+            fail_msg("ppbench exited before writing grid.txt:\n%s", slurp(c.log));
+        if (now_s() - t0 > 60) {
+            kill(c.pid, SIGKILL);
+            waitpid(c.pid, &st, 0);
+            fail_msg("no grid.txt within 60 s:\n%s", slurp(c.log));
+        }
+        sleep_s(0.02);
+    }
+    sleep_s(1.5);
+    send(&c, SIGINT);
+    assert_int_equal(expect_exit(&c), 130);
+    const char *log = slurp(c.log);
+    expect_in(log, "t: interrupted: 0 of 2 points done", "stderr");
+    expect_in(log, "t: 0 points in ", "stderr");
+    expect_not_in(log, "t: 1 point in ", "stderr");
+    assert_int_equal(tu_sh("test -z \"$(ls '%s/out/points/' | grep rows.csv)\"", dir), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -357,6 +397,7 @@ int main(void)
         cmocka_unit_test(test_interrupted_mc_skips_the_rest),
         cmocka_unit_test(test_mp_completion_line),
         cmocka_unit_test(test_mp_ss_reuses_mp_and_ss),
+        cmocka_unit_test(test_interrupted_sweep_counts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -4,8 +4,12 @@
  *   run's bytes);
  * - one Monte Carlo run split into 4 shards and merged gives radiance.csv and totals.csv
  *   byte-identical to the single run (photon i's random numbers depend on i alone);
- * - bad sweep configs fail before any work starts. */
-#include "testutil.h"
+ * - bad sweep configs fail before any work starts;
+ * - the reference cache serves sweep points: a 2-point sweep run again into another directory
+ *   traces no photon (counted from what each point's mc says, not timed), by --ref-cache and by
+ *   the default ($PPBENCH_CACHE), with the same sweep.csv;
+ * - --jobs 2 reports the sweep's point count, not one worker's (issue 16). */
+#include "cliutil.h"
 
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -117,12 +121,79 @@ static void test_bad_sweeps(void **state)
     }
 }
 
+/* Two points, the Monte Carlo alone: the cache's bookkeeping. */
+static const char *two_points =
+    "[experiment]\nname = sw2\nmethods = mc, mp\n[mp]\npairs = 2\n[tube]\nsegments_top = "
+    "8\nsegments_side = 3\n"
+    "[bins]\ntheta = 2\nphi = 2\n[medium]\ng = 0, 0.5\n[mc]\nphotons = 20000\nbatches = 4\n";
+
+/* How many times out holds needle. */
+static int count_of(const char *out, const char *needle)
+{
+    int n = 0;
+    for (const char *p = strstr(out, needle); p; p = strstr(p + 1, needle))
+        n++;
+    return n;
+}
+
+static void test_sweep_ref_cache(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("sweepcache");
+    char cfg[1200], args[4096], env[1400], w[1300], m[1300];
+    snprintf(cfg, sizeof cfg, "%s/sw2.ini", d);
+    tu_write_file(cfg, two_points);
+    /* First run: both points trace (no point says it read the cache) and store. */
+    snprintf(args, sizeof args, "sweep --ref-cache %s/cache --out %s/first %s", d, d, cfg);
+    cli_expect(args, 0, "wrote");
+    assert_int_equal(count_of(cli_out, "from the reference cache"), 0);
+    assert_int_equal(tu_sh("test $(ls %s/cache/mc-*.bin | wc -l) -eq 2", d), 0);
+    /* Again into a fresh directory (its points not done): every point reads the cache. */
+    snprintf(args, sizeof args, "sweep --ref-cache %s/cache --out %s/second %s", d, d, cfg);
+    cli_expect(args, 0, "wrote");
+    assert_int_equal(count_of(cli_out, "20000 photons from the reference cache"), 2);
+    assert_int_equal(count_of(cli_out, ", 0 traced"), 2);
+    /* The default cache: $PPBENCH_CACHE, no option. */
+    snprintf(env, sizeof env, "PPBENCH_CACHE=%s/cache", d);
+    snprintf(args, sizeof args, "sweep --out %s/third %s", d, cfg);
+    cli_expect_env(env, args, 0, "wrote");
+    assert_int_equal(count_of(cli_out, ", 0 traced"), 2);
+    /* --no-ref-cache: traced again. */
+    snprintf(args, sizeof args, "sweep --no-ref-cache --out %s/fourth %s", d, cfg);
+    cli_expect_env(env, args, 0, "wrote");
+    assert_int_equal(count_of(cli_out, "from the reference cache"), 0);
+    const char *dirs[] = {"second", "third", "fourth"};
+    snprintf(w, sizeof w, "%s/first/sweep.csv", d);
+    for (int i = 0; i < 3; i++) {
+        snprintf(m, sizeof m, "%s/%s/sweep.csv", d, dirs[i]);
+        same_bytes(w, m);
+    }
+}
+
+/* --jobs 2 over 2 points: the completion line counts both (it was the first worker's own
+ * line, "1 point"); the sweep's own count is the expected value. */
+static void test_jobs_count(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("sweepjobs");
+    char cfg[1200], args[4096];
+    snprintf(cfg, sizeof cfg, "%s/sw2.ini", d);
+    tu_write_file(cfg, two_points);
+    snprintf(args, sizeof args, "sweep --no-ref-cache --jobs 2 --out %s/j %s", d, cfg);
+    cli_expect(args, 0, "sw2: 2 points in ");
+    if (strstr(cli_out, "sw2: 1 point in "))
+        fail_msg("a worker's count was printed:\n%s", cli_out);
+    assert_int_equal(count_of(cli_out, " points in "), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_sweeps),
         cmocka_unit_test(test_mc_shards_merge),
         cmocka_unit_test(test_sweep_whole_shards_resume),
+        cmocka_unit_test(test_sweep_ref_cache),
+        cmocka_unit_test(test_jobs_count),
     };
     return cmocka_run_group_tests_name("sweep", tests, NULL, NULL);
 }

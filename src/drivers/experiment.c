@@ -20,14 +20,16 @@
 #define PPB_VERSION "unknown"
 #endif
 
-static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx, ppb_err *err)
+/* Runs method m under the config's id for it (an external method's descriptor has none). */
+static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, ppb_run_ctx *ctx,
+                      ppb_err *err)
 {
     int nout = m->also ? 2 : 1;
     if (ex->n + nout > PPB_MAX_RESULTS)
         return ppb_fail(err, "too many results");
     ppb_layout lo = ppb_scene_layout(&ex->cfg->scene);
     ppb_result *out = &ex->res[ex->n];
-    if (ppb_result_init(&out[0], m->id, &lo, err))
+    if (ppb_result_init(&out[0], id, &lo, err))
         return -1;
     if (nout == 2 && ppb_result_init(&out[1], m->also, &lo, err)) {
         ppb_result_free(&out[0]);
@@ -35,7 +37,7 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
     }
     ex->n += nout;
     if (!ctx->quiet)
-        fprintf(stderr, "%s: %s ...\n", ex->cfg->name, m->id);
+        fprintf(stderr, "%s: %s ...\n", ex->cfg->name, id);
     double t0 = ppb_now();
     ppb_err why = {{0}};
     ctx->prior = ex->res; /* what ran before it, for a method that combines others */
@@ -50,18 +52,18 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
              * failure, an incomplete method (no rows), as when it stops midway (below). */
             ex->partial = 1;
             if (ex->nincomplete < PPB_MAX_METHODS)
-                snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", m->id);
+                snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", id);
             fprintf(stderr,
                     "%s: %s interrupted before it finished (%s): none of its rows written\n",
-                    ex->cfg->name, m->id, why.msg);
+                    ex->cfg->name, id, why.msg);
             return 0;
         }
         if (ex->nfailed < PPB_MAX_METHODS) {
-            snprintf(ex->failed[ex->nfailed], sizeof ex->failed[0], "%s", m->id);
+            snprintf(ex->failed[ex->nfailed], sizeof ex->failed[0], "%s", id);
             snprintf(ex->failed_why[ex->nfailed], sizeof ex->failed_why[0], "%s", why.msg);
             ex->nfailed++;
         }
-        fprintf(stderr, "%s: %s failed: %s\n", ex->cfg->name, m->id, why.msg);
+        fprintf(stderr, "%s: %s failed: %s\n", ex->cfg->name, id, why.msg);
         return 0;
     }
     for (int i = 0; i < nout; i++) {
@@ -76,9 +78,9 @@ static int run_method(ppb_experiment *ex, const ppb_method *m, ppb_run_ctx *ctx,
             ppb_result_free(&out[i]);
         ex->n -= nout;
         if (ex->nincomplete < PPB_MAX_METHODS)
-            snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", m->id);
+            snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", id);
         fprintf(stderr, "%s: %s interrupted before it finished: none of its rows written\n",
-                ex->cfg->name, m->id);
+                ex->cfg->name, id);
     }
     return 0;
 }
@@ -101,7 +103,7 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
         ppb_work_print(stderr, cfg);
     int i = 0;
     for (; i < cfg->nmethods && !ppb_interrupted(); i++)
-        if (run_method(ex, ppb_method_find(cfg->methods[i]), ctx, err))
+        if (run_method(ex, cfg->methods[i], ppb_method_find(cfg, cfg->methods[i]), ctx, err))
             return -1;
     ctx->prior = NULL;
     ctx->nprior = 0;
@@ -132,7 +134,7 @@ void ppb_experiment_free(ppb_experiment *ex)
 const ppb_result *ppb_experiment_reference(const ppb_experiment *ex)
 {
     for (int i = 0; i < ex->n; i++) {
-        const ppb_method *m = ppb_method_find(ex->res[i].method);
+        const ppb_method *m = ppb_method_find(ex->cfg, ex->res[i].method);
         if (m && m->reference == 1)
             return &ex->res[i];
     }
@@ -154,7 +156,7 @@ static const ppb_method *parent_of(const char *id)
  * companion (mc1) and the slab solution (ppslab, reference == 2). */
 static int is_secondary(const char *id)
 {
-    const ppb_method *m = ppb_method_find(id);
+    const ppb_method *m = ppb_method_find(NULL, id); /* built-in: no external method is one */
     const ppb_method *p = parent_of(id);
     return (m && m->reference == 2) || (p && p->reference == 1);
 }
@@ -162,7 +164,7 @@ static int is_secondary(const char *id)
 /* The result left out when measuring against ref: its companion, or its parent. */
 static const char *skip_for(const ppb_result *ref)
 {
-    const ppb_method *m = ppb_method_find(ref->method);
+    const ppb_method *m = ppb_method_find(NULL, ref->method); /* references are built-in */
     if (m && m->also)
         return m->also;
     const ppb_method *p = parent_of(ref->method);
@@ -320,8 +322,8 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
     if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err) ||
-        ppb_rte2d_write_refinements(ex->cfg, dir, err) ||
-        write_provenance(ex, dir, err) || write_config_ini(ex, dir, err))
+        ppb_rte2d_write_refinements(ex->cfg, dir, err) || write_provenance(ex, dir, err) ||
+        write_config_ini(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
     const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};

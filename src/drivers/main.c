@@ -44,6 +44,7 @@ enum {
     OPT_QUIET = 1 << 6,
     OPT_REF = 1 << 20,
     OPT_REF_CACHE = 1 << 21,
+    OPT_NO_REF_CACHE = 1 << 22,
     OPT_SHARDS = 1 << 7, /* slurm's: its job array and scripts (drivers/slurm.h) */
     OPT_PARTITION = 1 << 8,
     OPT_TIME = 1 << 9,
@@ -67,8 +68,11 @@ static const struct option_doc {
     {OPT_QUIET, "--quiet", NULL, "no progress lines on stderr"},
     {OPT_REF, "--ref", "DIR", "score: the finished experiment to score against"},
     {OPT_REF_CACHE, "--ref-cache", "DIR",
-     "run: reuse the Monte Carlo reference stored under DIR\nby its fingerprint (and "
-     "store it there)"},
+     "run, sweep: reuse the Monte Carlo reference stored under\nDIR by its fingerprint (and "
+     "store it there); default:\n$PPBENCH_CACHE, else $XDG_CACHE_HOME/ppbench/ref, else\n"
+     "~/.cache/ppbench/ref ($PPBENCH_CACHE set empty: none)"},
+    {OPT_NO_REF_CACHE, "--no-ref-cache", NULL,
+     "run, sweep: no reference cache: trace the Monte Carlo"},
     {OPT_SHARDS, "--shards", "N",
      "slurm: N array tasks, each one shard (1 to 1000; at most\nthe grid points or photons)"},
     {OPT_PARTITION, "--partition", "P", "slurm: #SBATCH --partition (default: the cluster's)"},
@@ -93,6 +97,7 @@ typedef struct cli {
     int jobs;
     const char *ref;
     const char *ref_cache;
+    int no_ref_cache;
     int shards, cpus, submit; /* slurm's */
     const char *partition, *time, *mem;
     const char **args;
@@ -196,6 +201,9 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
         case OPT_REF_CACHE:
             c->ref_cache = v;
             break;
+        case OPT_NO_REF_CACHE:
+            c->no_ref_cache = 1;
+            break;
         case OPT_SUBMIT:
             c->submit = 1;
             break;
@@ -247,6 +255,16 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
             break;
         }
     }
+    if (c->ref_cache && c->no_ref_cache) {
+        fprintf(stderr, "ppbench %s: --ref-cache and --no-ref-cache: give one of them\n",
+                cmd->name);
+        return EXIT_USAGE;
+    }
+    if (c->ref_cache && !*c->ref_cache) {
+        fprintf(stderr, "ppbench %s: --ref-cache: empty (use --no-ref-cache for none)\n",
+                cmd->name);
+        return EXIT_USAGE;
+    }
     if (!cmd->takes_args && c->nargs > 0) {
         fprintf(stderr, "ppbench %s: unexpected argument '%s' (see ppbench %s --help)\n", cmd->name,
                 c->args[0], cmd->name);
@@ -259,6 +277,32 @@ static void free_cli(cli *c)
 {
     free(c->sets);
     free(c->args);
+}
+
+/* The Monte Carlo reference cache of run and sweep (methods/mc_cache.h): --ref-cache DIR,
+ * none with --no-ref-cache, else $PPBENCH_CACHE (set empty: none), else the user's cache
+ * directory by the XDG base directory rule ($XDG_CACHE_HOME, else ~/.cache) under
+ * ppbench/ref: per user and outside any checkout, so every run of every checkout shares the
+ * references already traced, and a cleaner of caches may delete it (it is only ever a miss).
+ * NULL: no cache (also when no home is known). buf holds a composed path. */
+static const char *ref_cache_dir(const cli *c, char *buf, size_t cap)
+{
+    if (c->no_ref_cache)
+        return NULL;
+    if (c->ref_cache)
+        return c->ref_cache;
+    const char *env = getenv("PPBENCH_CACHE");
+    if (env)
+        return *env ? env : NULL;
+    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    int n;
+    if (xdg && xdg[0] == '/') /* the XDG rule: a relative value is ignored */
+        n = snprintf(buf, cap, "%s/ppbench/ref", xdg);
+    else if (home && *home)
+        n = snprintf(buf, cap, "%s/.cache/ppbench/ref", home);
+    else
+        return NULL;
+    return n > 0 && (size_t)n < cap ? buf : NULL;
 }
 
 /* Loads a config with its grid (the keys holding lists), applies every --set and then --out.
@@ -426,11 +470,12 @@ static int cmd_run(const cli *c)
         }
     }
     ppb_grid_free(grid);
+    char cache_buf[PPB_PATH_MAX];
+    const char *cache = ref_cache_dir(c, cache_buf, sizeof cache_buf);
     for (int i = 0; i < c->nargs && code == EXIT_OK; i++) {
         const ppb_config *cfg = &cfgs[i];
         ppb_experiment ex = {0};
-        ppb_run_ctx ctx = {
-            .device_selector = c->device, .quiet = c->quiet, .ref_cache = c->ref_cache};
+        ppb_run_ctx ctx = {.device_selector = c->device, .quiet = c->quiet, .ref_cache = cache};
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
@@ -490,34 +535,46 @@ static int cmd_perf(const cli *c)
     return EXIT_OK;
 }
 
+/* The one config of sweep and slurm, with its grid, loaded and checked (load_config) and its
+ * output directory checked: EXIT_OK with *grid to free, else the exit code (message printed,
+ * nothing to free). */
+static int load_grid_config(const cli *c, ppb_config *cfg, ppb_grid **grid)
+{
+    *grid = ppb_grid_new();
+    if (!*grid) {
+        fprintf(stderr, "ppbench: out of memory\n");
+        return EXIT_RUN;
+    }
+    ppb_err err = {{0}};
+    int code =
+        load_config(c, c->args[0], cfg, *grid, &err) ? usage_error(&err) : check_config_out(c, cfg);
+    if (code) {
+        ppb_grid_free(*grid);
+        *grid = NULL;
+    }
+    return code;
+}
+
 static int cmd_sweep(const cli *c)
 {
     if (c->nargs != 1) {
         fprintf(stderr, "ppbench sweep: give exactly one config (see ppbench sweep --help)\n");
         return EXIT_USAGE;
     }
-    ppb_grid *grid = ppb_grid_new();
-    if (!grid) {
-        fprintf(stderr, "ppbench: out of memory\n");
-        return EXIT_RUN;
-    }
+    ppb_grid *grid;
     ppb_config cfg;
-    ppb_err err = {{0}};
-    if (load_config(c, c->args[0], &cfg, grid, &err)) {
-        ppb_grid_free(grid);
-        return usage_error(&err);
-    }
-    int code = check_config_out(c, &cfg);
-    if (code) {
-        ppb_grid_free(grid);
+    int code = load_grid_config(c, &cfg, &grid);
+    if (code)
         return code;
-    }
+    char cache_buf[PPB_PATH_MAX];
     ppb_sweep_opts o = {.device = c->device,
                         .quiet = c->quiet,
                         .yes = c->yes,
                         .shard_i = c->shard_i,
                         .shard_n = c->shard_n,
-                        .jobs = c->jobs};
+                        .jobs = c->jobs,
+                        .ref_cache = ref_cache_dir(c, cache_buf, sizeof cache_buf)};
+    ppb_err err = {{0}};
     int rc = ppb_sweep_run(&cfg, grid, &o, &err);
     ppb_grid_free(grid);
     if (rc == PPB_SWEEP_BAD_CONFIG) {
@@ -594,18 +651,11 @@ static int cmd_slurm(const cli *c)
                         "(see ppbench slurm --help)\n");
         return EXIT_USAGE;
     }
-    ppb_grid *grid = ppb_grid_new();
-    if (!grid) {
-        fprintf(stderr, "ppbench: out of memory\n");
-        return EXIT_RUN;
-    }
+    ppb_grid *grid;
     ppb_config cfg;
-    ppb_err err = {{0}};
-    if (load_config(c, c->args[0], &cfg, grid, &err)) {
-        ppb_grid_free(grid);
-        return usage_error(&err);
-    }
-    int code = check_config_out(c, &cfg);
+    int code = load_grid_config(c, &cfg, &grid);
+    if (code)
+        return code;
     ppb_slurm_opts o = {.shards = c->shards,
                         .partition = c->partition,
                         .time = c->time,
@@ -614,10 +664,9 @@ static int cmd_slurm(const cli *c)
                         .device = c->device,
                         .out = c->out,
                         .submit = c->submit};
-    int rc = code ? 0 : ppb_slurm_run(&cfg, grid, &o, &err);
+    ppb_err err = {{0}};
+    int rc = ppb_slurm_run(&cfg, grid, &o, &err);
     ppb_grid_free(grid);
-    if (code)
-        return code;
     if (rc) {
         fprintf(stderr, "ppbench slurm: %s\n", err.msg);
         return rc == PPB_SLURM_BAD_CONFIG ? EXIT_USAGE : EXIT_RUN;
@@ -676,10 +725,12 @@ static const command commands[] = {
      "run every method of each experiment config and write\nthe outputs of docs/reference.md under "
      "[output] dir",
      "ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini",
-     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET | OPT_REF_CACHE, 1, cmd_run},
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET | OPT_REF_CACHE | OPT_NO_REF_CACHE, 1, cmd_run},
     {"sweep", "CONFIG", 0, "run a grid sweep (keys holding lists) into <dir>/sweep.csv",
      "ppbench sweep --shard 2/3 --jobs 2 configs/sweep_example.ini",
-     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARD | OPT_JOBS | OPT_YES | OPT_QUIET, 1, cmd_sweep},
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARD | OPT_JOBS | OPT_YES | OPT_QUIET | OPT_REF_CACHE |
+         OPT_NO_REF_CACHE,
+     1, cmd_sweep},
     {"merge", "SHARD_DIR...", OPT_OUT, "merge sweep shards (--out DIR) into one sweep.csv",
      "ppbench merge --out /tmp/sweep /tmp/part1 /tmp/part2 /tmp/part3", OPT_OUT, 1, cmd_merge},
     {"mc-shard", "CONFIG", OPT_OUT,

@@ -347,17 +347,38 @@ static long long assemble(const char *const *dirs, int ndirs, const char *out, p
     return ppb_sweep_failures_assemble(dirs, ndirs, out, err) ? -1 : 0;
 }
 
-/* The points with index % parts == part, one device context for all of them. */
+/* The points of this shard whose rows are written (computed now or before). */
+static long long shard_done(const ppb_config *cfg, const ppb_grid *grid, const uint64_t *hashes,
+                            const ppb_sweep_opts *o, long long *mine)
+{
+    long long done = 0, n = ppb_grid_npoints(grid);
+    *mine = 0;
+    for (long long i = o->shard_i - 1; i < n; i += o->shard_n) {
+        char path[1300];
+        point_file(cfg->out_dir, hashes[i], ROWS_EXT, path, sizeof path);
+        ++*mine;
+        done += exists(path);
+    }
+    return done;
+}
+
+/* The points with index % parts == part, one device context for all of them. A point counts as
+ * done once its rows are written: an interrupted or failed one is not (issue 16: the point in
+ * progress at a Ctrl-C was counted). The completion line is printed when end_line is set (the
+ * serial sweep; with --jobs the parent prints it for all workers). */
 static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t *hashes,
-                     const ppb_sweep_opts *o, int part, int parts, int quiet, ppb_err *err)
+                     const ppb_sweep_opts *o, int part, int parts, int quiet, int end_line,
+                     ppb_err *err)
 {
     long long n = ppb_grid_npoints(grid);
     ppb_config pt;
     ppb_progress pr;
     ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
     /* Points that share a medium share the marcher's tables: built once per process. */
-    ppb_run_ctx ctx = {
-        .device_selector = o->device, .quiet = 1, .march_cache = ppb_march_cache_new()};
+    ppb_run_ctx ctx = {.device_selector = o->device,
+                       .quiet = 1,
+                       .march_cache = ppb_march_cache_new(),
+                       .ref_cache = o->ref_cache};
     long long done = 0;
     int rc = 0;
     for (long long i = part; i < n && rc == 0 && !ppb_interrupted(); i += parts) {
@@ -367,11 +388,13 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t
         point_file(cfg->out_dir, hashes[i], ROWS_EXT, path, sizeof path);
         if (!exists(path))
             rc = run_point(cfg, &pt, hashes[i], &ctx, err);
-        ppb_progress_update(&pr, (double)++done * parts);
+        if (exists(path))
+            ppb_progress_update(&pr, (double)++done * parts);
     }
     ppb_ctx_close(&ctx);
     ppb_march_cache_free(ctx.march_cache);
-    ppb_progress_end(&pr, (double)done);
+    if (end_line)
+        ppb_progress_end(&pr, (double)done);
     return rc;
 }
 
@@ -382,7 +405,9 @@ static void sleep_ms(long ms)
 }
 
 /* --jobs J: J processes, each its own device context, taking every J-th point of this shard;
- * the first one shows progress. A failing child's message is on its stderr.
+ * the first one shows progress, and this process, once all have ended, the completion line
+ * with the points of the whole shard done (issue 16: it was the first worker's own count,
+ * "1 points" of a 2-point sweep under --jobs 2). A failing child's message is on its stderr.
  *
  * The workers die with the sweep: each asks the kernel for SIGTERM when its parent dies
  * (PR_SET_PDEATHSIG; the getppid() check covers a parent gone before the request), so a
@@ -396,9 +421,11 @@ static int run_jobs(const ppb_config *cfg, const ppb_grid *grid, const uint64_t 
     enum { MAX_JOBS = 64 };
     int jobs = o->jobs > 1 ? o->jobs : 1, parts = o->shard_n * jobs;
     if (jobs == 1)
-        return run_shard(cfg, grid, hashes, o, o->shard_i - 1, o->shard_n, o->quiet, err);
+        return run_shard(cfg, grid, hashes, o, o->shard_i - 1, o->shard_n, o->quiet, 1, err);
     if (jobs > MAX_JOBS)
         return ppb_fail(err, "--jobs %d: at most %d", jobs, MAX_JOBS);
+    ppb_progress pr;
+    ppb_progress_begin(&pr, cfg->name, "points", (double)ppb_grid_npoints(grid), o->quiet);
     fflush(NULL);
     pid_t pids[MAX_JOBS], parent = getpid();
     int started = 0;
@@ -412,7 +439,7 @@ static int run_jobs(const ppb_config *cfg, const ppb_grid *grid, const uint64_t 
                 _exit(1);
             ppb_err e = {{0}};
             int rc = run_shard(cfg, grid, hashes, o, o->shard_i - 1 + o->shard_n * started, parts,
-                               o->quiet || started, &e);
+                               o->quiet || started, 0, &e);
             if (rc)
                 fprintf(stderr, "ppbench sweep (job %d): %s\n", started + 1, e.msg);
             fflush(NULL);
@@ -459,6 +486,8 @@ static int run_jobs(const ppb_config *cfg, const ppb_grid *grid, const uint64_t 
                 failed += !ok && !stopped;
             }
     }
+    long long mine;
+    ppb_progress_end(&pr, (double)shard_done(cfg, grid, hashes, o, &mine));
     if (fork_failed)
         return ppb_fail(err, "--jobs %d: fork failed after %d: %s", jobs, started,
                         strerror(fork_errno));
@@ -482,13 +511,7 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_o
         rc = run_jobs(cfg, grid, hashes, o, err);
     if (ppb_interrupted() && hashed) {
         /* Interrupted: no failure (the caller exits 130), the finished points are kept. */
-        long long mine = 0, done = 0;
-        for (long long i = o->shard_i - 1; i < n; i += o->shard_n) {
-            char path[1300];
-            point_file(cfg->out_dir, hashes[i], ROWS_EXT, path, sizeof path);
-            mine++;
-            done += exists(path);
-        }
+        long long mine, done = shard_done(cfg, grid, hashes, o, &mine);
         fprintf(stderr,
                 "%s: interrupted: %lld of %lld points done, no sweep.csv written (run the same "
                 "command again to compute the other %lld)\n",

@@ -24,8 +24,9 @@
 typedef struct ppb_sweep_opts {
     const char *device;
     int quiet, yes;
-    int shard_i, shard_n; /* 1-based part of n */
-    int jobs;             /* processes on this machine (each opens the device), 1 = serial */
+    int shard_i, shard_n;  /* 1-based part of n */
+    int jobs;              /* processes on this machine (each opens the device), 1 = serial */
+    const char *ref_cache; /* every point's Monte Carlo reference cache (mc_cache.h), or NULL */
 } ppb_sweep_opts;
 
 /* Runs the grid points of cfg (its keys holding lists, loaded into grid by

@@ -172,7 +172,7 @@ static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, con
     int nm = 0;
     for (int m = 0; m < cfg->nmethods; m++) {
         const char *id = cfg->methods[m];
-        if (ppb_method_find(id)->reference == 1)
+        if (ppb_method_find(cfg, id)->reference == 1)
             continue;
         cell_row *rows = NULL;
         int n = 0;
@@ -196,7 +196,7 @@ static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, con
         int j = 0;
         for (int m = 0; m < cfg->nmethods; m++) {
             const char *id = cfg->methods[m];
-            if (ppb_method_find(id)->reference == 1)
+            if (ppb_method_find(cfg, id)->reference == 1)
                 continue;
             fprintf(gp,
                     "%s$m%d_%d using 1:2 with linespoints pt mpoint('%s') lc rgb mcolor('%s') "
@@ -265,14 +265,14 @@ int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *
         return 0;
     int has_reference = 0;
     for (int m = 0; m < cfg->nmethods; m++)
-        has_reference |= ppb_method_find(cfg->methods[m])->reference == 1;
+        has_reference |= ppb_method_find(cfg, cfg->methods[m])->reference == 1;
     if (!has_reference)
         return 0; /* no Monte Carlo: sweep.csv holds no RMS to draw, only totals */
     if (grid->naxes == 1)
         return draw(cfg, grid, dir, "sweep_rms", NULL, err);
     for (int m = 0; m < cfg->nmethods; m++) {
         const char *id = cfg->methods[m];
-        if (ppb_method_find(id)->reference == 1)
+        if (ppb_method_find(cfg, id)->reference == 1)
             continue; /* the reference: its RMS against itself is empty */
         char base[128];
         snprintf(base, sizeof base, "heatmap_%s", id);

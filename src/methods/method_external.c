@@ -22,11 +22,10 @@
 
 int ppb_external_check(const ppb_config *cfg, const ppb_external_def *d, ppb_err *err)
 {
+    char where[1200];
     if (!strstr(d->command, "{out}"))
-        return ppb_fail(err,
-                        "%s:%d: [method.%s] command: holds no {out} (the directory its "
-                        "radiance.csv goes to)",
-                        cfg->path, d->command_line, d->name);
+        return ppb_fail(err, "%s: holds no {out} (the directory its radiance.csv goes to)",
+                        ppb_config_external_where(cfg, d, "command", where, sizeof where));
     return 0;
 }
 

@@ -434,7 +434,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         return -1;
     ppb_mc_trace_info info = {0};
     int status = 0;
-    if (ctx->ref_cache && ppb_mc_cache_get(ctx->ref_cache, cfg, &t)) {
+    if (ctx->ref_cache && ppb_mc_cache_get(ctx, &t)) {
         /* The same reference was traced before (SPEC 13): no photon is traced now. */
         fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n", cfg->name,
                 (unsigned long long)t.count, ctx->ref_cache);
@@ -443,7 +443,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
             return -1;
         status = ppb_mc_trace(ctx, cfg->mc.first, cfg->mc.photons, &t, &info, err);
         if (status == 0 && !info.interrupted && ctx->ref_cache)
-            ppb_mc_cache_put(ctx->ref_cache, cfg, &t, info.traced);
+            ppb_mc_cache_put(ctx, &t, info.traced);
     }
     if (status == 0) {
         /* Said, not hidden: interactions past the event cap were rouletted (mc_params.h). */

@@ -43,31 +43,14 @@ static const ppb_method methods[] = {
      .check = ppb_rte2d_check},
 };
 
-/* Methods a config defines ([method.NAME], model/config.h), entered by ppb_methods_check when
- * it accepts the config: from then on they are found by id like the built-in ones, and run by
- * methods/method_external.c, which reads the command from the experiment's config. A process
- * loads one config (or the points of one sweep), so entries are only ever added. */
-static struct {
-    char id[32];
-    ppb_method m;
-} external[PPB_MAX_EXTERNAL];
-static int nexternal;
-
-static int add_external(const char *id)
-{
-    for (int i = 0; i < nexternal; i++)
-        if (strcmp(external[i].id, id) == 0)
-            return 0;
-    if (nexternal == PPB_MAX_EXTERNAL)
-        return -1;
-    snprintf(external[nexternal].id, sizeof external[nexternal].id, "%s", id);
-    external[nexternal].m =
-        (ppb_method){.id = external[nexternal].id,
-                     .summary = "external method (the config's [method.NAME] command)",
-                     .run = ppb_method_external};
-    nexternal++;
-    return 0;
-}
+/* Every method a config defines ([method.NAME], model/config.h) is run by
+ * methods/method_external.c, which reads its command from the experiment's config: one
+ * descriptor serves them all, found through the config's own list (ppb_method_find), so no
+ * table of them outlives the config or is shared between configs. */
+static const ppb_method external_method = {
+    .id = NULL,
+    .summary = "external method (the config's [method.NAME] command)",
+    .run = ppb_method_external};
 
 int ppb_method_count(void)
 {
@@ -79,17 +62,6 @@ const ppb_method *ppb_method_at(int i)
     return (i >= 0 && i < ppb_method_count()) ? &methods[i] : NULL;
 }
 
-const ppb_method *ppb_method_find(const char *id)
-{
-    for (int i = 0; i < ppb_method_count(); i++)
-        if (strcmp(methods[i].id, id) == 0)
-            return &methods[i];
-    for (int i = 0; i < nexternal; i++)
-        if (strcmp(external[i].id, id) == 0)
-            return &external[i].m;
-    return NULL;
-}
-
 static const ppb_method *builtin(const char *id)
 {
     for (int i = 0; i < ppb_method_count(); i++)
@@ -98,24 +70,30 @@ static const ppb_method *builtin(const char *id)
     return NULL;
 }
 
+const ppb_method *ppb_method_find(const ppb_config *cfg, const char *id)
+{
+    const ppb_method *m = builtin(id);
+    if (!m && cfg && ppb_config_external(cfg, id))
+        m = &external_method;
+    return m;
+}
+
 int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
 {
     /* A [method.NAME] may not take a built-in id: the config would then mean two methods. */
     int nbuiltin = ppb_method_count();
+    char where[1200];
     for (int i = 0; i < cfg->nexternal; i++)
         for (int j = 0; j < nbuiltin; j++)
             if (strcmp(cfg->external[i].name, methods[j].id) == 0 ||
                 (methods[j].also && strcmp(cfg->external[i].name, methods[j].also) == 0))
-                return ppb_fail(err, "%s:%d: [method.%s]: '%s' is a built-in method's id",
-                                cfg->path, cfg->external[i].line, cfg->external[i].name,
-                                cfg->external[i].name);
+                return ppb_fail(
+                    err, "%s: '%s' is a built-in method's id",
+                    ppb_config_external_where(cfg, &cfg->external[i], NULL, where, sizeof where),
+                    cfg->external[i].name);
     for (int i = 0; i < cfg->nexternal; i++)
         if (ppb_external_check(cfg, &cfg->external[i], err))
             return -1;
-    for (int i = 0; i < cfg->nmethods; i++)
-        if (ppb_config_external(cfg, cfg->methods[i]) && add_external(cfg->methods[i]))
-            return ppb_config_key_fail(cfg, "experiment", "methods", err,
-                                       "more than %d external methods", PPB_MAX_EXTERNAL);
     /* Unknown ids first, over the whole list, then slab-only methods: the order in which the
      * config used to refuse them when it parsed the list itself. */
     for (int i = 0; i < cfg->nmethods; i++)
@@ -124,10 +102,10 @@ int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
                                        "unknown method '%s' (see ppbench --help)", cfg->methods[i]);
     int slab = cfg->scene.geometry == PPB_GEOM_SLAB;
     for (int i = 0; i < cfg->nmethods; i++) {
-        const ppb_method *m = ppb_method_find(cfg->methods[i]);
+        const ppb_method *m = ppb_method_find(cfg, cfg->methods[i]);
         if (m->slab_only && !slab)
             return ppb_config_key_fail(cfg, "experiment", "methods", err,
-                                       "method '%s' runs in slab mode only", m->id);
+                                       "method '%s' runs in slab mode only", cfg->methods[i]);
         /* A point where the method's model has no meaning is refused here, before any work. */
         if (m->check && m->check(cfg, err))
             return -1;

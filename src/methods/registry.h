@@ -10,7 +10,11 @@
 #include "methods/method.h"
 #include "model/config.h"
 
-const ppb_method *ppb_method_find(const char *id); /* NULL when no method has that id */
+/* The method `id` names: a built-in one, or, when cfg defines [method.<id>], the descriptor
+ * every external method shares (its `id` is NULL: the id is the caller's, the NAME of the
+ * config's section). NULL when no method has that id (cfg NULL: built-in ones only). The
+ * lookup goes through cfg's own list: the registry keeps no state of its own. */
+const ppb_method *ppb_method_find(const ppb_config *cfg, const char *id);
 int ppb_method_count(void);
 const ppb_method *ppb_method_at(int i); /* NULL outside [0, ppb_method_count()) */
 

@@ -40,7 +40,7 @@ double ppb_work_results_bytes(const ppb_config *cfg)
 {
     double nres = 0;
     for (int m = 0; m < cfg->nmethods; m++) {
-        const ppb_method *me = ppb_method_find(cfg->methods[m]);
+        const ppb_method *me = ppb_method_find(cfg, cfg->methods[m]);
         nres += me && me->also ? 2 : 1;
     }
     return nres * (double)ppb_scene_layout(&cfg->scene).ncells * 2.0 * sizeof(double);

@@ -543,6 +543,7 @@ typedef struct parse_state {
     char seen[PPB_MAX_KEYS];
     int err_line; /* line of the first error (handler or text), 0 = none */
     int text_err; /* that error is the text's: why says it all */
+    int from_set; /* a --set method.NAME.KEY: may replace the file's key (on_method_key) */
     char why[1200];
     char what[160];
 } parse_state;
@@ -646,9 +647,17 @@ static int on_method_key(parse_state *st, const char *section, const char *name,
         snprintf(d->name, sizeof d->name, "%s", id);
         d->line = st->line;
     }
+    if (st->from_set) {
+        /* --set defines the key or replaces the file's (or an earlier --set's): the last wins,
+         * as for every other key. */
+        if (strcmp(name, "command") == 0)
+            d->command[0] = '\0', d->command_line = 0, d->command_set = 0;
+        if (strcmp(name, "timeout") == 0)
+            d->timeout = 0, d->timeout_line = 0, d->timeout_set = 0;
+    }
     if (strcmp(name, "command") == 0) {
         size_t have = strlen(d->command);
-        if (d->command_line && st->cont) {
+        if (d->command_line && st->cont && !st->from_set) {
             /* An indented line continues the command (inih's multi-line value): joined by a
              * space, so a command longer than one config line can be written. */
             if (have + 1 + strlen(value) >= sizeof d->command) {
@@ -670,6 +679,7 @@ static int on_method_key(parse_state *st, const char *section, const char *name,
         }
         snprintf(d->command, sizeof d->command, "%s", value);
         d->command_line = st->line;
+        d->command_set = st->from_set;
         return 1;
     }
     if (strcmp(name, "timeout") == 0) {
@@ -685,6 +695,7 @@ static int on_method_key(parse_state *st, const char *section, const char *name,
         }
         d->timeout = t;
         d->timeout_line = st->line;
+        d->timeout_set = st->from_set;
         return 1;
     }
     snprintf(st->why, sizeof st->why, "unknown key (a [method.NAME] holds command and timeout)");
@@ -820,7 +831,16 @@ static int validate(const ppb_config *cfg, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     int slab = sc->geometry == PPB_GEOM_SLAB;
-    char where[160];
+    char where[1200];
+    /* After every --set: a --set may give the command of a section the file opened. */
+    for (int i = 0; i < cfg->nexternal; i++) {
+        const ppb_external_def *d = &cfg->external[i];
+        if (!d->command_line && !d->command_set)
+            return ppb_fail(err, "%s: no command given%s%s%s",
+                            ppb_config_external_where(cfg, d, NULL, where, sizeof where),
+                            d->line ? "" : " (add --set method.", d->line ? "" : d->name,
+                            d->line ? "" : ".command=...)");
+    }
     if (slab && sc->step != PPB_STEP_NONE)
         return ppb_config_key_fail(
             cfg, "medium", "step", err,
@@ -886,10 +906,6 @@ static int read_file(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err 
         return ppb_fail(err, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
     if (rc < 0)
         return ppb_fail(err, "%s: cannot read config", path);
-    for (int i = 0; i < cfg->nexternal; i++)
-        if (!cfg->external[i].command_line)
-            return ppb_fail(err, "%s:%d: [method.%s]: no command given", path,
-                            cfg->external[i].line, cfg->external[i].name);
     if (!cfg->name[0])
         base_name(path, cfg->name, sizeof cfg->name);
     if (!cfg->out_dir[0])
@@ -943,6 +959,30 @@ int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const 
     return ppb_config_set_grid(cfg, NULL, section, key, value, err);
 }
 
+/* --set method.NAME.KEY=VALUE (eq: its '='): KEY is what follows the last dot before the '='
+ * (a NAME may hold dots), checked as the file's [method.NAME] KEY is (on_method_key). */
+static int set_method_key(ppb_config *cfg, const char *set, const char *eq, ppb_err *err)
+{
+    char q[96], section[128], key[64];
+    const char *name = set + 7, *dot = NULL;
+    for (const char *p = name; p < eq; p++)
+        if (*p == '.')
+            dot = p;
+    if (!dot || dot == name || dot + 1 == eq || (size_t)(dot - set) >= sizeof section ||
+        (size_t)(eq - dot - 1) >= sizeof key)
+        return ppb_fail(err, "--set %s: expected method.NAME.KEY=VALUE (KEY: command or timeout)",
+                        shown(set, q, sizeof q));
+    snprintf(section, sizeof section, "%.*s", (int)(dot - set), set);
+    snprintf(key, sizeof key, "%.*s", (int)(eq - dot - 1), dot + 1);
+    parse_state st = {.cfg = cfg, .from_set = 1};
+    if (!on_method_key(&st, section, key, eq + 1)) {
+        char qs[160];
+        return ppb_fail(err, "--set %s.%s: %s", shown(section, qs, sizeof qs),
+                        shown(key, q, sizeof q), st.why);
+    }
+    return 0;
+}
+
 int ppb_config_load_sets(ppb_config *cfg, ppb_grid *grid, const char *path, const char *const *sets,
                          int nsets, ppb_err *err)
 {
@@ -955,6 +995,11 @@ int ppb_config_load_sets(ppb_config *cfg, ppb_grid *grid, const char *path, cons
         if (!eq || !dot || dot > eq || dot == sets[j] || dot + 1 == eq)
             return ppb_fail(err, "--set %s: expected SECTION.KEY=VALUE",
                             shown(sets[j], q, sizeof q));
+        if (strncmp(sets[j], "method.", 7) == 0) {
+            if (set_method_key(cfg, sets[j], eq, err))
+                return -1;
+            continue;
+        }
         char section[64], key[64];
         size_t ns = (size_t)(dot - sets[j]), nk = (size_t)(eq - dot - 1);
         if (ns >= sizeof section || nk >= sizeof key)
@@ -1015,7 +1060,7 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out)
     }
     for (int i = 0; i < cfg->nexternal; i++) {
         fprintf(out, "method.%s.command = %s\n", cfg->external[i].name, cfg->external[i].command);
-        if (cfg->external[i].timeout_line)
+        if (cfg->external[i].timeout > 0) /* given: in the file or by --set */
             fprintf(out, "method.%s.timeout = %.17g\n", cfg->external[i].name,
                     cfg->external[i].timeout);
     }
@@ -1079,9 +1124,9 @@ static void write_externals(const ppb_config *cfg, int ini, FILE *out)
                 s += cut < n ? cut + 1 : cut;
             }
         }
-        if (d->timeout_line && ini)
+        if (d->timeout > 0 && ini)
             fprintf(out, "timeout = %.17g\n", d->timeout);
-        else if (d->timeout_line)
+        else if (d->timeout > 0)
             fprintf(out, "method.%s.timeout = %.17g\n", d->name, d->timeout);
     }
 }
@@ -1149,4 +1194,17 @@ const ppb_external_def *ppb_config_external(const ppb_config *cfg, const char *i
         if (strcmp(cfg->external[i].name, id) == 0)
             return &cfg->external[i];
     return NULL;
+}
+
+const char *ppb_config_external_where(const ppb_config *cfg, const ppb_external_def *d,
+                                      const char *key, char *buf, size_t cap)
+{
+    int set = key ? (strcmp(key, "command") == 0 ? d->command_set : d->timeout_set) : !d->line;
+    int line = key ? (strcmp(key, "command") == 0 ? d->command_line : d->timeout_line) : d->line;
+    if (set)
+        snprintf(buf, cap, "--set method.%s%s%s", d->name, key ? "." : "", key ? key : "");
+    else
+        snprintf(buf, cap, "%s:%d: [method.%s]%s%s", cfg->path, line ? line : d->line, d->name,
+                 key ? " " : "", key ? key : "");
+    return buf;
 }

@@ -60,17 +60,20 @@ typedef struct ppb_rte2d_settings {
 } ppb_rte2d_settings;
 
 /* A method defined by the config itself: a section [method.NAME] with `command` (a shell
- * command holding {scene} and {out}) and an optional `timeout` in seconds. The config stores
- * them without knowing what they run (methods/method_external.h runs them; the registry accepts
- * NAME as a method id once it is defined here). */
+ * command holding {scene} and {out}) and an optional `timeout` in seconds, or the same keys
+ * given as --set method.NAME.command=... (which defines NAME, or overrides the file's key).
+ * The config stores them without knowing what they run (methods/method_external.h runs them;
+ * the registry finds NAME as a method id through this list). */
 #define PPB_MAX_EXTERNAL 8
 typedef struct ppb_external_def {
     char name[32];
     char command[2048];
     double timeout;   /* seconds; 0 = the default (3600) */
-    int line;         /* line of the section's first key */
-    int command_line; /* line of its command (0: none given) */
-    int timeout_line; /* line of its timeout (0: the default) */
+    int line;         /* line of the section's first key (0: defined by --set) */
+    int command_line; /* line of its command (0: not in the file) */
+    int timeout_line; /* line of its timeout (0: not in the file) */
+    int command_set;  /* 1: the command is --set's */
+    int timeout_set;  /* 1: the timeout is --set's */
 } ppb_external_def;
 
 /* Where a key's value came from, so that checks made after loading name the right place. */
@@ -159,5 +162,10 @@ int ppb_config_has_method(const ppb_config *cfg, const char *id);
 
 /* The [method.NAME] section of id, or NULL. */
 const ppb_external_def *ppb_config_external(const ppb_config *cfg, const char *id);
+
+/* Where d's key (`command`, `timeout`; NULL: the definition) was given, for a message about it:
+ * "--set method.NAME.KEY" when --set gave it, else "file:line: [method.NAME] KEY". */
+const char *ppb_config_external_where(const ppb_config *cfg, const ppb_external_def *d,
+                                      const char *key, char *buf, size_t cap);
 
 #endif

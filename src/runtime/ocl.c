@@ -3,6 +3,9 @@
 #include <ctype.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "base/hash.h"
 
 #ifndef PPB_KERNEL_DIR
 #define PPB_KERNEL_DIR "kernels"
@@ -311,6 +314,83 @@ static char *read_file(const char *path, ppb_err *err)
     buf[n] = '\0';
     fclose(f);
     return buf;
+}
+
+/* The source-text hash (ocl.h): the file, then each file it includes that the build would
+ * find, depth first, each once. "x" is looked up beside its includer first, as the compiler
+ * does; both forms then in the build's -I dirs (ppb_ocl_build). */
+typedef struct src_walk {
+    ppb_hasher *h;
+    char seen[64][1024];
+    int nseen;
+} src_walk;
+
+static int hash_source(src_walk *w, const char *path, int depth, ppb_err *err)
+{
+    for (int i = 0; i < w->nseen; i++)
+        if (strcmp(w->seen[i], path) == 0)
+            return 0;
+    if (depth > 16 || w->nseen == (int)(sizeof w->seen / sizeof w->seen[0]))
+        return ppb_fail(err, "%s: kernel sources include too many files to hash", path);
+    snprintf(w->seen[w->nseen++], sizeof w->seen[0], "%s", path);
+    char *src = read_file(path, err);
+    if (!src)
+        return -1;
+    ppb_hash64_update(w->h, src, strlen(src) + 1); /* + 1: the NUL ends one file's text */
+    int rc = 0;
+    for (char *line = src; rc == 0 && line && *line; line = strchr(line, '\n'), line += !!line) {
+        char *p = line + strspn(line, " \t");
+        if (*p != '#')
+            continue;
+        p += 1 + strspn(p + 1, " \t");
+        if (strncmp(p, "include", 7) != 0)
+            continue;
+        p += 7 + strspn(p + 7, " \t");
+        char close = *p == '"' ? '"' : *p == '<' ? '>' : 0;
+        char *end = close ? strchr(p + 1, close) : NULL;
+        char *eol = strchr(p, '\n');
+        if (!end || (eol && end > eol))
+            continue;
+        char name[512], cand[1024];
+        snprintf(name, sizeof name, "%.*s", (int)(end - p - 1), p + 1);
+        const char *slash = strrchr(path, '/');
+        const char *dirs[3] = {NULL, kernel_dir(), "/usr/include"};
+        char here[1024];
+        if (close == '"' && slash) {
+            snprintf(here, sizeof here, "%.*s", (int)(slash - path), path);
+            dirs[0] = here;
+        }
+        for (int d = 0; d < 3; d++) {
+            if (!dirs[d])
+                continue;
+            snprintf(cand, sizeof cand, "%s/%s", dirs[d], name);
+            if (access(cand, R_OK) == 0) {
+                rc = hash_source(w, cand, depth + 1, err);
+                break;
+            }
+        }
+        /* Not found: a header of the OpenCL compiler itself, or one under a branch the kernel
+         * build never takes; the text that includes it is hashed. */
+    }
+    free(src);
+    return rc;
+}
+
+int ppb_ocl_source_hash(const char *file, uint64_t *hash, ppb_err *err)
+{
+    src_walk *w = calloc(1, sizeof *w);
+    if (!w || !(w->h = ppb_hash64_begin())) {
+        free(w);
+        return ppb_fail(err, "out of memory hashing kernel %s", file);
+    }
+    char path[2048];
+    snprintf(path, sizeof path, "%s/%s", kernel_dir(), file);
+    int rc = hash_source(w, path, 0, err);
+    uint64_t h = ppb_hash64_end(w->h);
+    free(w);
+    if (rc == 0)
+        *hash = h;
+    return rc;
 }
 
 /* Reports the build log and releases the program; the caller's handle is cleared by

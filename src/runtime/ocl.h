@@ -9,6 +9,7 @@
 
 #define CL_TARGET_OPENCL_VERSION 120
 #include <CL/cl.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "base/err.h"
@@ -51,6 +52,12 @@ void ppb_ocl_close(ppb_ocl *ocl);
  * releases it as a fresh one); ppb_ocl_close releases them. */
 int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog,
                   ppb_err *err);
+
+/* A hash of the source text a build of kernels/<file> compiles: the file and, transitively,
+ * every header it includes that the build's include path finds (the shared kernels/ headers,
+ * Random123), so a cache of a kernel's results (methods/mc_cache.h) can tell a changed kernel.
+ * Fails as ppb_ocl_build does when a file cannot be read. */
+int ppb_ocl_source_hash(const char *file, uint64_t *hash, ppb_err *err);
 
 /* Creates kernel `name` from prog, naming it in the error. */
 int ppb_ocl_kernel(cl_program prog, const char *name, cl_kernel *k, ppb_err *err);
