@@ -26,10 +26,11 @@
  * its index.
  *
  * Precision: transport in float (positions are O(10) mfp, so float's 1e-7 relative resolution
- * is far below any bin or segment; float doubles the SIMD width over double). Binning at exit
- * uses the shared double-precision conventions (ppb_conventions.h) on the float direction
- * promoted to double, the same code the host uses. log and sin/cos are written out in plain
- * arithmetic (below) so that results cannot depend on which math-library variant a compiler
+ * is far below any bin or segment; float doubles the SIMD width over double). Exits are binned
+ * as the shared double-precision conventions (ppb_conventions.h) bin the float direction
+ * promoted to double, the same code the host uses: in float vectors where float decides the
+ * same bin, in that double code where it may not (ppb_mc_vbins). log and sin/cos are written out in
+ * plain arithmetic (below) so that results cannot depend on which math-library variant a compiler
  * picks for a vector width. */
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 
@@ -57,7 +58,15 @@ typedef PPB_VEC(uint) vuint;
 #define CONVERT_VUINT  PPB_CAT(convert_uint, PPB_MC_LANES)
 #define CONVERT_VULONG PPB_CAT(convert_ulong, PPB_MC_LANES)
 typedef PPB_VEC(ulong) vulong;
-#define LANES PPB_MC_LANES
+typedef PPB_VEC(long) vlong; /* masks for vulong selects */
+typedef PPB_VEC(double) vdouble;
+#define CONVERT_VLONG   PPB_CAT(convert_long, PPB_MC_LANES)
+#define CONVERT_VDOUBLE PPB_CAT(convert_double, PPB_MC_LANES)
+#define AS_VULONG       PPB_CAT(as_ulong, PPB_MC_LANES)
+#define LANES           PPB_MC_LANES
+/* PoCL compiles `inline` away (-Dinline=); the per-step functions are inlined by force so the
+ * lane vectors need not pass through memory between them. */
+#define PPB_MC_HOT inline __attribute__((always_inline))
 
 /* Uniforms and the scattering samplers (tests/test_mc.c runs them alone). */
 #include "ppb_sampling.h"
@@ -67,7 +76,7 @@ typedef struct ppb_mc_vctr {
     vuint v0, v1, v2, v3;
 } ppb_mc_vctr;
 
-inline ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
+PPB_MC_HOT ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
 {
     for (int round = 0; round < 10; round++) {
         if (round > 0) {
@@ -90,7 +99,7 @@ inline ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
 /* Natural log of x in (0, 1], by the fdlibm/musl logf reduction (x = 2^k (1 + f),
  * log(1 + f) = 2 atanh(f / (2 + f)) by a minimax polynomial in s^2); relative error below
  * 1e-7 over the uniforms drawn here. */
-inline vfloat ppb_mc_log(vfloat x)
+PPB_MC_HOT vfloat ppb_mc_log(vfloat x)
 {
     vint ix = AS_VINT(x) + (0x3f800000 - 0x3f3504f3); /* mantissa into [sqrt(1/2), sqrt(2)) */
     vfloat k = CONVERT_VFLOAT((ix >> 23) - 0x7f);
@@ -117,6 +126,7 @@ inline int ppb_mc_segment(const ppb_mc_params *p, int surf, float x, float y)
  * kernel's time). */
 typedef struct ppb_mc_edges {
     double c[PPB_MC_MAX_PHI], s[PPB_MC_MAX_PHI];
+    float cf[PPB_MC_MAX_PHI], sf[PPB_MC_MAX_PHI]; /* the same rounded to float (ppb_mc_vbins) */
 } ppb_mc_edges;
 
 inline void ppb_mc_edges_init(const ppb_mc_params *p, ppb_mc_edges *e)
@@ -124,6 +134,7 @@ inline void ppb_mc_edges_init(const ppb_mc_params *p, ppb_mc_edges *e)
     for (int k = 1; k < p->nphi && k < PPB_MC_MAX_PHI; k++) {
         double a = (double)k * (PPB_PI / (double)p->nphi);
         e->c[k] = cos(a), e->s[k] = sin(a);
+        e->cf[k] = (float)e->c[k], e->sf[k] = (float)e->s[k];
     }
 }
 
@@ -161,20 +172,33 @@ inline int ppb_mc_dir_bin(const ppb_mc_params *p, const ppb_mc_edges *e, int sur
     return ppb_theta_bin(mu, p->ntheta) * p->nphi + ppb_mc_phi_bin(e, wt, fabs(wz), p->nphi);
 }
 
-/* Fixed-point weight (kernels/mc_params.h). */
-inline ulong ppb_mc_fixed(float w)
+/* Fixed-point weights (kernels/mc_params.h) of every lane, round(w 2^32) half to even, as
+ * convert_ulong_rte would give, without PoCL's generic float -> ulong conversion nor a scalar
+ * double -> long one per lane (x86 has no vector form below AVX-512): w * 2^32 is exact in
+ * float (a power-of-two scale) and in double, below 2^45 (weights are >= 0 and at most
+ * 8 PPB_MC_CAP_WMAX); adding 2^52 rounds it to the integer grid of [2^52, 2^53) half to even,
+ * leaving the integer in the low mantissa bits. */
+PPB_MC_HOT vulong ppb_mc_vfixed(vfloat w)
 {
-    /* convert_ulong_rte(w * 2^32) without PoCL's generic float -> ulong conversion: w * 2^32 is
-     * exact in float (a power-of-two scale), and as a double rint rounds it half to even, as
-     * _rte does, to an integer below 2^45 (weights are at most 8 PPB_MC_CAP_WMAX), which
-     * converts to long exactly. */
-    return (ulong)(long)rint((double)(w * PPB_MC_FIXED_SCALE));
+    vdouble d = CONVERT_VDOUBLE(w * PPB_MC_FIXED_SCALE) + 0x1p52;
+    return AS_VULONG(d) - (vulong)0x4330000000000000UL; /* the bits of 2^52 */
 }
 
-/* Per-work-item sums of the totals: integers, added to the batch's totals once at the end. */
+/* Per-work-item sums of the totals, lane by lane: integers, so their order does not matter;
+ * added to the batch's totals once at the end. */
 typedef struct ppb_mc_sums {
-    ulong ballistic, capture, rgain, rloss, events, capped;
+    vulong ballistic, capture, rgain, rloss, events, capped;
 } ppb_mc_sums;
+
+/* Sum of a vulong's lanes (by pointer: a 512-bit vector argument draws PoCL's ABI warning). */
+inline ulong ppb_mc_hsum(const vulong *v)
+{
+    ulong a[LANES], sum = 0;
+    VSTORE(*v, 0, a);
+    for (int l = 0; l < LANES; l++)
+        sum += a[l];
+    return sum;
+}
 
 /* Cell-tally additions waiting to be made, flushed PPB_MC_PEND at a time (issue 21: the lock
  * add of each exit, made at once, was a sixth of the kernel's time, stalled behind the step's
@@ -228,8 +252,8 @@ inline void ppb_mc_entry_words(const ppb_mc_params *p, ulong photon0, ulong stri
 
 /* Starts photon `photon` in lane l: entry on S1 (y = 0) along w_L, at the point its entry word
  * (ppb_mc_entry_words) gives in the tube. */
-inline void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong photon,
-                         uint entry_word)
+PPB_MC_HOT void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong photon,
+                             uint entry_word)
 {
     s->ctr0[l] = (uint)photon, s->ctr1[l] = (uint)(photon >> 32), s->step[l] = 0;
     float x = 0.0f;
@@ -251,7 +275,7 @@ typedef struct ppb_mc_queue {
 } ppb_mc_queue;
 
 /* Starts the next photon in lane l, or marks the lane idle when none is left. */
-inline void ppb_mc_next(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ppb_mc_queue *q)
+PPB_MC_HOT void ppb_mc_next(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ppb_mc_queue *q)
 {
     if (q->m >= q->n) {
         s->active[l] = 0;
@@ -267,32 +291,119 @@ inline void ppb_mc_next(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ppb_mc_q
     q->m += q->step;
 }
 
-/* Tallies lane l's photon, which has left (s->left) or died. */
-inline void ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_mc_lanes *s,
-                          int l, ppb_mc_pending *pend, ppb_mc_sums *sums)
+/* The cell (before the tally's offset) of one exit by the scalar double code: the exit's
+ * surface (a side wall by wx, else S1/S2 by wy), its segment and its bin. */
+inline size_t ppb_mc_exit_cell(const ppb_mc_params *p, const ppb_mc_edges *e, int side, float x,
+                               float y, float wx, float wy, float wz)
 {
-    if (s->left[l]) {
-        float wx = s->wx[l], wy = s->wy[l];
-        int surf = s->side[l] ? (wx > 0.0f ? PPB_S4 : PPB_S3) : (wy > 0.0f ? PPB_S1 : PPB_S2);
-        ulong q = ppb_mc_fixed(s->weight[l]);
-        if (s->nscat[l] == 0) {
-            sums->ballistic += q;
-        } else {
-            int seg = ppb_mc_segment(p, surf, s->x[l], s->y[l]);
-            int bin = ppb_mc_dir_bin(p, e, surf, (double)wx, (double)wy, (double)s->wz[l]);
-            size_t cell =
-                ppb_cell_index(p->offset[surf], seg, ppb_bin_count(p->ntheta, p->nphi), bin);
-            pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = q;
-            /* mc1's addition, kept only for a once-scattered photon (no branch to mispredict) */
-            pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n] = q;
-            pend->n += s->nscat[l] == 1;
-        }
+    int surf = side ? (wx > 0.0f ? PPB_S4 : PPB_S3) : (wy > 0.0f ? PPB_S1 : PPB_S2);
+    int seg = ppb_mc_segment(p, surf, x, y);
+    int bin = ppb_mc_dir_bin(p, e, surf, (double)wx, (double)wy, (double)wz);
+    return ppb_cell_index(p->offset[surf], seg, ppb_bin_count(p->ntheta, p->nphi), bin);
+}
+
+/* Cell (row and bin, before the tally's offset) of every lane's exit as it would be binned
+ * now, in float vectors, and where float cannot decide (a value within its rounding of a segment,
+ * theta or phi edge) a lane flag: that lane is binned by the scalar double code
+ * (ppb_mc_segment, ppb_mc_dir_bin) instead, so every bin is the one that code gives (issue 21:
+ * binning exit by exit in scalar code was half of the kernel's time). The bounds: each float
+ * quantity below is a few roundings (relative 2^-24 each) of values of magnitude <= 1 times
+ * nseg or ntheta, so within 2e-7 nseg, 2e-7 ntheta and 3e-7 of the double one (itself within
+ * 1e-15); the margins are ten times that and more, so outside them both sides of every edge
+ * agree. The phi bin is the count of edges below phi (ppb_mc_phi_bin's c_k > 0, a prefix in
+ * k), and a margin of 1e-5 on c_k also covers ppb_mc_phi_bin's own 1e-12 test. */
+PPB_MC_HOT vint ppb_mc_vbins(const ppb_mc_params *p, const ppb_mc_edges *e, vint side, vfloat x,
+                             vfloat y, vfloat wx, vfloat wy, vfloat wz, vint *exact)
+{
+    /* surface: S4/S3 on a side wall by wx, S1/S2 by wy (as the step put the photon there) */
+    vint surf = select(select((vint)PPB_S2, (vint)PPB_S1, wy > 0.0f),
+                       select((vint)PPB_S3, (vint)PPB_S4, wx > 0.0f), side);
+    vfloat wn = select(wy, wx, side); /* +-mu: only its square is used */
+    /* t = n x b (ppb_conventions.h): +x on S1, -x on S2, +y on S3, -y on S4 */
+    vfloat wt = select(select(-wx, wx, surf == PPB_S1), select(-wy, wy, surf == PPB_S3), side);
+    vfloat wb = fabs(wz);
+
+    const float nt = (float)p->ntheta;
+    vfloat vt = (1.0f - wn * wn) * nt;
+    vint near = fabs(vt - rint(vt)) < 2e-6f * nt;
+    vint kt = clamp(CONVERT_VINT(vt), 0, p->ntheta - 1);
+
+    vint kp = (vint)0;
+    for (int k = 1; k < p->nphi && k < PPB_MC_MAX_PHI; k++) {
+        vfloat c = wb * e->cf[k] - wt * e->sf[k];
+        kp -= c > 0.0f;
+        near |= fabs(c) <= 1e-5f;
     }
-    sums->capture += ppb_mc_fixed(s->capture[l]);
-    sums->events += (ulong)s->nscat[l];
-    sums->capped += (ulong)s->capped[l];
-    sums->rgain += ppb_mc_fixed(s->rgain[l]);
-    sums->rloss += ppb_mc_fixed(s->rloss[l]);
+    if (p->nphi > PPB_MC_MAX_PHI)
+        near = (vint)-1;
+
+    vint seg = (vint)0;
+    if (p->tube) {
+        vint top = ~side;
+        vint nseg =
+            select(select((vint)p->nseg[PPB_S2], (vint)p->nseg[PPB_S1], surf == PPB_S1),
+                   select((vint)p->nseg[PPB_S3], (vint)p->nseg[PPB_S4], surf == PPB_S4), side);
+        vfloat fseg = CONVERT_VFLOAT(nseg);
+        vfloat vs = select(y + p->height, x + 0.5f * p->width, top) *
+                    select(fseg / p->height, fseg / p->width, top);
+        near |= fabs(vs - rint(vs)) < 2e-6f * fseg;
+        seg = clamp(CONVERT_VINT(vs), 0, nseg - 1);
+    }
+    vint off =
+        select(select((vint)p->offset[PPB_S2], (vint)p->offset[PPB_S1], surf == PPB_S1),
+               select((vint)p->offset[PPB_S3], (vint)p->offset[PPB_S4], surf == PPB_S4), side);
+    *exact = near;
+    int nbins = ppb_bin_count(p->ntheta, p->nphi);
+    return (off + seg) * nbins + kt * p->nphi + kp;
+}
+
+/* Tallies every lane whose photon has left (s->left) or died (s->done) this step: the totals
+ * as lane vectors, the cell additions of the scattered exits queued (ppb_mc_pending). Returns
+ * the mask of those lanes. */
+PPB_MC_HOT vint ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_mc_lanes *s,
+                              ppb_mc_pending *pend, ppb_mc_sums *sums, __global ulong *base,
+                              __global ulong *spare)
+{
+    vint done = VLOAD(0, s->done) & VLOAD(0, s->active);
+    if (!any(done))
+        return done;
+    vint left = VLOAD(0, s->left) & done;
+    vint nscat = VLOAD(0, s->nscat);
+    vulong zero = (vulong)0;
+    vulong q = ppb_mc_vfixed(VLOAD(0, s->weight));
+    vlong ldone = CONVERT_VLONG(done);
+    sums->ballistic += select(zero, q, CONVERT_VLONG(left & (nscat == 0)));
+    sums->capture += select(zero, ppb_mc_vfixed(VLOAD(0, s->capture)), ldone);
+    sums->rgain += select(zero, ppb_mc_vfixed(VLOAD(0, s->rgain)), ldone);
+    sums->rloss += select(zero, ppb_mc_vfixed(VLOAD(0, s->rloss)), ldone);
+    sums->events += select(zero, CONVERT_VULONG(nscat), ldone);
+    sums->capped += select(zero, CONVERT_VULONG(VLOAD(0, s->capped)), ldone);
+
+    vint scat = left & (nscat != 0);
+    if (!any(scat))
+        return done;
+    vint exact;
+    vint cellv = ppb_mc_vbins(p, e, VLOAD(0, s->side), VLOAD(0, s->x), VLOAD(0, s->y),
+                              VLOAD(0, s->wx), VLOAD(0, s->wy), VLOAD(0, s->wz), &exact);
+    int cells[LANES], ex[LANES], sc[LANES], ns[LANES];
+    ulong qs[LANES];
+    VSTORE(cellv, 0, cells), VSTORE(exact, 0, ex), VSTORE(scat, 0, sc), VSTORE(nscat, 0, ns);
+    VSTORE(q, 0, qs);
+    for (int l = 0; l < LANES; l++) {
+        if (!sc[l])
+            continue;
+        size_t cell = (size_t)(uint)cells[l];
+        if (ex[l])
+            cell =
+                ppb_mc_exit_cell(p, e, s->side[l], s->x[l], s->y[l], s->wx[l], s->wy[l], s->wz[l]);
+        pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = qs[l];
+        /* mc1's addition, kept only for a once-scattered photon (no branch to mispredict) */
+        pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n] = qs[l];
+        pend->n += ns[l] == 1;
+        if (pend->n > PPB_MC_PEND - 2)
+            ppb_mc_flush(pend, base, spare);
+    }
+    return done;
 }
 
 /* n > 1: lane l's photon has reached a wall (s->left; s->side: a side wall). With probability
@@ -326,7 +437,7 @@ inline void ppb_mc_boundary(const ppb_mc_params *p, ppb_mc_lanes *s, int l, uint
  * then (at an interaction) implicit capture, HG scattering and roulette. A leg that reaches
  * the step plane stops there with its remaining optical depth; a straight line crosses the
  * plane at most once, so a flight takes at most two legs. */
-inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *medium)
+PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *medium)
 {
     const float half_w = 0.5f * p->width, sx = p->step_x;
     vint active = VLOAD(0, s->active);
@@ -343,9 +454,9 @@ inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *me
      * moving parallel to a wall divide by zero; select() discards those values. */
     vfloat inf = (vfloat)INFINITY;
     vfloat dx = inf;
-    if (p->tube)
-        dx = select(select(inf, (-half_w - x) / wx, wx < 0.0f), (half_w - x) / wx, wx > 0.0f);
-    vfloat dy = select(select(inf, (-p->height - y) / wy, wy < 0.0f), -y / wy, wy > 0.0f);
+    if (p->tube) /* the wall ahead's offset, then one division */
+        dx = select(inf, select(-half_w - x, half_w - x, wx > 0.0f) / wx, wx != 0.0f);
+    vfloat dy = select(inf, select(-p->height - y, -y, wy > 0.0f) / wy, wy != 0.0f);
     vfloat d_wall = fmin(dx, dy);
     /* medium: sigma_t left/right, 1/sigma_t left/right, alpha left/right (ppb_conventions.h) */
     vfloat sigma = (vfloat)medium[0], inv_sigma = (vfloat)medium[2], d_plane = inf;
@@ -430,20 +541,24 @@ inline void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *me
     }
 }
 
-/* The global size is batches x P (the host makes it so): work-items [b P, (b + 1) P) trace the
- * chunk's photons of batch b (i % batches == b), work-item b P + q taking the q-th, (q + P)-th,
- * ... of them. Work-groups of consecutive work-items then stay inside one batch, so the cell
- * tallies they update are one batch's slice, and a work-item's totals are summed privately with
- * one atomic per total at the end. Which work-item or lane traces a photon never changes the
- * photon's path, and integer sums do not depend on their order, so any global size, work-group
- * size, lane count or chunking gives the same tallies. */
+/* The global size is batches x P, P a multiple of the work-group size L (the host makes it
+ * so). Work-group w traces the chunk's photons of batch b = w mod batches (i % batches == b),
+ * its work-item j being the q-th of the batch, q = (w / batches) L + j, which takes the q-th,
+ * (q + P)-th, ... of them. A work-group then stays inside one batch, so the cell tallies it
+ * updates are one batch's slice, and consecutive work-groups, which a CPU runs at the same time
+ * on its cores, update different slices (issue 21: two cores adding into the same lines of one
+ * slice pass them back and forth). A work-item's totals are summed privately with one atomic
+ * per total at the end. Which work-item or lane traces a photon never changes the photon's
+ * path, and integer sums do not depend on their order, so any global size, work-group size,
+ * lane count or chunking gives the same tallies. */
 __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
                                   __global ulong *totals)
 {
     const ulong batches = (ulong)p.batches;
     const ulong per_batch = get_global_size(0) / batches;
-    const int batch = (int)(get_global_id(0) / per_batch);
-    const ulong q0 = get_global_id(0) % per_batch;
+    const ulong group = get_group_id(0), wg_size = get_local_size(0);
+    const int batch = (int)(group % batches);
+    const ulong q0 = group / batches * wg_size + get_local_id(0);
     /* The chunk's photons of this batch: first + off + batches m, m = 0 .. n - 1. */
     const ulong off = ((ulong)batch + batches - p.first % batches) % batches;
     const ulong n = off < p.count ? (p.count - off - 1) / batches + 1 : 0;
@@ -462,7 +577,8 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     ppb_mc_edges edges;
     ppb_mc_edges_init(&p, &edges);
 
-    ppb_mc_sums sums = {0, 0, 0, 0, 0, 0};
+    ppb_mc_sums sums;
+    sums.ballistic = sums.capture = sums.rgain = sums.rloss = sums.events = sums.capped = (vulong)0;
     ppb_mc_pending pend;
     pend.n = 0;
     __global ulong *spare = totals + (size_t)batch * PPB_MC_NTOT + PPB_MC_NTOT - 1;
@@ -473,14 +589,14 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
         ppb_mc_next(&p, &s, l, &queue);
     for (;;) {
         ppb_mc_step(&p, &s, medium);
-        int busy = 0;
+        vint done = ppb_mc_finish(&p, &edges, &s, &pend, &sums, base, spare);
+        if (!any(done))
+            continue; /* every active lane is still flying */
+        int dn[LANES], busy = 0;
+        VSTORE(done, 0, dn);
         for (int l = 0; l < LANES; l++) {
-            if (s.active[l] && s.done[l]) {
-                ppb_mc_finish(&p, &edges, &s, l, &pend, &sums);
-                if (pend.n > PPB_MC_PEND - 2)
-                    ppb_mc_flush(&pend, base, spare);
+            if (dn[l])
                 ppb_mc_next(&p, &s, l, &queue);
-            }
             busy |= s.active[l];
         }
         if (!busy)
@@ -489,12 +605,12 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
 
     ppb_mc_flush(&pend, base, spare);
     __global ulong *tot = totals + (size_t)batch * PPB_MC_NTOT;
-    atom_add(tot + PPB_MC_T_BALLISTIC, sums.ballistic);
-    atom_add(tot + PPB_MC_T_CAPTURE, sums.capture);
-    atom_add(tot + PPB_MC_T_EVENTS, sums.events);
-    atom_add(tot + PPB_MC_T_RGAIN, sums.rgain);
-    atom_add(tot + PPB_MC_T_RLOSS, sums.rloss);
-    atom_add(tot + PPB_MC_T_CAPPED, sums.capped);
+    atom_add(tot + PPB_MC_T_BALLISTIC, ppb_mc_hsum(&sums.ballistic));
+    atom_add(tot + PPB_MC_T_CAPTURE, ppb_mc_hsum(&sums.capture));
+    atom_add(tot + PPB_MC_T_EVENTS, ppb_mc_hsum(&sums.events));
+    atom_add(tot + PPB_MC_T_RGAIN, ppb_mc_hsum(&sums.rgain));
+    atom_add(tot + PPB_MC_T_RLOSS, ppb_mc_hsum(&sums.rloss));
+    atom_add(tot + PPB_MC_T_CAPPED, ppb_mc_hsum(&sums.capped));
 }
 
 /* Self-check for tests/test_mc.c: the vector Philox above against Random123's philox4x32 on
@@ -519,5 +635,83 @@ __kernel void ppb_mc_philox_check(ulong seed, __global uint *mismatches)
         for (int w = 0; w < 4; w++)
             if (r.v[w] != out[w][l])
                 atomic_inc(mismatches);
+    }
+}
+
+/* Self-check for tests/test_mc.c: ppb_mc_vbins, with the scalar fallback ppb_mc_finish takes on
+ * the lanes it flags, against the conventions' own binning (ppb_segment_of, ppb_dir_bin with
+ * atan2) on exits of every surface the params have: a quarter at random, a quarter with mu on
+ * a theta edge (sin^2 theta = k / ntheta), a quarter with phi on a phi edge (k pi / nphi) and a
+ * quarter at a segment edge, each rounded to float as a photon's state is. Counts into out[0]
+ * the cells that differ, out[1] the lanes flagged for the fallback, out[2] the lanes checked. */
+__kernel void ppb_mc_bins_check(const ppb_mc_params p, __global uint *out)
+{
+    uint g = (uint)get_global_id(0);
+    ppb_mc_edges edges;
+    ppb_mc_edges_init(&p, &edges);
+    uint c0[LANES];
+    for (int l = 0; l < LANES; l++)
+        c0[l] = g * LANES + (uint)l;
+    ppb_mc_vctr c = {VLOAD(0, c0), (vuint)0x5eed, (vuint)7, (vuint)3};
+    c = ppb_mc_philox(c, (uint)p.seed, (uint)(p.seed >> 32));
+    uint r[4][LANES];
+    VSTORE(c.v0, 0, r[0]), VSTORE(c.v1, 0, r[1]), VSTORE(c.v2, 0, r[2]), VSTORE(c.v3, 0, r[3]);
+    float fx[LANES], fy[LANES], fwx[LANES], fwy[LANES], fwz[LANES];
+    int fside[LANES], fsurf[LANES];
+    const int nsurf = p.tube ? 4 : 2;
+    for (int l = 0; l < LANES; l++) {
+        int kind = (int)(c0[l] % 4u), surf = (int)(r[0][l] % (uint)nsurf);
+        double u1 = ((double)r[1][l] + 0.5) / 4294967296.0;
+        double u2 = ((double)r[2][l] + 0.5) / 4294967296.0;
+        double u3 = ((double)r[3][l] + 0.5) / 4294967296.0;
+        double s2 = u1, phi = PPB_PI * u2, along = u3; /* sin^2 theta, phi, position in [0, 1) */
+        if (kind == 1)
+            s2 = (double)(r[1][l] % (uint)(p.ntheta + 1)) / p.ntheta;
+        if (kind == 2)
+            phi = (double)(r[2][l] % (uint)(p.nphi + 1)) * PPB_PI / p.nphi;
+        int nseg = p.tube ? p.nseg[surf] : 1;
+        if (kind == 3)
+            along = (double)(r[3][l] % (uint)(nseg + 1)) / nseg;
+        double mu = sqrt(1.0 - s2), st = sqrt(s2);
+        double wt = st * cos(phi), wb = st * sin(phi) * ((r[0][l] >> 16) & 1 ? -1.0 : 1.0);
+        double wx = mu * ppb_normal_x(surf) + wt * ppb_tangent_x(surf);
+        double wy = mu * ppb_normal_y(surf) + wt * ppb_tangent_y(surf);
+        double w = (double)p.width, h = (double)p.height, x, y;
+        if (surf == PPB_S1 || surf == PPB_S2)
+            x = -0.5 * w + along * w, y = surf == PPB_S1 ? 0.0 : -h;
+        else
+            x = surf == PPB_S3 ? -0.5 * w : 0.5 * w, y = -h + along * h;
+        /* the state as floats; a float mu of 0 would leave the surface undecided, so it keeps
+         * its outward sign */
+        fwx[l] = (float)wx, fwy[l] = (float)wy, fwz[l] = (float)wb;
+        if (surf == PPB_S1 && !(fwy[l] > 0.0f))
+            fwy[l] = 1e-30f;
+        if (surf == PPB_S4 && !(fwx[l] > 0.0f))
+            fwx[l] = 1e-30f;
+        fx[l] = (float)x, fy[l] = (float)y;
+        fside[l] = -(surf == PPB_S3 || surf == PPB_S4), fsurf[l] = surf;
+    }
+    vint exact;
+    vint cellv = ppb_mc_vbins(&p, &edges, VLOAD(0, fside), VLOAD(0, fx), VLOAD(0, fy),
+                              VLOAD(0, fwx), VLOAD(0, fwy), VLOAD(0, fwz), &exact);
+    int cells[LANES], ex[LANES];
+    VSTORE(cellv, 0, cells), VSTORE(exact, 0, ex);
+    for (int l = 0; l < LANES; l++) {
+        size_t cell = (size_t)(uint)cells[l];
+        if (ex[l]) {
+            cell = ppb_mc_exit_cell(&p, &edges, fside[l], fx[l], fy[l], fwx[l], fwy[l], fwz[l]);
+            atomic_inc(out + 1);
+        }
+        int surf = fsurf[l];
+        double sv = (surf == PPB_S1 || surf == PPB_S2) ? (double)fx[l] : (double)fy[l];
+        double s0 = (surf == PPB_S1 || surf == PPB_S2) ? -0.5 * (double)p.width : -(double)p.height;
+        double len = (surf == PPB_S1 || surf == PPB_S2) ? (double)p.width : (double)p.height;
+        int seg = p.tube ? ppb_segment_of(sv, s0, len, p.nseg[surf]) : 0;
+        int bin =
+            ppb_dir_bin(surf, (double)fwx[l], (double)fwy[l], (double)fwz[l], p.ntheta, p.nphi);
+        size_t ref = ppb_cell_index(p.offset[surf], seg, ppb_bin_count(p.ntheta, p.nphi), bin);
+        if (cell != ref)
+            atomic_inc(out);
+        atomic_inc(out + 2);
     }
 }

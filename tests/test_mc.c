@@ -11,6 +11,7 @@
 #include <math.h>
 #include <signal.h>
 
+#include "kernels/mc_params.h"
 #include "methods/mc_tally.h"
 #include "methods/method_mc.h"
 #include "methods/method_ppslab.h"
@@ -609,6 +610,71 @@ static void test_philox_matches_random123(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
+/* The kernel bins an exit in float vectors and sends a lane to the scalar double code only
+ * where float cannot decide (issue 21): checked against the conventions' own binning
+ * (ppb_segment_of, ppb_dir_bin with atan2, in the kernel's double) on 4096 x lanes exits per
+ * layout, a quarter of them put on a theta, phi or segment edge each, at 8 and 2 lanes, in
+ * the tube at the study's bins, at odd bin counts, at the largest bins and segments the config
+ * allows, and in the slab. Every cell must agree, and the edge exits must have taken the
+ * fallback (so that path is exercised, not only the float one). */
+static void test_vector_bins_match_conventions(void **state)
+{
+    (void)state;
+    mc_fixture f = {0};
+    fixture_init(&f, tu_tube(), 0);
+    ppb_ocl *ocl;
+    ppb_err err;
+    if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
+        fail_msg("%s", err.msg);
+    /* ntheta, nphi, top and side segments, tube */
+    const int layouts[4][5] = {
+        {8, 8, 128, 36, 1}, {7, 5, 100, 30, 1}, {64, 64, 4096, 4096, 1}, {8, 8, 1, 1, 0}};
+    const char *opts[2] = {"-D PPB_MC_LANES=8", "-D PPB_MC_LANES=2"};
+    for (int i = 0; i < 2; i++) {
+        cl_program prog;
+        cl_kernel k;
+        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
+            ppb_ocl_kernel(prog, "ppb_mc_bins_check", &k, &err))
+            fail_msg("%s", err.msg);
+        for (int j = 0; j < 4; j++) {
+            const int *lo = layouts[j];
+            ppb_mc_params p = {0};
+            p.seed = 0x9e3779b97f4a7c15ull + (cl_ulong)j;
+            p.tube = lo[4];
+            p.ntheta = lo[0], p.nphi = lo[1];
+            p.nseg[0] = p.nseg[1] = lo[2];
+            p.nseg[2] = p.nseg[3] = p.tube ? lo[3] : 0;
+            p.offset[0] = 0, p.offset[1] = lo[2], p.offset[2] = 2 * lo[2];
+            p.offset[3] = 2 * lo[2] + p.nseg[2];
+            p.width = 4.0f, p.height = 2.5f;
+            cl_uint counts[3] = {0, 0, 0};
+            cl_int rc;
+            cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                                        sizeof counts, counts, &rc);
+            assert_int_equal(rc, CL_SUCCESS);
+            size_t global = 4096;
+            assert_int_equal(clSetKernelArg(k, 0, sizeof p, &p), CL_SUCCESS);
+            assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
+            assert_int_equal(
+                clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
+                CL_SUCCESS);
+            assert_int_equal(clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof counts, counts,
+                                                 0, NULL, NULL),
+                             CL_SUCCESS);
+            clReleaseMemObject(buf);
+            int lanes = i == 0 ? 8 : 2;
+            assert_int_equal(counts[2], 4096 * lanes);
+            assert_int_equal(counts[0], 0);
+            /* the edge quarters' exits mostly sit on an edge: over a tenth of all lanes fall
+             * back; the random quarter almost never does, so not nine tenths */
+            assert_between(counts[1], 0.1 * counts[2], 0.9 * counts[2]);
+        }
+        clReleaseKernel(k);
+        clReleaseProgram(prog);
+    }
+    ppb_ctx_close(&f.ctx);
+}
+
 /* The sampler check kernel: the lane types of mc.cl at 8 lanes (the CPU path), then
  * kernels/ppb_sampling.h, the code the transport kernel runs. Work-item q draws for the photons
  * 8q..8q+7 at step k with Philox keyed as mc.cl keys it (counter (photon mod 2^32, photon /
@@ -807,6 +873,7 @@ int main(void)
         cmocka_unit_test(test_count_range),
         cmocka_unit_test(test_hg_sampler_chi_square),
         cmocka_unit_test(test_philox_matches_random123),
+        cmocka_unit_test(test_vector_bins_match_conventions),
         cmocka_unit_test(test_semi_infinite_albedo_and_roulette),
         cmocka_unit_test(test_ballistic),
         cmocka_unit_test(test_slab_published),

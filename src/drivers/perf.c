@@ -1,5 +1,8 @@
 #include "drivers/perf.h"
 
+#include <stdlib.h>
+#include <string.h>
+
 #include "drivers/perf_march.h"
 #include "drivers/perf_mc.h"
 #include "drivers/perf_pp.h"
@@ -16,6 +19,14 @@ int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
         ctx->cfg = &defaults;
     }
     setvbuf(out, NULL, _IOLBF, 0);
+    /* $PPBENCH_PERF_ONLY=mc runs the Monte Carlo alone (paired timing runs of two builds). */
+    const char *only = getenv("PPBENCH_PERF_ONLY");
+    if (only && strcmp(only, "mc") == 0) {
+        fprintf(out, "== Monte Carlo (OpenCL)\n");
+        int rc = ppb_perf_mc(ctx, out, err);
+        ctx->cfg = given;
+        return rc;
+    }
     fprintf(out, "== plane-parallel solver (host, LAPACKE)\n");
     int rc = ppb_perf_ppsolver(out, err);
     if (rc == 0) {
