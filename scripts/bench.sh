@@ -27,7 +27,10 @@ mkdir -p "$out"
 t0=$(date +%s)
 for i in "${!cases[@]}"; do
   c=${cases[$i]}
-  printf '[%d/%d] %s (%ds elapsed)\n' $((i + 1)) ${#cases[@]} "$c" $(( $(date +%s) - t0 )) >&2
+  # The whole study's ETA: the mean time of the cases done so far times the cases left.
+  el=$(( $(date +%s) - t0 )) eta=
+  [ "$i" -gt 0 ] && eta=$(printf ', study ETA %ds more' $(( el * (${#cases[@]} - i) / i )))
+  printf '[%d/%d] %s (%ds elapsed%s)\n' $((i + 1)) ${#cases[@]} "$c" $el "$eta" >&2
   ./ppbench run "${sets[@]}" --ref-cache "$cache" --out "$out/$c" "configs/$c.ini"
   theta=$(awk -F' *= *' '$1 == "theta_deg" {print $2}' "configs/$c.ini")
   bash scripts/plots.sh "$out/$c" "${theta:-0}"
