@@ -9,7 +9,21 @@
  * vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged over the
  * segment (its 1/rho^2 part exactly, the smooth rest on samples_seg points); radiance = flux / pi
  * in every direction bin. The ballistic total is the scene's exact one (physics/maps.h), as for
- * every deterministic method. */
+ * every deterministic method.
+ *
+ * n > 1 (reference: Methods, `mp`; every factor is 1 and skipped at n = 1):
+ * - A = (1 + F_dr) / (1 - F_dr) with the exact inside diffuse Fresnel reflectance, z_b = 2 A D
+ *   at both faces (Jensen et al. 2001 Eq. 4; Donner & Jensen 2005 Sec. 3).
+ * - Entry: the sources carry the power that enters, 1 - F(theta_L) of the incident (the
+ *   `specular` total is F(theta_L), as for every method). They stay z_r = 1/sigma_t' below the
+ *   entry point: a depth along the refracted beam (z_r cos theta_t) would make mp at n -> 1+
+ *   differ from mp at n = 1 at oblique light, where the placement is Jensen's at every angle.
+ * - Exit: Jensen et al. 2001's S_d = (1/pi) F_t(w_i) R_d F_t(w_o) form with the exit lobe
+ *   normalised (multipole.h, ppb_multipole_exit_lobe): radiance J lobe(theta_o) / pi, so a
+ *   face's total is its diffusion flux J; R, T, sides are then (1 - F(theta_L)) times the n = 1
+ *   formulas' with A.
+ * - Ballistic: the unscattered refracted beam followed through its internal reflections (F at
+ *   each face, TIR entirely) until it has left; slab mode in closed form. */
 #include "methods/method_mp.h"
 
 #include <math.h>
@@ -17,10 +31,38 @@
 #include <string.h>
 
 #include "base/progress.h"
+#include "kernels/ppb_fresnel.h"
 #include "methods/method_ss.h"
 #include "methods/result_check.h"
 #include "physics/maps.h"
 #include "physics/multipole.h"
+
+/* The boundary terms at n > 1 (file comment); fresnel = 0 at n = 1, where none applies. */
+#define MP_MAX_THETA 64
+typedef struct mp_boundary {
+    int fresnel;
+    double A;                  /* boundary factor, 1 at n = 1 */
+    double specular;           /* F(cos theta_L) */
+    double entry;              /* 1 - F(cos theta_L) */
+    double lobe[MP_MAX_THETA]; /* exit lobe per theta bin, mean 1 */
+} mp_boundary;
+
+static int mp_boundary_init(const ppb_scene *sc, mp_boundary *b, ppb_err *err)
+{
+    b->fresnel = sc->n > 1.0;
+    b->A = 1.0;
+    b->specular = 0.0;
+    b->entry = 1.0;
+    if (!b->fresnel)
+        return 0;
+    if (sc->ntheta > MP_MAX_THETA)
+        return ppb_fail(err, "mp: bins.theta = %d above %d", sc->ntheta, MP_MAX_THETA);
+    b->A = ppb_multipole_boundary_A(sc->n);
+    b->specular = ppb_fresnel(ppb_scene_cos_theta_l(sc), sc->n);
+    b->entry = 1.0 - b->specular;
+    ppb_multipole_exit_lobe(sc->n, sc->ntheta, b->lobe);
+    return 0;
+}
 
 /* A stretch of the lit strip of S1 with one set of medium coefficients. */
 typedef struct mp_piece {
@@ -29,7 +71,8 @@ typedef struct mp_piece {
 } mp_piece;
 
 /* The lit strip, cut at the step when the medium changes there: at most two pieces. */
-static int mp_pieces(const ppb_config *cfg, mp_piece piece[2], int *npiece, ppb_err *err)
+static int mp_pieces(const ppb_config *cfg, const mp_boundary *bd, mp_piece piece[2], int *npiece,
+                     ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     double xa = -0.5 * sc->width, xb = 0.5 * sc->width;
@@ -52,7 +95,8 @@ static int mp_pieces(const ppb_config *cfg, mp_piece piece[2], int *npiece, ppb_
         p->xb = cut[i + 1];
         double st = ppb_sigma_t_at(x, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
         double al = ppb_albedo_at(x, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
-        if (ppb_multipole_init(&p->mp, st, al, sc->g, sc->height, cfg->mp.pairs, err))
+        if (ppb_multipole_init_boundary(&p->mp, st, al, sc->g, sc->height, cfg->mp.pairs, bd->A,
+                                        err))
             return -1;
     }
     return 0;
@@ -74,10 +118,69 @@ static double mp_segment_flux(const ppb_config *cfg, const mp_piece *piece, int 
     return sum;
 }
 
-static void fill_bins(ppb_result *out, int surf, int seg, double radiance)
+/* A face's radiance from its flux J per unit E_perp: J / pi in every bin at n = 1, J lobe / pi
+ * (the exit lobe of its theta bin) at n > 1. */
+static void fill_bins(ppb_result *out, const ppb_scene *sc, const mp_boundary *bd, int surf,
+                      int seg, double flux)
 {
+    double radiance = flux / PPB_PI;
     for (int b = 0; b < out->layout.nbins; b++)
-        out->radiance[ppb_cell(&out->layout, surf, seg, b)] = radiance;
+        out->radiance[ppb_cell(&out->layout, surf, seg, b)] =
+            bd->fresnel ? radiance * bd->lobe[b / sc->nphi] : radiance;
+}
+
+/* ---- the unscattered beam at n > 1 ---- */
+
+typedef struct beam_dir {
+    double n, sin_t, cos_t;
+} beam_dir;
+
+/* Fraction of the power entering at x_e on S1 that leaves the tube unscattered: the refracted
+ * beam runs to a face, leaves with 1 - F(cos_i, 1/n) and reflects specularly with F (TIR: all),
+ * until less than 1e-16 of it is left (a corner hit reflects both components). */
+static double beam_left(const ppb_scene *sc, double xe, void *arg)
+{
+    const beam_dir *b = arg;
+    double hw = 0.5 * sc->width, depth = sc->height;
+    double x = xe, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, left = 0.0;
+    for (int hit = 0; hit < 1000000 && w > 1e-16; hit++) {
+        double tx = dx > 0 ? (hw - x) / dx : (dx < 0 ? (-hw - x) / dx : INFINITY);
+        double ty = dy > 0 ? -y / dy : (dy < 0 ? (-depth - y) / dy : INFINITY);
+        int wall_x = tx <= ty, wall_y = ty <= tx;
+        double t = fmin(tx, ty);
+        double x1 = wall_x ? (dx > 0 ? hw : -hw) : x + t * dx;
+        double y1 = wall_y ? (dy > 0 ? 0.0 : -depth) : y + t * dy;
+        w *= exp(-ppb_segment_optical_depth(sc, x, y, x1, y1));
+        double f = ppb_fresnel(wall_y ? fabs(dy) : fabs(dx), 1.0 / b->n);
+        left += w * (1.0 - f);
+        w *= f;
+        if (wall_x)
+            dx = -dx;
+        if (wall_y)
+            dy = -dy;
+        x = x1;
+        y = y1;
+    }
+    return left;
+}
+
+/* The ballistic total at n > 1 per unit incident power: the entering 1 - F(theta_L) times what
+ * leaves unscattered. Slab: with e = exp(-tau0 / cos theta_t) and F_b = F(cos theta_t, 1/n) at
+ * both faces, the bounces sum to (1 - F_b) e / (1 - F_b e). Tube: beam_left averaged over the
+ * lit entry points (ppb_lit_integral's Gauss-Legendre panels). Where every side hit is total
+ * internal reflection (sin theta_t below the critical cosine: theta_L < 78.5 deg at n = 1.4)
+ * the mirrored path is the slab's and the integrand is the slab's constant; otherwise the
+ * panels' breaks, those of the unreflected path, miss the kinks that side exits add. */
+static double ballistic_refracted(const ppb_scene *sc, const mp_boundary *bd)
+{
+    beam_dir b = {sc->n, 0.0, ppb_refract_cos(ppb_scene_cos_theta_l(sc), sc->n)};
+    b.sin_t = sqrt(fmax(0.0, 1.0 - b.cos_t * b.cos_t));
+    if (sc->geometry == PPB_GEOM_SLAB) {
+        double e = exp(-sc->sigma_t * sc->height / b.cos_t), fb = ppb_fresnel(b.cos_t, 1.0 / sc->n);
+        return bd->entry * (1.0 - fb) * e / (1.0 - fb * e);
+    }
+    double width, sum = ppb_lit_integral(sc, beam_left, &b, &width);
+    return width > 0.0 ? bd->entry * sum / width : 0.0;
 }
 
 /* Issue 15: the diffusion flux through a surface can come out negative (the dipole images
@@ -107,12 +210,12 @@ static void clamp_report(const ppb_config *cfg, const ppb_result *out, const cla
                 cfg->name, out->method, c->n, c->low);
 }
 
-static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
+static int mp_tube(const ppb_config *cfg, const mp_boundary *bd, ppb_result *out, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     mp_piece piece[2];
     int npiece;
-    if (mp_pieces(cfg, piece, &npiece, err))
+    if (mp_pieces(cfg, bd, piece, &npiece, err))
         return -1;
     double cos_l = ppb_scene_cos_theta_l(sc);
     double power = ppb_scene_power_in(sc); /* entering the lit S1 per unit z */
@@ -122,9 +225,11 @@ static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
         int nseg = out->layout.nseg[surf];
         double len = ppb_scene_segment_length(sc, surf);
         for (int seg = 0; seg < nseg; seg++) {
-            double flux =
-                clamp_flux(&neg, cos_l * mp_segment_flux(cfg, piece, npiece, surf, seg, len));
-            fill_bins(out, surf, seg, flux / PPB_PI);
+            double flux = cos_l * mp_segment_flux(cfg, piece, npiece, surf, seg, len);
+            if (bd->fresnel)
+                flux *= bd->entry; /* the power that entered */
+            flux = clamp_flux(&neg, flux);
+            fill_bins(out, sc, bd, surf, seg, flux);
             surface_power[surf] += flux * len;
         }
     }
@@ -133,25 +238,34 @@ static int mp_tube(const ppb_config *cfg, ppb_result *out, ppb_err *err)
     out->totals.R = surface_power[PPB_S1] * scale;
     out->totals.T = surface_power[PPB_S2] * scale;
     out->totals.sides = (surface_power[PPB_S3] + surface_power[PPB_S4]) * scale;
-    out->totals.ballistic = ppb_ballistic_fraction(sc); /* over the lit strip */
+    out->totals.ballistic = bd->fresnel ? ballistic_refracted(sc, bd)
+                                        : ppb_ballistic_fraction(sc); /* over the lit strip */
+    out->totals.specular = bd->specular;
     return 0;
 }
 
-static int mp_slab(const ppb_config *cfg, ppb_result *out, ppb_err *err)
+static int mp_slab(const ppb_config *cfg, const mp_boundary *bd, ppb_result *out, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     ppb_multipole mp;
-    if (ppb_multipole_init(&mp, sc->sigma_t, sc->albedo, sc->g, sc->height, cfg->mp.pairs, err))
+    if (ppb_multipole_init_boundary(&mp, sc->sigma_t, sc->albedo, sc->g, sc->height, cfg->mp.pairs,
+                                    bd->A, err))
         return -1;
     double cos_l = ppb_scene_cos_theta_l(sc);
     clamp_count neg = {0, 0.0};
-    out->totals.R = clamp_flux(&neg, ppb_multipole_total_R(&mp));
-    out->totals.T = clamp_flux(&neg, ppb_multipole_total_T(&mp));
+    double R = ppb_multipole_total_R(&mp), T = ppb_multipole_total_T(&mp);
+    if (bd->fresnel) {
+        R *= bd->entry;
+        T *= bd->entry;
+    }
+    out->totals.R = clamp_flux(&neg, R);
+    out->totals.T = clamp_flux(&neg, T);
     clamp_report(cfg, out, &neg);
     out->totals.sides = 0;
-    out->totals.ballistic = ppb_ballistic_fraction(sc);
-    fill_bins(out, PPB_S1, 0, cos_l * out->totals.R / PPB_PI);
-    fill_bins(out, PPB_S2, 0, cos_l * out->totals.T / PPB_PI);
+    out->totals.ballistic = bd->fresnel ? ballistic_refracted(sc, bd) : ppb_ballistic_fraction(sc);
+    out->totals.specular = bd->specular;
+    fill_bins(out, sc, bd, PPB_S1, 0, cos_l * out->totals.R);
+    fill_bins(out, sc, bd, PPB_S2, 0, cos_l * out->totals.T);
     return 0;
 }
 
@@ -166,9 +280,13 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     int nseg = 0; /* over every surface: the slab's two faces are one segment each */
     for (int surf = 0; surf < out->layout.nsurf; surf++)
         nseg += out->layout.nseg[surf];
+    mp_boundary bd;
+    if (mp_boundary_init(&cfg->scene, &bd, err))
+        return -1;
     ppb_progress pr; /* the completion line, as every method prints one */
     ppb_progress_begin(&pr, out->method, "segments", nseg, ctx->quiet);
-    int rc = cfg->scene.geometry == PPB_GEOM_SLAB ? mp_slab(cfg, out, err) : mp_tube(cfg, out, err);
+    int rc = cfg->scene.geometry == PPB_GEOM_SLAB ? mp_slab(cfg, &bd, out, err)
+                                                  : mp_tube(cfg, &bd, out, err);
     if (!rc)
         ppb_progress_end(&pr, nseg);
     if (rc || ppb_radiance_check(cfg->name, out, NULL, err))
@@ -197,7 +315,7 @@ int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "albedo_right", err,
             "mp, mp+ss: albedo = 1 gives sigma_tr = 0, where the multipole's image series of a "
             "finite slab converges only conditionally; use albedo < 1 or leave mp out");
-    return ppb_method_refuse_refractive(cfg, "mp", err);
+    return 0; /* n > 1: mp has the Fresnel boundary (file comment) */
 }
 
 int ppb_mp_ss_check(const ppb_config *cfg, ppb_err *err)

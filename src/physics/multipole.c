@@ -5,6 +5,7 @@
 #include <math.h>
 
 #include "kernels/ppb_conventions.h"
+#include "kernels/ppb_fresnel.h"
 
 #include "base/quadrature.h"
 
@@ -31,6 +32,12 @@ static void place_sources(ppb_multipole *mp)
 int ppb_multipole_init(ppb_multipole *mp, double sigma_t, double albedo, double g, double d,
                        int extra_pairs, ppb_err *err)
 {
+    return ppb_multipole_init_boundary(mp, sigma_t, albedo, g, d, extra_pairs, 1.0, err);
+}
+
+int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo, double g,
+                                double d, int extra_pairs, double A, ppb_err *err)
+{
     if (!(sigma_t > 0) || !(albedo >= 0 && albedo <= 1) || !(g > -1 && g < 1) || !(d > 0))
         return ppb_fail(err,
                         "multipole: needs sigma_t > 0, 0 <= albedo <= 1, -1 < g < 1, d > 0 "
@@ -40,6 +47,8 @@ int ppb_multipole_init(ppb_multipole *mp, double sigma_t, double albedo, double 
         return ppb_fail(err, "multipole: albedo = 1 gives sigma_tr = 0, where the image series of "
                              "a finite slab converges only conditionally (truncated, it gives "
                              "T = 0); use albedo < 1");
+    if (!(A >= 1.0) || !isfinite(A))
+        return ppb_fail(err, "multipole: boundary factor A = %g, needs A >= 1", A);
     if (extra_pairs < 0 || extra_pairs >= PPB_MP_MAX_PAIRS)
         return ppb_fail(err, "multipole: pairs = %d outside [0, %d]", extra_pairs,
                         PPB_MP_MAX_PAIRS - 1);
@@ -53,11 +62,64 @@ int ppb_multipole_init(ppb_multipole *mp, double sigma_t, double albedo, double 
     mp->sigma_tr = sqrt(3.0 * sigma_a * mp->sigma_t_reduced);
     mp->D = 1.0 / (3.0 * mp->sigma_t_reduced);
     mp->z_r = 1.0 / mp->sigma_t_reduced;
-    mp->z_b = 2.0 * 1.0 * mp->D; /* A = 1 for n = 1 (no boundary mismatch) */
+    mp->A = A;
+    mp->z_b = 2.0 * A * mp->D; /* Jensen 2001: z_b = 2 A D; A = 1 at n = 1 */
     mp->thickness = d;
     mp->npairs = isinf(d) ? 1 : 1 + extra_pairs;
     place_sources(mp);
     return 0;
+}
+
+/* 2 int_a^b (1 - F(mu, n)) mu dmu for light from air (n_rel = n >= 1), where F is analytic in
+ * mu on [0, 1] (cos_t >= sqrt(1 - 1/n^2) > 0): `panels` panels of 16-point Gauss-Legendre. */
+static double transmitted_moment(double n, double a, double b, int panels)
+{
+    double x[16], w[16], sum = 0, half = 0.5 * (b - a) / panels;
+    ppb_gauss_legendre(16, x, w);
+    for (int p = 0; p < panels; p++) {
+        double mid = a + (2 * p + 1) * half;
+        for (int j = 0; j < 16; j++) {
+            double mu = mid + half * x[j];
+            sum += w[j] * (1.0 - ppb_fresnel(mu, n)) * mu;
+        }
+    }
+    return 2.0 * half * sum;
+}
+
+double ppb_mp_diffuse_fresnel(double n_rel)
+{
+    if (n_rel == 1.0)
+        return 0.0;
+    if (n_rel > 1.0)
+        return 1.0 - transmitted_moment(n_rel, 0.0, 1.0, 8);
+    double n = 1.0 / n_rel; /* from inside: Prahl 1988 Eq. B.14 (multipole.h) */
+    return 1.0 - transmitted_moment(n, 0.0, 1.0, 8) / (n * n);
+}
+
+double ppb_mp_diffuse_fresnel_fit(double n)
+{
+    return -1.440 / (n * n) + 0.710 / n + 0.668 + 0.0636 * n;
+}
+
+double ppb_multipole_boundary_A(double n)
+{
+    if (!(n > 1.0))
+        return 1.0;
+    double fdr = ppb_mp_diffuse_fresnel(1.0 / n);
+    return (1.0 + fdr) / (1.0 - fdr);
+}
+
+void ppb_multipole_exit_lobe(double n, int ntheta, double *lobe)
+{
+    double mean = 1.0 - ppb_mp_diffuse_fresnel(n); /* 1 - F_dr,e */
+    for (int k = 0; k < ntheta; k++) {
+        /* Bin k spans sin^2 in [k, k + 1] / ntheta, i.e. mu_o from sqrt(1 - (k + 1) / ntheta)
+         * to sqrt(1 - k / ntheta); d(sin^2) = 2 mu dmu, so the bin mean is ntheta times the
+         * transmitted moment over that mu range. */
+        double lo = sqrt(fmax(0.0, 1.0 - (double)(k + 1) / ntheta));
+        double hi = sqrt(1.0 - (double)k / ntheta);
+        lobe[k] = ntheta * transmitted_moment(n, lo, hi, 1) / mean;
+    }
 }
 
 int ppb_multipole_nsources(const ppb_multipole *mp)

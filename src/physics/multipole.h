@@ -4,8 +4,10 @@
  * plane integrals, and the flux through any surface of the tube from sources below a strip of S1.
  *
  * Geometry: depth z is measured down from the lit face (S1, tube y = -z); the slab is
- * 0 <= z <= d. With n = 1 the boundary factor is A = 1 and the extrapolated boundaries sit
- * z_b = 2 A D outside each face. Pair i (i = 0, +1, -1, +2, -2, ...) is a real source at
+ * 0 <= z <= d. The extrapolated boundaries sit z_b = 2 A D outside each face, A the boundary
+ * factor: 1 at n = 1, (1 + F_dr) / (1 - F_dr) at n > 1 (Jensen et al. 2001 Eq. 4-5's form, with
+ * the exact diffuse Fresnel reflectance below; the same A at both faces, both facing air, as in
+ * Donner & Jensen 2005 Sec. 3). Pair i (i = 0, +1, -1, +2, -2, ...) is a real source at
  * z_{r,i} = 2i(d + 2 z_b) + z_r and a negative (virtual) source at z_{v,i} = 2i(d + 2 z_b) - z_r
  * - 2 z_b, each of strength alpha' per unit incident power (DJ2005's source placement; i = 0 is
  * Jensen 2001's dipole with z_v = -(z_r + 4 A D)). A point source's fluence is
@@ -25,7 +27,8 @@ typedef struct ppb_multipole {
     double albedo_reduced;     /* alpha' = sigma_s' / sigma_t' */
     double sigma_tr;           /* effective transport coefficient sqrt(3 sigma_a sigma_t') */
     double D;                  /* diffusion constant 1 / (3 sigma_t') */
-    double z_r, z_b;           /* depth of the first real source 1/sigma_t'; z_b = 2 A D, A = 1 */
+    double A;                  /* boundary factor: 1 at n = 1 (ppb_multipole_boundary_A) */
+    double z_r, z_b;           /* depth of the first real source 1/sigma_t'; z_b = 2 A D */
     double thickness;          /* d; INFINITY for the semi-infinite dipole */
     int npairs;                /* dipole pairs in use: 1 + extra pairs */
     double depth[2 * PPB_MP_MAX_PAIRS];  /* source depths z (signed, below S1) */
@@ -42,6 +45,41 @@ typedef struct ppb_multipole {
  * exp(-sigma_tr 2 (d + 2 z_b) n): slow as albedo -> 1. */
 int ppb_multipole_init(ppb_multipole *mp, double sigma_t, double albedo, double g, double d,
                        int extra_pairs, ppb_err *err);
+
+/* The same with boundary factor A >= 1 (A = 1: ppb_multipole_init, bit for bit). */
+int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo, double g,
+                                double d, int extra_pairs, double A, ppb_err *err);
+
+/* ---- Refractive boundaries (n > 1; reference: Methods, `mp`) ---- */
+
+/* Diffuse (hemispherical, cosine-weighted) Fresnel reflectance 2 int_0^1 F(mu, n_rel) mu dmu of
+ * the exact unpolarized F of kernels/ppb_fresnel.h, for light arriving from the side where the
+ * relative index is n_rel: n_rel = n from air (F_dr,e, smooth in mu: composite 16-point
+ * Gauss-Legendre, ~1e-15), n_rel = 1/n from inside (the F_dr of Jensen et al. 2001, with TIR).
+ * The inside value is 1 - (1 - F_dr,e(n)) / n^2 exactly: substituting the air-side cosine
+ * (n^2 mu dmu = mu_o dmu_o by Snell) in the part below the critical angle, with F equal on both
+ * sides of a refraction (Stokes); Prahl 1988 Eq. B.14. 0 at n_rel = 1. */
+double ppb_mp_diffuse_fresnel(double n_rel);
+
+/* The Egan-Hilgeman / Groenhuis polynomial fit of the inside F_dr that Jensen et al. 2001 Eq. 5
+ * uses, -1.440/n^2 + 0.710/n + 0.668 + 0.0636 n (n the medium's index): kept for comparison
+ * (tests), not used by mp (0.0016 at n = 1, where the exact value is 0). */
+double ppb_mp_diffuse_fresnel_fit(double n);
+
+/* A = (1 + F_dr) / (1 - F_dr) with the exact inside F_dr = ppb_mp_diffuse_fresnel(1/n)
+ * (Jensen et al. 2001 Eq. 4); exactly 1 at n <= 1. */
+double ppb_multipole_boundary_A(double n);
+
+/* The exit lobe in air at n > 1, per theta bin of kernels/ppb_conventions.h (edges sin^2 =
+ * k / ntheta, equal projected solid angle): lobe[k] = the bin's projected-solid-angle mean of
+ * F_t(mu_o) = 1 - F(mu_o, n), divided by 1 - F_dr,e(n), its mean over the hemisphere. The
+ * radiance leaving a face is J lobe[k] / pi for a diffusion flux J through it: Jensen et al.
+ * 2001's F_t(eta, w_o) / pi form, normalised so that the lobe integrates to J over the exit
+ * hemisphere (the flux -D grad(phi) already is the power that crosses the boundary: the
+ * boundary condition with A holds its internal reflections; unnormalised, J (1 - F_dr,e) would
+ * leave and F_dr,e J would be lost). The mean of lobe[] over the bins is 1 to rounding; each
+ * bin's mean by 16-point Gauss-Legendre in mu_o, where F is smooth. */
+void ppb_multipole_exit_lobe(double n, int ntheta, double *lobe);
 
 int ppb_multipole_nsources(const ppb_multipole *mp);
 
