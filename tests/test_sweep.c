@@ -8,7 +8,9 @@
  * - the reference cache serves sweep points: a 2-point sweep run again into another directory
  *   traces no photon (counted from what each point's mc says, not timed), by --ref-cache and by
  *   the default ($PPBENCH_CACHE), with the same sweep.csv;
- * - --jobs 2 reports the sweep's point count, not one worker's (issue 16). */
+ * - --jobs 2 reports the sweep's point count, not one worker's (issue 16);
+ * - a 1-D sweep of mc alone succeeds without a line plot (nothing is measured against mc), and
+ *   with mp beside it draws sweep_rms.png. */
 #include "cliutil.h"
 
 #include <sys/stat.h>
@@ -186,6 +188,25 @@ static void test_jobs_count(void **state)
     assert_int_equal(count_of(cli_out, " points in "), 1);
 }
 
+/* A 1-D sweep whose only method is the reference: no RMS curve exists, so no sweep_rms figure
+ * (gnuplot failed on the empty plot and the sweep exited 1); with mp the figure is drawn. */
+static void test_reference_only_sweep(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("sweepmc");
+    char cfg[1200], args[4096];
+    snprintf(cfg, sizeof cfg, "%s/sw2.ini", d);
+    tu_write_file(cfg, two_points);
+    snprintf(args, sizeof args, "sweep --no-ref-cache --set experiment.methods=mc --out %s/mc %s",
+             d, cfg);
+    cli_expect(args, 0, "wrote");
+    assert_int_equal(tu_sh("test -s %s/mc/sweep.csv", d), 0);
+    assert_int_not_equal(tu_sh("test -e %s/mc/sweep_rms.png", d), 0);
+    snprintf(args, sizeof args, "sweep --no-ref-cache --out %s/mp %s", d, cfg);
+    cli_expect(args, 0, "wrote");
+    assert_int_equal(tu_sh("test -s %s/mp/sweep_rms.png -a -s %s/mp/sweep_rms.pdf", d, d), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -194,6 +215,7 @@ int main(void)
         cmocka_unit_test(test_sweep_whole_shards_resume),
         cmocka_unit_test(test_sweep_ref_cache),
         cmocka_unit_test(test_jobs_count),
+        cmocka_unit_test(test_reference_only_sweep),
     };
     return cmocka_run_group_tests_name("sweep", tests, NULL, NULL);
 }

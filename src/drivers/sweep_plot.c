@@ -263,11 +263,16 @@ int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *
 {
     if (grid->naxes < 1)
         return 0;
-    int has_reference = 0;
-    for (int m = 0; m < cfg->nmethods; m++)
-        has_reference |= ppb_method_find(cfg, cfg->methods[m])->reference == 1;
-    if (!has_reference)
-        return 0; /* no Monte Carlo: sweep.csv holds no RMS to draw, only totals */
+    int has_reference = 0, compared = 0;
+    for (int m = 0; m < cfg->nmethods; m++) {
+        int ref = ppb_method_find(cfg, cfg->methods[m])->reference == 1;
+        has_reference |= ref;
+        compared += !ref;
+    }
+    /* No Monte Carlo: sweep.csv holds no RMS to draw, only totals. The Monte Carlo alone: no
+     * method is measured against it, so there is no curve (gnuplot refuses an empty plot). */
+    if (!has_reference || compared == 0)
+        return 0;
     if (grid->naxes == 1)
         return draw(cfg, grid, dir, "sweep_rms", NULL, err);
     for (int m = 0; m < cfg->nmethods; m++) {
