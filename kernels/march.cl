@@ -376,7 +376,9 @@ inline double ppb_piece_images(const ppb_march_params *P, double px, double py, 
 /* One straight leg of the viewing ray inside, from (px, py) along (mx, my) for length lfar,
  * with the light travelling along v = -(mx, my, mz): the pieces of ppb_march_ray (cut at the step
  * plane and the light lines), each with the source J above; advances *d. */
-inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *map, double px,
+inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *map,
+                              __global const double *tabR, __global const double *tabS,
+                              __global const double *coefC, int ndir, int dirv, double px,
                               double py, double vx, double vy, double vz, double lfar, double *d)
 {
     double mx = -vx, my = -vy;
@@ -415,7 +417,18 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
                            : P->albedo;
         double db = sigma_t * P->height / ct;
         double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
-        if (P->tube && P->tan_theta_l > 0.0)
+        if (P->with_modes) {
+            /* pp: the Fresnel slab solution's field, tabulated along this leg's direction
+             * variant dirv (march_tables.c), read by ppb_piece with the downward beam's whole
+             * coefficient (its single scattering, series and entry included); the upward
+             * beam's coefficient multiplies e^{-(D_b - D)}. One column, one albedo node
+             * (pp's check). */
+            double dpp = *d;
+            L += ppb_piece(P, map, tabR, tabS, coefC, ppb_column(P, ndir, 0), ndir, dirv, vy, px,
+                           py, mx, my, la, lb, sigma_t, alpha, &dpp);
+            double cup = coefC[(long)P->ncols * P->nalb * ndir + dirv];
+            L += ppb_piece_fresnel(P, map, px, py, mx, my, la, lb, sigma_t, alpha, 0.0, cup, db, d);
+        } else if (P->tube && P->tan_theta_l > 0.0)
             L += ppb_piece_images(P, px, py, mx, my, vx, vy, la, lb, sigma_t, alpha, d);
         else
             L += ppb_piece_fresnel(P, map, px, py, mx, my, la, lb, sigma_t, alpha, e * p_down,
@@ -432,9 +445,13 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
  * distance reaches d_cap or the weight times e^{-d} falls below 1e-15 (below the sum's
  * resolution), and after 4096 legs (a ray so close to the tube's axis that its legs are
  * shorter than d_cap / 4096 in total: e^{-d} decides long before). */
-inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const double *map, int surf,
+inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const double *map,
+                                    __global const double *tabR, __global const double *tabS,
+                                    __global const double *coefC, int ndir, int dir, int surf,
                                     double px, double py, double wx, double wy, double wz)
 {
+    /* pp's tables: variant v of sample dir at dir + v nbase (y mirrored: v & 1, x: v & 2). */
+    int nbase = ndir / (P->with_modes ? (P->tube ? 4 : 2) : 1), var = 0;
     double n = P->n, nx = ppb_normal_x(surf), ny = ppb_normal_y(surf);
     double ca = wx * nx + wy * ny, ci = ppb_refract_cos(ca, n);
     double vx = (wx - ca * nx) / n + ci * nx, vy = (wy - ca * ny) / n + ci * ny, vz = wz / n;
@@ -451,22 +468,27 @@ inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const do
                           : (mx < 0.0 ? (-0.5 * P->width - px) / mx : INFINITY);
         int side = lx < ly;
         double lfar = fmax(0.0, fmin(lx, ly)), lcap = (P->d_cap - d) / sig_min;
+        int dirv = dir + var * nbase;
         if (!(lfar <= lcap)) {
-            L += W * ppb_leg_fresnel(P, map, px, py, vx, vy, vz, lcap, &d);
+            L += W * ppb_leg_fresnel(P, map, tabR, tabS, coefC, ndir, dirv, px, py, vx, vy, vz,
+                                     lcap, &d);
             break;
         }
-        L += W * ppb_leg_fresnel(P, map, px, py, vx, vy, vz, lfar, &d);
+        L += W *
+             ppb_leg_fresnel(P, map, tabR, tabS, coefC, ndir, dirv, px, py, vx, vy, vz, lfar, &d);
         /* Onto the face exactly, then mirrored. */
         if (side) {
             px = mx > 0.0 ? 0.5 * P->width : -0.5 * P->width;
             py += lfar * my;
             W *= ppb_fresnel(fabs(vx), 1.0 / n);
             vx = -vx;
+            var ^= 2;
         } else {
             px += lfar * mx;
             py = my > 0.0 ? 0.0 : -P->height;
             W *= ppb_fresnel(fabs(vy), 1.0 / n);
             vy = -vy;
+            var ^= 1;
         }
     }
     return wt * L;
@@ -484,7 +506,9 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
     int seg, surf = ppb_row_surface(row, P.offset, P.nseg, &seg);
     if (surf < 0)
         return;
-    int ndir = ppb_march_ndir(ppb_surface_count(P.tube), nbins, P.nsamp);
+    /* pp's tables at n > 1 hold 2 (slab) or 4 (tube) variants of each sample (march_tables.h) */
+    int nvar = P.n > 1.0 && P.with_modes ? (P.tube ? 4 : 2) : 1;
+    int ndir = nvar * ppb_march_ndir(ppb_surface_count(P.tube), nbins, P.nsamp);
     int npts = P.tube ? P.npts : 1;
     double sum = 0.0;
     for (int ip = 0; ip < npts; ip++) {
@@ -496,7 +520,8 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
                 ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
                 int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
                 if (P.n > 1.0)
-                    sum += ppb_march_ray_fresnel(&P, map, surf, px, py, wx, wy, wz);
+                    sum += ppb_march_ray_fresnel(&P, map, tabR, tabS, coefC, ndir, dir, surf, px,
+                                                 py, wx, wy, wz);
                 else
                     sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, wx, wy);
             }

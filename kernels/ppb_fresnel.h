@@ -35,6 +35,19 @@ PPB_FN double ppb_fresnel(double cos_i, double n_rel)
     return 0.5 * (rs * rs + rp * rp);
 }
 
+/* The direction inside that leaves surface surf along the air-side direction w (w . n > 0,
+ * n the outward normal), in place: Snell's law keeps the tangential part divided by n and
+ * gives the normal part the refracted cosine. Returns the air-side cosine. */
+PPB_FN double ppb_inside_dir(int surf, double n, double *w)
+{
+    double nx = ppb_normal_x(surf), ny = ppb_normal_y(surf);
+    double ca = w[0] * nx + w[1] * ny, ci = ppb_refract_cos(ca, n);
+    w[0] = (w[0] - ca * nx) / n + ci * nx;
+    w[1] = (w[1] - ca * ny) / n + ci * ny;
+    w[2] = w[2] / n;
+    return ca;
+}
+
 /* The collimated beam at S1 (E_perp = 1 in air at cos theta_L): the refracted direction inside
  * (cos_t, sin_t, in the plane of incidence), the specular fraction F(cos theta_L), the
  * perpendicular irradiance of the transmitted beam inside, (1 - F) cos theta_L / cos theta_t (the

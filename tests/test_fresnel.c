@@ -403,6 +403,48 @@ static void test_ss_vs_mc1_tube(void **state)
     }
 }
 
+/* ---- pp at n > 1 ----
+ * In slab mode pp marches the very slab solution ppslab evaluates (the Fresnel solver's modes
+ * and beams, tabulated along every leg's direction: the bin sample mapped inside and its mirror
+ * in y), so the two must agree to the march's own error, not to a discretisation: both integrate
+ * the same exponentials in closed form (the S table telescopes). Measured: the largest relative
+ * difference over the 128 bins is 1.2e-9 (30 deg, g 0.5, tau0 2, n 1.4) and 8.2e-9 (normal, g
+ * -0.5, alpha 0.475, tau0 1, n 1.33); at n = 1 the same comparison gives 3e-9 (README). The limit
+ * 1e-6 leaves room for rounding across platforms and none for a wrong factor: the smallest the
+ * march has, F at exit, is ~3 % at normal exit. */
+static void test_pp_vs_ppslab(void **state)
+{
+    (void)state;
+    const char *ini_body[2] = {
+        "[tube]\nheight = 2\n[medium]\nalbedo = 0.95\ng = 0.5\nn = 1.4\n[light]\n"
+        "theta_deg = 30\n",
+        "[tube]\nheight = 1\n[medium]\nalbedo = 0.475\ng = -0.5\nn = 1.33\n[light]\n"
+        "theta_deg = 0\n"};
+    for (int c = 0; c < 2; c++) {
+        char name[64];
+        snprintf(name, sizeof name, "fresnel_pp%d", c);
+        const char *dir = tu_scratch(name);
+        char ini[1400], csv[1300], text[2400];
+        snprintf(ini, sizeof ini, "%s/a.ini", dir);
+        snprintf(text, sizeof text,
+                 "[experiment]\nname = %s\ngeometry = slab\nmethods = ppslab, pp\n%s"
+                 "[bins]\nsamples_dir = 8\n[output]\ndir = %s/out\n",
+                 name, ini_body[c], dir);
+        tu_write_file(ini, text);
+        assert_int_equal(tu_sh("%s run %s > %s/log 2>&1", tu_bin(), ini, dir), 0);
+        snprintf(csv, sizeof csv, "%s/out/radiance.csv", dir);
+        double a[128], ase[128], b[128], bse[128], worst = 0;
+        assert_int_equal(read_bins(csv, "pp", a, ase), 128);
+        assert_int_equal(read_bins(csv, "ppslab", b, bse), 128);
+        for (int k = 0; k < 128; k++) {
+            assert_true(b[k] > 0);
+            worst = fmax(worst, fabs(a[k] - b[k]) / b[k]);
+        }
+        printf("# %s: pp vs ppslab, largest relative difference %.2e over 128 bins\n", name, worst);
+        assert_lt(worst, 1e-6);
+    }
+}
+
 /* At n > 1 a photon's path still depends only on the seed and its index: the same tallies
  * whatever the work-group size, the chunking or the split into shards (the reflect-or-leave
  * choice comes from the photon's own Philox stream). The tube, oblique light and a density
@@ -456,8 +498,8 @@ static void test_bit_identical_n(void **state)
 }
 
 /* Methods without refractive boundaries yet are refused at n > 1 (exit 2, before any work, by
- * the method's check hook in the registry), not run as if n were 1; mc, ppslab and ss are
- * accepted. */
+ * the method's check hook in the registry), not run as if n were 1; mc, ppslab, ss and pp
+ * are accepted. */
 static void test_config_refuses_other_methods(void **state)
 {
     (void)state;
@@ -465,8 +507,10 @@ static void test_config_refuses_other_methods(void **state)
     char path[1200];
     snprintf(path, sizeof path, "%s/a.ini", dir);
     const char *texts[3] = {
-        "[experiment]\ngeometry = slab\nmethods = mc, ppslab, ss\n[medium]\nn = 1.4\n",
-        "[experiment]\ngeometry = slab\nmethods = mc, pp\n[medium]\nn = 1.4\n",
+        "[experiment]\ngeometry = slab\nmethods = mc, ppslab, ss, pp\n[medium]\nn = 1.4\n",
+        /* pp marches one column slab at one albedo node: a step that needs two is refused */
+        "[experiment]\ngeometry = tube\nmethods = mc, pp\n[medium]\nn = 1.4\nstep = albedo\n"
+        "albedo_right = 0.5\n",
         /* ss's mirror images assume one sigma_t: oblique light with a density step is refused */
         "[experiment]\ngeometry = tube\nmethods = ss\n[medium]\nn = 1.4\nstep = density\n"
         "sigma_t_right = 2\n[light]\ntheta_deg = 30\n"};
@@ -497,6 +541,7 @@ int main(void)
         cmocka_unit_test(test_ppslab_vs_mc_bins),
         cmocka_unit_test(test_ss_vs_mc1_slab),
         cmocka_unit_test(test_ss_vs_mc1_tube),
+        cmocka_unit_test(test_pp_vs_ppslab),
         cmocka_unit_test(test_config_refuses_other_methods),
         cmocka_unit_test(test_bit_identical_n),
         cmocka_unit_test(test_mc_vs_adding_doubling),

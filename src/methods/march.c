@@ -117,7 +117,8 @@ static int march_buffers(ppb_marcher *mr, const ppb_maps *maps, const ppb_march_
     if (!mr->tab_s)
         return -1;
     mr->coef_c =
-        upload(ocl, tab->C, (size_t)tab->ncols * tab->nalb * tab->ndir, "beam coefficients", err);
+        upload(ocl, tab->C, (size_t)(tab->nvar > 1 ? 2 : 1) * tab->ncols * tab->nalb * tab->ndir,
+               "beam coefficients", err);
     if (!mr->coef_c)
         return -1;
     cl_int rc;

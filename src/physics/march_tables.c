@@ -11,13 +11,33 @@
 
 #include "base/progress.h"
 #include "kernels/march_params.h"
+#include "kernels/ppb_fresnel.h"
 
-/* Direction sample `dir` in the table order of ppb_march_dir_index. */
+/* Direction sample `dir` in the table order of ppb_march_dir_index. At n > 1 (issue 18) the
+ * tables hold nvar variants of every sample, variant v at dir + v ndir_base: the air-side sample
+ * mapped inside by Snell (kernels/ppb_fresnel.h: ppb_inside_dir), mirrored in y when v & 1 and in
+ * x when v & 2: the directions of the viewing ray's legs after its reflections (march.cl). */
 static void table_dir(const ppb_scene *sc, int nsamp, int dir, double w[3])
 {
-    int surf, bin, a, b;
-    ppb_march_dir_split(dir, nsamp, ppb_bin_count(sc->ntheta, sc->nphi), &surf, &bin, &a, &b);
+    int surf, bin, a, b, nbins = ppb_bin_count(sc->ntheta, sc->nphi);
+    int nbase = ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE), nbins, nsamp);
+    int var = dir / nbase;
+    ppb_march_dir_split(dir % nbase, nsamp, nbins, &surf, &bin, &a, &b);
     ppb_march_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+    if (sc->n > 1.0) {
+        ppb_inside_dir(surf, sc->n, w);
+        if (var & 1)
+            w[1] = -w[1];
+        if (var & 2)
+            w[0] = -w[0];
+    }
+}
+
+/* Variants of each direction sample in the tables (table_dir): 1 at n = 1; at n > 1 2 in the
+ * slab (legs mirrored in y), 4 in the tube (and in x). */
+static int table_variants(const ppb_scene *sc)
+{
+    return sc->n > 1.0 ? (sc->geometry == PPB_GEOM_TUBE ? 4 : 2) : 1;
 }
 
 static double beam_phase(const ppb_scene *sc, const double w[3])
@@ -32,7 +52,7 @@ static double beam_phase(const ppb_scene *sc, const double w[3])
 typedef struct table_key {
     int with_modes, geometry, ntheta, nphi, nsamp, tau_per_mfp;
     int directions, modes, want_s, nalb, ncols, ntau[PPB_MARCH_MAX_COLS];
-    double g, theta_deg, height, alb0, alb_h, sigma_t[PPB_MARCH_MAX_COLS];
+    double g, theta_deg, height, alb0, alb_h, sigma_t[PPB_MARCH_MAX_COLS], n;
 } table_key;
 
 /* Columns: the left medium's slab always; the right one's when a density step changes sigma_t
@@ -61,6 +81,7 @@ static table_key plan(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
     k.g = sc->g;
     k.theta_deg = sc->theta_deg;
     k.height = sc->height;
+    k.n = sc->n > 1.0 ? sc->n : 1.0;
     k.alb0 = sc->albedo;
     k.alb_h = 1.0;
     k.nalb = 1;
@@ -96,8 +117,9 @@ static int alloc_common(const ppb_scene *sc, const table_key *k, ppb_march_table
 {
     memset(t, 0, sizeof *t);
     t->nsamp = k->nsamp;
-    t->ndir = ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
-                             ppb_bin_count(sc->ntheta, sc->nphi), k->nsamp);
+    t->nvar = k->with_modes ? table_variants(sc) : 1;
+    t->ndir = t->nvar * ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                       ppb_bin_count(sc->ntheta, sc->nphi), k->nsamp);
     t->nalb = k->nalb;
     t->alb0 = k->alb0;
     t->alb_h = k->alb_h;
@@ -110,7 +132,8 @@ static int alloc_common(const ppb_scene *sc, const table_key *k, ppb_march_table
         col->tau_h = col->tau0 / (col->ntau - 1);
         t->ntau += col->ntau;
     }
-    t->C = calloc((size_t)t->ncols * t->nalb * t->ndir, sizeof *t->C);
+    /* At n > 1 the upward beam's coefficients follow the downward one's (march_tables.h). */
+    t->C = calloc((size_t)(t->nvar > 1 ? 2 : 1) * t->ncols * t->nalb * t->ndir, sizeof *t->C);
     if (!t->C)
         return ppb_fail(err, "march tables: out of memory");
     return 0;
@@ -120,14 +143,15 @@ double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, in
                               int tau_per_mfp, int with_modes, double *tables)
 {
     table_key k = plan(sc, pp, nsamp, tau_per_mfp, with_modes);
-    double ndir = ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
-                                 ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
+    int nvar = with_modes ? table_variants(sc) : 1;
+    double ndir = nvar * ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                        ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
     double ntau = 0.0, ntau_max = 0.0;
     for (int c = 0; c < k.ncols; c++) {
         ntau += k.ntau[c];
         ntau_max = k.ntau[c] > ntau_max ? k.ntau[c] : ntau_max;
     }
-    double d = sizeof(double), coef = k.ncols * k.nalb * ndir * d;
+    double d = sizeof(double), coef = (nvar > 1 ? 2 : 1) * k.ncols * k.nalb * ndir * d;
     if (!with_modes) {
         *tables = coef;
         return coef;
@@ -327,15 +351,24 @@ static int adopt_mode_count(pp_build *b, int nm, ppb_err *err)
 
 /* A_k(w) and C(w) of one block from the slab solution. The slab's J carries its albedo; the
  * march multiplies by the local sigma_s, hence the division by alb. */
-static void block_coeffs(pp_build *b, const pp_solution *sol, double alb, int ne, double *C)
+static void block_coeffs(pp_build *b, const pp_solution *sol, double alb, int ne, double *C,
+                         double *Cup)
 {
     for (int dir = 0; dir < b->t->ndir && !ppb_interrupted(); dir++) {
         const double *w = b->wdir + 3 * dir;
         double bcoef;
-        pp_source_coeffs(sol, w, b->a, &bcoef);
+        if (Cup) {
+            /* n > 1: the solver's beams, D's series and 1 - F entry included (ppsolver.h). */
+            double up;
+            pp_source_beams(sol, w, b->a, &bcoef, &up);
+            C[dir] = bcoef / alb;
+            Cup[dir] = up / alb;
+        } else {
+            pp_source_coeffs(sol, w, b->a, &bcoef);
+            C[dir] = beam_phase(b->sc, w) + bcoef / alb;
+        }
         for (int k = 0; k < ne; k++)
             b->A[(size_t)dir * ne + k] = b->a[k] / alb;
-        C[dir] = beam_phase(b->sc, w) + bcoef / alb;
     }
 }
 
@@ -348,6 +381,8 @@ static int solve_block(pp_build *b, double tau0, double alb, pp_solution **sol, 
                      .g = sc->g,
                      .mu0 = ppb_scene_cos_theta_l(sc),
                      .directions = b->pp->directions};
+    if (sc->n > 1.0)
+        return pp_solve_fresnel(&prm, sc->n, b->first, sol, NULL, err);
     return pp_solve_ex(&prm, b->first, sol, NULL, err);
 }
 
@@ -358,6 +393,7 @@ static int build_block(pp_build *b, int c, int node, ppb_err *err)
     const ppb_march_col *col = &t->col[c];
     double alb = t->alb0 + node * t->alb_h;
     double *C = t->C + ppb_march_coef_offset(c, node, t->nalb, t->ndir);
+    double *Cup = t->nvar > 1 ? C + (size_t)t->ncols * t->nalb * t->ndir : NULL;
     int ntau[PPB_MARCH_MAX_COLS];
     for (int k = 0; k < t->ncols; k++)
         ntau[k] = t->col[k].ntau;
@@ -380,7 +416,7 @@ static int build_block(pp_build *b, int c, int node, ppb_err *err)
         return -1;
     }
     pp_modes(sol, b->lambda, b->tau_ref);
-    block_coeffs(b, sol, alb, ne, C);
+    block_coeffs(b, sol, alb, ne, C, Cup);
     double lin = pp_source_linear(sol) / alb;
     if (!b->first)
         b->first = sol;

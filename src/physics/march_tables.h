@@ -46,7 +46,9 @@ typedef struct ppb_march_col {
 
 typedef struct ppb_march_tables {
     int nsamp; /* direction samples per bin axis */
-    int ndir;  /* nsurf x nbins x nsamp^2, ordered by ppb_march_dir_index */
+    int ndir;  /* nvar x nsurf x nbins x nsamp^2, ordered by ppb_march_dir_index per variant */
+    int nvar;  /* direction variants: 1; at n > 1 in pp's tables 2 (slab) or 4 (tube): the
+                * inside direction and its mirrors in y, x, both (march_tables.c) */
     int nalb;  /* albedo nodes */
     double alb0, alb_h;
     int ncols; /* column slabs, 1 or 2 (ss: 1) */
@@ -56,7 +58,7 @@ typedef struct ppb_march_tables {
     int modes_kept;
     double *R; /* [ncols][nalb][ndir][col.ntau], NULL for ss */
     double *S; /* same layout, NULL unless the S table was asked for */
-    double *C; /* [ncols][nalb][ndir] */
+    double *C; /* [ncols][nalb][ndir]; at nvar > 1 followed by as many for the upward beam */
 } ppb_march_tables;
 
 /* Single scattering: C = p(w.w_L), no tables. */

@@ -484,6 +484,15 @@ static double direct_up(const pp_solution *s, const double w[3])
     return s->p.albedo * s->U * pp_hg(s->p.g, c);
 }
 
+void pp_source_beams(const pp_solution *s, const double w[3], double *a, double *down, double *up)
+{
+    double c = w[0] * s->wL[0] + w[1] * s->wL[1] + w[2] * s->wL[2];
+    source_coeffs(s, w, a, down, up);
+    *down += s->p.albedo * (s->fresnel ? s->D : 1.0) * pp_hg(s->p.g, c);
+    if (s->fresnel)
+        *up += direct_up(s, w);
+}
+
 double pp_source_linear(const pp_solution *s)
 {
     return s->p.albedo * s->c_lin;

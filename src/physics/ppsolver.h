@@ -101,9 +101,14 @@ void pp_modes(const pp_solution *s, double *lambda, double *tau_ref);
  * per unit optical depth, E_perp = 1:
  *   J(tau, w) = alpha integral p(w.w') I_diffuse(tau, w') dw' + alpha p(w.w_L) exp(-tau/mu0).
  * Diffuse part in modal form: sum_k a_k(w) e_k(tau) + b(w) exp(-tau/mu0) + a_lin tau.
- * At n > 1 b is the downward beam's part only (the upward reflected beam's is not in it; the
- * marcher, its user, does not run at n > 1 yet); pp_source and pp_radiance hold both. */
+ * At n > 1 b is the downward beam's part only (the upward reflected beam's is not in it:
+ * pp_source_beams gives both, which the marcher uses); pp_source and pp_radiance hold both. */
 void pp_source_coeffs(const pp_solution *s, const double w[3], double *a, double *b);
+/* The same modes a_k(w) with the beams' whole coefficients, single scattering included: J's
+ * coefficient of exp(-tau/mu0) (*down) and of exp(-(tau0 - tau)/mu0) (*up, the beam reflected
+ * at S2; 0 at n = 1): J = sum_k a_k e_k + down e^{-tau/mu0} + up e^{-(tau0-tau)/mu0} + a_lin tau
+ * (issue 18: the marcher at n > 1). */
+void pp_source_beams(const pp_solution *s, const double w[3], double *a, double *down, double *up);
 double pp_source_linear(const pp_solution *s); /* a_lin: 0 unless alpha = 1 */
 double pp_source_direct(const pp_solution *s, double tau, const double w[3]);
 double pp_source(const pp_solution *s, double tau, const double w[3]);
