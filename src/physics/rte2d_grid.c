@@ -35,7 +35,7 @@ static void grid_x(const ppb_scene *sc, double spacing, int *nl, int *nr, double
  * spacing / 16 doubling to spacing / 2 (depth 15/16 spacing), the middle at about spacing;
  * uniform when the layers would not leave a middle of at least one spacing. Measured on
  * uniform_g0_normal at spacing 0.1 (issue 19): the energy balance -4.7e-3 uniform, -3.3e-3 with
- * the layers (8 rows more: 39 instead of 31); in the slab -4.2e-3 and -2.8e-3; six levels gain
+ * the layers (7 rows more: 38 instead of 31); in the slab -4.2e-3 and -2.8e-3; six levels gain
  * nothing more (-2.75e-3). */
 #define RTE_LAYER_LEVELS 4
 static void grid_y(const ppb_scene *sc, double spacing, ppb_rte_params *P)
