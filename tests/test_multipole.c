@@ -467,7 +467,8 @@ static void test_dipole_rd_with_boundary(void **state)
         for (int j = 0; j < 3; j++) {
             ppb_multipole mp;
             assert_int_equal(
-                ppb_multipole_init_boundary(&mp, 1.0, albedo[j], 0.0, INFINITY, 0, A, &err), 0);
+                ppb_multipole_init_boundary(&mp, 1.0, albedo[j], 0.0, INFINITY, 0, A, 1.0, &err),
+                0);
             assert_close(mp.z_b, 2 * A * mp.D, 1e-15);
             double numeric = plane_integral(&mp, 1), closed = jensen_rd_a(mp.albedo_reduced, A);
             if (j == 1)
@@ -481,11 +482,12 @@ static void test_dipole_rd_with_boundary(void **state)
         ppb_multipole one;
         assert_int_equal(ppb_multipole_init(&one, 1.0, 0.95, 0.0, INFINITY, 0, &err), 0);
         ppb_multipole mp;
-        assert_int_equal(ppb_multipole_init_boundary(&mp, 1.0, 0.95, 0.0, INFINITY, 0, A, &err), 0);
+        assert_int_equal(
+            ppb_multipole_init_boundary(&mp, 1.0, 0.95, 0.0, INFINITY, 0, A, 1.0, &err), 0);
         assert_lt(ppb_multipole_total_R(&mp), ppb_multipole_total_R(&one));
     }
     ppb_multipole mp;
-    assert_int_equal(ppb_multipole_init_boundary(&mp, 1.0, 0.95, 0.0, 3.0, 0, 0.5, &err), -1);
+    assert_int_equal(ppb_multipole_init_boundary(&mp, 1.0, 0.95, 0.0, 3.0, 0, 0.5, 1.0, &err), -1);
 }
 
 static void test_exit_lobe(void **state)
@@ -521,7 +523,8 @@ static void test_slab_mode_refractive(void **state)
 {
     (void)state;
     /* Slab mode at n = 1.4, theta_L = 30: R and T are the entering fraction 1 - F(cos 30) times
-     * the multipole's totals with A(1.4); specular = F; the radiance over the bins integrates to
+     * the multipole's totals with A(1.4) and its real source at depth cos(theta_t) / sigma_t'
+     * (1/sigma_t' along the refracted beam); specular = F; the radiance over the bins integrates to
      * cos(theta_L) R (the lobe's normalisation: radiance x projected solid angle pi / nbins);
      * the ballistic is the refracted beam's geometric series (1 - F)(1 - F_b) e / (1 - F_b e),
      * here checked against its own first 200 bounces summed one by one. */
@@ -534,9 +537,11 @@ static void test_slab_mode_refractive(void **state)
     run_mp(&cfg, &out);
     double cos_l = cos(PPB_PI / 6), f = ppb_fresnel(cos_l, 1.4);
     ppb_multipole mp;
+    double mu_in = ppb_refract_cos(cos_l, 1.4); /* the source 1/sigma_t' along the beam */
     assert_int_equal(ppb_multipole_init_boundary(&mp, 1.0, 0.95, 0.0, 3.0, 10,
-                                                 ppb_multipole_boundary_A(1.4), &err),
+                                                 ppb_multipole_boundary_A(1.4), mu_in, &err),
                      0);
+    assert_close(mp.z_r, mu_in, 1e-15); /* sigma_t' = 1 at g = 0 */
     assert_rel(out.totals.R, (1 - f) * ppb_multipole_total_R(&mp), 1e-14);
     assert_rel(out.totals.T, (1 - f) * ppb_multipole_total_T(&mp), 1e-14);
     assert_close(out.totals.specular, f, 0.0);
@@ -656,6 +661,19 @@ static void test_tube_refractive(void **state)
                   out.totals.ballistic, out.totals.specular, out.totals.R, out.totals.T,
                   out.totals.sides);
     assert_close(out.totals.specular, fl, 0.0);
+    /* The placement: S2's middle segment equals the flux of one multipole with its real source
+     * at depth mu_t (sigma_t' = 1) under the lit strip shifted by sin(theta_t), times
+     * cos(theta_L) (1 - F) lobe / pi (S2 segment 16 of 32 spans x in [0, 10/32]). */
+    ppb_multipole placed;
+    ppb_err err;
+    assert_int_equal(ppb_multipole_init_boundary(&placed, 1.0, 0.95, 0.0, 3.0, 10,
+                                                 ppb_multipole_boundary_A(1.4), mu_t, &err),
+                     0);
+    double st = sqrt(1 - mu_t * mu_t), lobe[8];
+    ppb_multipole_exit_lobe(1.4, 8, lobe);
+    double seg = 10.0 / 32, flux = ppb_multipole_segment_flux(&placed, 0.0, -3.0, seg, -3.0, 0, -1,
+                                                              -5 + st, 5 + st, 16, 4);
+    assert_rel(rad(&out, PPB_S2, 16, 0), cos_l * (1 - fl) * flux * lobe[0] / PPB_PI, 1e-12);
     double e45 = exp(-3.0 / mu_t);
     assert_lt(sqrt(1 - mu_t * mu_t), sqrt(1 - 1 / (1.4 * 1.4))); /* TIR at the side */
     assert_rel(out.totals.ballistic, (1 - fl) * (1 - fb) * e45 / (1 - fb * e45), 1e-12);

@@ -3,25 +3,29 @@
  * Slab mode: the multipole's plane-integrated R and T (Donner & Jensen 2005) as a Lambertian
  * exit radiance cos(theta_L) R / pi on S1 and cos(theta_L) T / pi on S2.
  * Tube: the multipole of a slab of the tube's thickness H is placed below every lit point of S1
- * (below the entry point, at every incidence angle: Jensen et al. 2001's placement, not a
- * refracted-direction one), with the medium coefficients of the entry point; each sample point
- * of S1..S4 takes the diffusive flux through its own surface from the 3-D source-to-point
- * vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged over the
- * segment (its 1/rho^2 part exactly, the smooth rest on samples_seg points); radiance = flux / pi
- * in every direction bin. The ballistic total is the scene's exact one (physics/maps.h), as for
- * every deterministic method.
+ * (at n = 1 below the entry point, at every incidence angle: Jensen et al. 2001's placement;
+ * at n > 1 along the refracted beam, below), with the medium coefficients of the entry point; each
+ * sample point of S1..S4 takes the diffusive flux through its own surface from the 3-D
+ * source-to-point vectors (multipole.h: exact over z, Gauss-Legendre over the lit strip), averaged
+ * over the segment (its 1/rho^2 part exactly, the smooth rest on samples_seg points); radiance =
+ * flux / pi in every direction bin. The ballistic total is the scene's exact one (physics/maps.h),
+ * as for every deterministic method.
  *
  * n > 1 (reference: Methods, `mp`; every factor is 1 and skipped at n = 1):
  * - A = (1 + F_dr) / (1 - F_dr) with the exact inside diffuse Fresnel reflectance, z_b = 2 A D
  *   at both faces (Jensen et al. 2001 Eq. 4; Donner & Jensen 2005 Sec. 3).
  * - Entry: the sources carry the power that enters, 1 - F(theta_L) of the incident (the
- *   `specular` total is F(theta_L), as for every method). They stay z_r = 1/sigma_t' below the
- *   entry point: a depth along the refracted beam (z_r cos theta_t) would make mp at n -> 1+
- *   differ from mp at n = 1 at oblique light, where the placement is Jensen's at every angle.
+ *   `specular` total is F(theta_L), as for every method), and sit on the refracted beam,
+ *   1/sigma_t' from the entry point: at depth cos(theta_t)/sigma_t', shifted by
+ *   sin(theta_t)/sigma_t' along x (the lit strip of sources moves with it; those of entry points
+ *   that close to S4 lie beyond it, as mp's slab model has no side walls). n = 1 keeps
+ *   Jensen's placement, 1/sigma_t' straight below the entry point at every angle (the paper's
+ *   baseline, kept bit for bit), so at oblique light mp jumps between n = 1 and n = 1 + 0. At
+ *   45 deg the refracted placement measured closer to mc at both n (README).
  * - Exit: Jensen et al. 2001's S_d = (1/pi) F_t(w_i) R_d F_t(w_o) form with the exit lobe
  *   normalised (multipole.h, ppb_multipole_exit_lobe): radiance J lobe(theta_o) / pi, so a
- *   face's total is its diffusion flux J; R, T, sides are then (1 - F(theta_L)) times the n = 1
- *   formulas' with A.
+ *   face's total is its diffusion flux J; R, T, sides are then (1 - F(theta_L)) times the
+ *   fluxes of the multipole with A and the placed sources.
  * - Ballistic: the unscattered refracted beam followed through its internal reflections (F at
  *   each face, TIR entirely) until it has left; slab mode in closed form. */
 #include "methods/method_mp.h"
@@ -45,6 +49,7 @@ typedef struct mp_boundary {
     double specular;           /* F(cos theta_L) */
     double entry;              /* 1 - F(cos theta_L) */
     double lobe[MP_MAX_THETA]; /* exit lobe per theta bin, mean 1 */
+    double cos_t, sin_t;       /* the refracted beam (1, 0 at n = 1: Jensen's placement) */
 } mp_boundary;
 
 static int mp_boundary_init(const ppb_scene *sc, mp_boundary *b, ppb_err *err)
@@ -53,6 +58,8 @@ static int mp_boundary_init(const ppb_scene *sc, mp_boundary *b, ppb_err *err)
     b->A = 1.0;
     b->specular = 0.0;
     b->entry = 1.0;
+    b->cos_t = 1.0;
+    b->sin_t = 0.0;
     if (!b->fresnel)
         return 0;
     if (sc->ntheta > MP_MAX_THETA)
@@ -60,6 +67,8 @@ static int mp_boundary_init(const ppb_scene *sc, mp_boundary *b, ppb_err *err)
     b->A = ppb_multipole_boundary_A(sc->n);
     b->specular = ppb_fresnel(ppb_scene_cos_theta_l(sc), sc->n);
     b->entry = 1.0 - b->specular;
+    b->cos_t = ppb_refract_cos(ppb_scene_cos_theta_l(sc), sc->n);
+    b->sin_t = sqrt(fmax(0.0, 1.0 - b->cos_t * b->cos_t));
     ppb_multipole_exit_lobe(sc->n, sc->ntheta, b->lobe);
     return 0;
 }
@@ -96,8 +105,13 @@ static int mp_pieces(const ppb_config *cfg, const mp_boundary *bd, mp_piece piec
         double st = ppb_sigma_t_at(x, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
         double al = ppb_albedo_at(x, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
         if (ppb_multipole_init_boundary(&p->mp, st, al, sc->g, sc->height, cfg->mp.pairs, bd->A,
-                                        err))
+                                        bd->cos_t, err))
             return -1;
+        if (bd->fresnel) { /* the sources 1/sigma_t' along the refracted beam */
+            double shift = bd->sin_t / p->mp.sigma_t_reduced;
+            p->xa += shift;
+            p->xb += shift;
+        }
     }
     return 0;
 }
@@ -249,7 +263,7 @@ static int mp_slab(const ppb_config *cfg, const mp_boundary *bd, ppb_result *out
     const ppb_scene *sc = &cfg->scene;
     ppb_multipole mp;
     if (ppb_multipole_init_boundary(&mp, sc->sigma_t, sc->albedo, sc->g, sc->height, cfg->mp.pairs,
-                                    bd->A, err))
+                                    bd->A, bd->cos_t, err))
         return -1;
     double cos_l = ppb_scene_cos_theta_l(sc);
     clamp_count neg = {0, 0.0};

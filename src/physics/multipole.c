@@ -32,11 +32,11 @@ static void place_sources(ppb_multipole *mp)
 int ppb_multipole_init(ppb_multipole *mp, double sigma_t, double albedo, double g, double d,
                        int extra_pairs, ppb_err *err)
 {
-    return ppb_multipole_init_boundary(mp, sigma_t, albedo, g, d, extra_pairs, 1.0, err);
+    return ppb_multipole_init_boundary(mp, sigma_t, albedo, g, d, extra_pairs, 1.0, 1.0, err);
 }
 
 int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo, double g,
-                                double d, int extra_pairs, double A, ppb_err *err)
+                                double d, int extra_pairs, double A, double mu_source, ppb_err *err)
 {
     if (!(sigma_t > 0) || !(albedo >= 0 && albedo <= 1) || !(g > -1 && g < 1) || !(d > 0))
         return ppb_fail(err,
@@ -49,6 +49,8 @@ int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo
                              "T = 0); use albedo < 1");
     if (!(A >= 1.0) || !isfinite(A))
         return ppb_fail(err, "multipole: boundary factor A = %g, needs A >= 1", A);
+    if (!(mu_source > 0.0 && mu_source <= 1.0))
+        return ppb_fail(err, "multipole: source cosine %g outside (0, 1]", mu_source);
     if (extra_pairs < 0 || extra_pairs >= PPB_MP_MAX_PAIRS)
         return ppb_fail(err, "multipole: pairs = %d outside [0, %d]", extra_pairs,
                         PPB_MP_MAX_PAIRS - 1);
@@ -61,7 +63,7 @@ int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo
     mp->albedo_reduced = mp->sigma_s_reduced / mp->sigma_t_reduced;
     mp->sigma_tr = sqrt(3.0 * sigma_a * mp->sigma_t_reduced);
     mp->D = 1.0 / (3.0 * mp->sigma_t_reduced);
-    mp->z_r = 1.0 / mp->sigma_t_reduced;
+    mp->z_r = mu_source / mp->sigma_t_reduced; /* 1 / sigma_t' at mu_source = 1 */
     mp->A = A;
     mp->z_b = 2.0 * A * mp->D; /* Jensen 2001: z_b = 2 A D; A = 1 at n = 1 */
     mp->thickness = d;

@@ -28,7 +28,8 @@ typedef struct ppb_multipole {
     double sigma_tr;           /* effective transport coefficient sqrt(3 sigma_a sigma_t') */
     double D;                  /* diffusion constant 1 / (3 sigma_t') */
     double A;                  /* boundary factor: 1 at n = 1 (ppb_multipole_boundary_A) */
-    double z_r, z_b;           /* depth of the first real source 1/sigma_t'; z_b = 2 A D */
+    double z_r, z_b;           /* depth of the first real source mu_source/sigma_t' (1/sigma_t' at
+                                * n = 1); z_b = 2 A D */
     double thickness;          /* d; INFINITY for the semi-infinite dipole */
     int npairs;                /* dipole pairs in use: 1 + extra pairs */
     double depth[2 * PPB_MP_MAX_PAIRS];  /* source depths z (signed, below S1) */
@@ -46,9 +47,12 @@ typedef struct ppb_multipole {
 int ppb_multipole_init(ppb_multipole *mp, double sigma_t, double albedo, double g, double d,
                        int extra_pairs, ppb_err *err);
 
-/* The same with boundary factor A >= 1 (A = 1: ppb_multipole_init, bit for bit). */
+/* The same with boundary factor A >= 1 and the real source at z_r = mu_source / sigma_t'
+ * (0 < mu_source <= 1: the depth of a point 1/sigma_t' along a beam of cosine mu_source);
+ * A = 1, mu_source = 1 is ppb_multipole_init, bit for bit. */
 int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo, double g,
-                                double d, int extra_pairs, double A, ppb_err *err);
+                                double d, int extra_pairs, double A, double mu_source,
+                                ppb_err *err);
 
 /* ---- Refractive boundaries (n > 1; reference: Methods, `mp`) ---- */
 
