@@ -12,7 +12,9 @@
  * - refinements = K: the paper's iteration from I_pp approaches the converged answer as K grows
  *   (Eq. 5 converges like alpha^K);
  * - the refinement study (rte2d_refinements.csv) against separate `refinements = K` runs scored
- *   with the summary metrics (model/metrics.h). */
+ *   with the summary metrics (model/metrics.h);
+ * - grid convergence: the change of the summary cells per halving of the spacing at least
+ *   halves (a scheme of order >= 1). */
 #include "testutil.h"
 
 #include <lapacke.h>
@@ -322,6 +324,36 @@ static void test_refinements_approach_converged(void **state)
     ppb_result_free(&conv);
 }
 
+/* Grid convergence in the spacing, on the reduced tube (graded rows at S1 and S2, step =
+ * spacing / 2): the summary cells' change from spacing 0.2 to 0.1 and from 0.1 to 0.05 (rms_rel
+ * of the coarser against the finer run); a scheme of order p >= 1 (the balance measures 1.6)
+ * must at least halve the change per halving. Issue 19's target, a change under 0.3 % per
+ * halving at the defaults, is measured on the study case in the README (0.19-0.30 %); on this
+ * reduced tube (32 cells) 0.1 -> 0.05 measures 0.19-0.30 % too, S4 0.304 %, and the change
+ * shrinks 2.75-3.29 times per halving. */
+static void test_grid_convergence(void **state)
+{
+    (void)state;
+    ppb_config cfg = small_tube();
+    ppb_result r[3];
+    for (int k = 0; k < 3; k++) {
+        cfg.rte2d.spacing = 0.2 / (1 << k);
+        cfg.rte2d.step = 0.5 * cfg.rte2d.spacing;
+        run(&cfg, "rte2d", &r[k], NULL);
+    }
+    ppb_point pts[64];
+    for (int c = 0; c < PPB_NCELLS; c++) {
+        int np = ppb_cell_points(&r[0].layout, c, pts, 64);
+        double e1 = ppb_rms_points(&r[0], &r[1], pts, np).rms_rel;
+        double e2 = ppb_rms_points(&r[1], &r[2], pts, np).rms_rel;
+        printf("grid convergence %s: 0.2 -> 0.1 %.4f %%, 0.1 -> 0.05 %.4f %% (ratio %.2f)\n",
+               ppb_cell_name(c), 100.0 * e1, 100.0 * e2, e1 / e2);
+        assert_lt(e2, 0.5 * e1);
+    }
+    for (int k = 0; k < 3; k++)
+        ppb_result_free(&r[k]);
+}
+
 /* The refinement study of a converged run (rte2d_refinements.csv, written by the method through
  * the registry's entry) against its definition: each rung K's rms_rel at each summary cell is
  * the RMS (metrics.h) of a separate `refinements = K` run against the converged run, both at the
@@ -402,6 +434,7 @@ int main(void)
         cmocka_unit_test(test_tube_mirror_symmetry),
         cmocka_unit_test(test_refinements_approach_converged),
         cmocka_unit_test(test_refinement_study),
+        cmocka_unit_test(test_grid_convergence),
     };
     return cmocka_run_group_tests(tests, open_device, close_device);
 }
