@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# bench.sh [--quick] [--out DIR] [--set SEC.KEY=VAL ...]: the accuracy study of SPEC.md
-# section 6: every case of configs/study.list with every method, its plots, Table 2 and the
+# bench.sh [--quick] [--out DIR] [--set SEC.KEY=VAL ...]: the accuracy study (docs/reference.md,
+# Cases): every case of configs/study.list with every method, its plots, Table 2 and the
 # study README. Full runs write results/ (committed); --quick writes build/bench-quick/ with a
 # small photon budget, for a look in about a minute.
 set -euo pipefail
@@ -20,7 +20,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 mapfile -t cases < configs/study.list
-# The Monte Carlo references are kept by fingerprint (SPEC 13, docs/external.md): a second
+# The Monte Carlo references are kept by fingerprint (docs/external.md): a second
 # bench that only adds a method traces no photon. PPB_REF_CACHE moves it.
 cache=${PPB_REF_CACHE:-build/ref-cache}
 mkdir -p "$out"

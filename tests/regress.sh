@@ -29,11 +29,12 @@ for f in tests/regress/*.ini; do
 done
 
 # value CASE FILE METHOD CELL COLUMN: one number from a case's CSV, as ppbench wrote it (every
-# metric is computed by src/model/metrics.c, the one owner of SPEC.md 5; nothing is re-derived
-# here).
+# metric is computed by src/model/metrics.c, the one owner of the Metrics of docs/reference.md;
+# nothing is re-derived here).
 #   FILE summary*.csv: the row (METHOD, CELL), COLUMN by name.
 #   FILE regions.csv:  the row (METHOD, REGION), e.g. "S1:x>x0+2" (model/metrics.h lists them).
-#   FILE totals.csv:   COLUMN by name, or "balance" = |R + T + sides + absorbed + ballistic - 1|.
+#   FILE totals.csv:   COLUMN by name, or "balance" = |R + T + sides + absorbed + ballistic +
+#                      specular - 1| (specular, the beam's reflection at entry, is 0 at n = 1).
 value() {
   local case=$1 file=$2 method=$3 cell=$4 col=$5
   local dir="$out/$case"
@@ -46,7 +47,8 @@ value() {
     totals.csv)
       awk -F, -v m="$method" -v col="$col" '
         NR == 1 {for (i = 1; i <= NF; i++) idx[$i] = i; next}
-        $1 == m {v = (col == "balance") ? $2 + $3 + $4 + $5 + $6 - 1 : $(idx[col]);
+        $1 == m {sum = $2 + $3 + $4 + $5 + $6 + $(idx["specular"]) - 1
+                 v = (col == "balance") ? sum : $(idx[col]);
                  if (v < 0 && col == "balance") v = -v; print v; found = 1}
         END {if (!found) print "missing"}' "$dir/$file" ;;
     *) echo "missing" ;;

@@ -1,7 +1,7 @@
-/* Config parsing: SPEC.md section 9's keys with their meaning, and every error class reported
- * as file:line: key: reason; the sweep grid a config's lists make; the method-id checks of the
- * registry on a loaded config. Expected values are the literal text of each config (its lines,
- * its keys' values) and the C enum values each documented name stands for. */
+/* Config parsing: the keys of the reference's Keys section with their meaning, and every error
+ * class reported as file:line: key: reason; the sweep grid a config's lists make; the method-id
+ * checks of the registry on a loaded config. Expected values are the literal text of each config
+ * (its lines, its keys' values) and the C enum values each documented name stands for. */
 #include "testutil.h"
 
 #include "kernels/march_params.h"
@@ -33,7 +33,8 @@ static void test_spec_example(void **state)
     assert_int_equal(cfg.scene.segments_top, 128);
     assert_int_equal(cfg.scene.step, PPB_STEP_DENSITY);
     assert_true(cfg.scene.theta_deg == 45.0);
-    assert_true(cfg.mc.photons == 10000000LL); /* "1e7" is an exact integer (SPEC.md 10) */
+    /* "1e7" is an exact integer (reference: Corrections) */
+    assert_true(cfg.mc.photons == 10000000LL);
     assert_int_equal(cfg.pp.directions, 334);
     assert_string_equal(cfg.out_dir, "out/x");
     /* Where each key stood in the file; 0 for a key left at its default. */
@@ -52,7 +53,7 @@ static void test_defaults(void **state)
     const char *p = tu_config("defaults", "[experiment]\n");
     ppb_err err = {{0}};
     assert_int_equal(ppb_config_load(&cfg, p, &err), 0);
-    /* Defaults are SPEC.md section 6's study values. */
+    /* Defaults are the study values (reference: Cases). */
     assert_string_equal(cfg.name, "defaults");
     assert_string_equal(cfg.out_dir, "results/defaults");
     assert_true(cfg.scene.width == 10 && cfg.scene.height == 3);
@@ -243,8 +244,9 @@ static void test_set_override(void **state)
     /* A check across keys names the key --set gave, not the file. */
     assert_int_equal(ppb_config_set(&cfg, "experiment", "geometry", "slab", &err), 0);
     assert_int_equal(ppb_config_set(&cfg, "medium", "step", "density", &err), -1);
-    assert_string_equal(err.msg, "--set medium.step: steps are refused in slab mode (SPEC.md 2; "
-                                 "geometry = slab from --set experiment.geometry)");
+    assert_string_equal(
+        err.msg, "--set medium.step: steps are refused in slab mode (docs/reference.md, Geometry; "
+                 "geometry = slab from --set experiment.geometry)");
 }
 
 int main(void)

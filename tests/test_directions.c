@@ -55,8 +55,8 @@ static double uniform01(uint64_t *s)
  * the sphere as normalised Gaussian vectors (Box-Muller; Marsaglia 1972), 500 per cell, looked up
  * with pp_dirs_cell_of. (1) The counts: each cell should get the fraction |Omega_i| / (4 pi) =
  * 1 / (2N); Pearson's chi-square over the 2N cells (2N - 1 degrees of freedom) must have
- * p > 1e-4. (2) The mean of mu over the directions that land in cell i estimates k_i (SPEC.md
- * section 10: k_i = |Omega_i|^-1 integral of mu over the cell); the z-scores against k_i, with
+ * p > 1e-4. (2) The mean of mu over the directions that land in cell i estimates k_i (reference:
+ * Corrections: k_i = |Omega_i|^-1 integral of mu over the cell); the z-scores against k_i, with
  * the sample standard deviation, summed in squares over the cells, are again chi-square with 2N
  * degrees of freedom. This replaces the check that the 2N cells of 2 pi / N cover 4 pi, which
  * holds by the definition of |Omega|. */

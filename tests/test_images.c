@@ -391,7 +391,7 @@ static void test_segment_field_through_exr(void **state)
         for (int k = 5; k < 128; k += 20) {
             /* The pixel holding segment k's centre is shaded from the ray through the pixel's
              * own centre, which may fall in a neighbouring segment: compare with the segment
-             * of the point that ray meets, counted from x = -W/2 as SPEC.md section 2 does. */
+             * of the point that ray meets, counted from x = -W/2 (reference: Geometry). */
             double p[3] = {0, 0, 0}, px, py;
             ppb_scene_sample_point(&f->cfg.scene, surf[v], k, &p[0], &p[1]);
             ppb_tube_view_project(&views[v], p, &px, &py);

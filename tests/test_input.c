@@ -307,7 +307,8 @@ static void test_set_overrides(void **state)
     snprintf(args, sizeof args, "sweep --quiet --out '%s' --set experiment.geometry=slab '%s'", out,
              cli_config("conflict2", "[medium]\nstep = shadow\n"));
     cli_expect(args, 2,
-               ":2: [medium] step: steps are refused in slab mode (SPEC.md 2; geometry = slab "
+               ":2: [medium] step: steps are refused in slab mode (docs/reference.md, Geometry; "
+               "geometry = slab "
                "from --set experiment.geometry)");
     assert_null(strstr(cli_out, ":0:"));
 }

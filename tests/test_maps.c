@@ -1,5 +1,6 @@
-/* test_maps.c: the light maps (src/physics/maps.h) against closed forms of SPEC.md sections 1-3 for
- * the uniform tube, the three step cases and oblique light, and the exact ballistic fraction. */
+/* test_maps.c: the light maps (src/physics/maps.h) against closed forms (reference: Medium,
+ * Geometry, Light) for the uniform tube, the three step cases and oblique light, and the exact
+ * ballistic fraction. */
 #include "testutil.h"
 
 #include <math.h>
@@ -52,7 +53,7 @@ static void test_density_step(void **state)
     sc.step = PPB_STEP_DENSITY;
     ppb_maps m = build(&sc);
     /* Closed form: the vertical light path stays in its column, D = sigma_t(x) |y|, with
-     * sigma_t = 1 for x < 0 and 0.5 for x >= 0 (SPEC.md section 6, density_step). Probes right
+     * sigma_t = 1 for x < 0 and 0.5 for x >= 0 (reference: Cases, density_step). Probes right
      * beside the step test that the jump is kept sharp. */
     double xs[] = {-4.9, -1.0, -0.01, -1e-6, 0.0, 1e-6, 0.01, 2.5, 4.99};
     for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++)
@@ -90,8 +91,8 @@ static void test_shadow_step(void **state)
     ppb_scene sc = tu_tube();
     sc.step = PPB_STEP_SHADOW;
     ppb_maps m = build(&sc);
-    /* SPEC.md section 3: S1 lit for x < 0 only; with vertical light D = |y| there and infinite
-     * (ppb_maps_depth) under the dark half, right up to the edge. */
+    /* Shadow step (reference: Light): S1 lit for x < 0 only; with vertical light D = |y| there and
+     * infinite (ppb_maps_depth) under the dark half, right up to the edge. */
     double xs[] = {-4.9, -0.5, -1e-6, 1e-6, 0.5, 4.9};
     for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++)
         for (int j = 0; j < NPY; j++) {
@@ -111,9 +112,9 @@ static void test_oblique_shadow_triangle(void **state)
     ppb_scene sc = tu_tube();
     sc.theta_deg = 45;
     ppb_maps m = build(&sc);
-    /* SPEC.md section 3 at 45 deg: D = sqrt(2) |y| along the slanted path, and the triangle
-     * x < -W/2 + |y| next to S3 is in shadow. The map's columns follow the light, so the edge is
-     * a column edge: exact on both sides. */
+    /* Shadow step at 45 deg (reference: Light): D = sqrt(2) |y| along the slanted path, and the
+     * triangle x < -W/2 + |y| next to S3 is in shadow. The map's columns follow the light, so the
+     * edge is a column edge: exact on both sides. */
     for (int i = 0; i < NPX; i++)
         for (int j = 0; j < NPY; j++) {
             double x, y;
@@ -196,7 +197,7 @@ static void test_slab(void **state)
     (void)state;
     ppb_scene sc = tu_slab(2.0, 0.9, 0.0, 30.0);
     ppb_maps m = build(&sc);
-    /* Slab mode: D = depth / cos(theta_L) at any x (SPEC.md section 2). */
+    /* Slab mode: D = depth / cos(theta_L) at any x (reference: Geometry). */
     for (int j = 0; j <= 20; j++) {
         double y = -2.0 * j / 20.0;
         for (double x = -100; x <= 100; x += 37.5)

@@ -109,7 +109,7 @@ static void test_ss_slab_closed_form(void **state)
         }
 }
 
-/* Mirror x -> -x (SPEC.md section 4): S3 <-> S4, top/bottom segment i <-> segments-1-i, phi bin
+/* Mirror x -> -x (reference: Bins): S3 <-> S4, top/bottom segment i <-> segments-1-i, phi bin
  * k <-> phi_bins-1-k. */
 static void assert_mirror_symmetric(const ppb_scene *sc, const double *rad, double rtol)
 {
@@ -462,7 +462,7 @@ static double columns_against_slabs(const ppb_scene *sc, int table, int *ncells)
     return worst;
 }
 
-/* The density step (SPEC.md section 6: sigma_t 1 -> 0.5 at x = 0, H = 3): the right column is a
+/* The density step (reference: Cases; sigma_t 1 -> 0.5 at x = 0, H = 3): the right column is a
  * slab of optical thickness 0.5 x 3 = 1.5, the left one of 3; far from the step each reads its
  * own. The tables hold exactly these two slabs (one node per distinct column thickness). */
 static void test_pp_density_step_columns(void **state)
@@ -595,8 +595,9 @@ static void test_shared_layout(void **state)
             for (int bin = 0; bin < lo.nbins; bin++)
                 assert_int_equal(ppb_cell(&lo, surf, seg, bin), next++);
     assert_int_equal(next, lo.ncells);
-    /* Cell measures (SPEC.md 4): a surface's segments add up to its length, the bins of a point to
-     * pi, so a surface's cells measure length x pi; the power entering is W cos(theta_L). */
+    /* Cell measures (reference: Bins): a surface's segments add up to its length, the bins of a
+     * point to pi, so a surface's cells measure length x pi; the power entering is W cos(theta_L).
+     */
     sc.theta_deg = 60;
     double len[PPB_NSURF] = {10.0, 10.0, 3.0, 3.0};
     for (int surf = 0; surf < lo.nsurf; surf++)

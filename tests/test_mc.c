@@ -275,10 +275,10 @@ static void test_single_scattering(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
-/* Bit-identity (SPEC.md 10): the same seed and photons give the same tallies, hence the same
- * radiance bytes, with work-group sizes 1, 16, 128 and the default (64), with 1 or 4
- * chunks, and as shards [0, 30000) + [30000, 100000) saved, loaded and merged in either order.
- * A density step at 45 deg exercises the plane crossing. */
+/* Bit-identity (reference: Corrections): the same seed and photons give the same tallies, hence the
+ * same radiance bytes, with work-group sizes 1, 16, 128 and the default (64), with 1 or 4 chunks,
+ * and as shards [0, 30000) + [30000, 100000) saved, loaded and merged in either order. A density
+ * step at 45 deg exercises the plane crossing. */
 static void test_bit_identical(void **state)
 {
     (void)state;
@@ -414,7 +414,7 @@ static void test_seeds(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
-/* Mirror symmetry x -> -x of the normal-incidence tube without a step (SPEC.md 4): S3 <-> S4,
+/* Mirror symmetry x -> -x of the normal-incidence tube without a step (reference: Bins): S3 <-> S4,
  * S1/S2 segment i <-> segments-1-i, phi bin k <-> nphi-1-k, theta bins unchanged. The two
  * halves come from the same photons, so they are correlated only through photons that reach
  * both, which is negligible; the mean z^2 test of test_seeds applies. */

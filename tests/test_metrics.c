@@ -1,7 +1,7 @@
 /* test_metrics.c: the region metric of src/model/metrics.h (which segments a region holds, and
- * SPEC.md 5's rms_rel / noise_rel / rms_excess over them, with and without unequal bin weights
- * w_k) and regions.csv as src/io/csv.c writes it. Every expected value is worked out by hand
- * from a tiny synthetic result; the arithmetic is in the comments. */
+ * the rms_rel / noise_rel / rms_excess (reference: Metrics) over them, with and without unequal bin
+ * weights w_k) and regions.csv as src/io/csv.c writes it. Every expected value is worked out by
+ * hand from a tiny synthetic result; the arithmetic is in the comments. */
 #include "testutil.h"
 
 #include "io/csv.h"
@@ -155,7 +155,7 @@ static void test_region_rms(void **state)
     ppb_result_free(&rs[1]);
 }
 
-/* Unequal w_k (SPEC.md 5). Points A = (S1, 3), B = (S1, 4), bins 0 and 1:
+/* Unequal w_k (reference: Metrics). Points A = (S1, 3), B = (S1, 4), bins 0 and 1:
  *   L_r: A (1, 2), B (2, 1);  L_m: A (1.5, 2), B (2, 0);  se_r: A (0.1, 0.3), B (0.2, 0.1).
  *   d = L_m - L_r: A (0.5, 0), B (0, -1).
  * With w = (1, 3):

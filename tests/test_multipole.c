@@ -101,10 +101,10 @@ static void test_slab_totals_match_profiles(void **state)
 static void test_slab_converges_with_pairs(void **state)
 {
     (void)state;
-    /* Finite slabs (d = 3 of SPEC.md section 6, and thinner/thicker ones, all with d > z_r where
-     * the model applies): R and T settle as pairs are added (the change from 2n to 2n + 2 extra
-     * pairs shrinks and ends below 1e-6), stay in [0, 1] and R + T <= 1 (energy: alpha' <= 1 of
-     * the power is scattered into the sources). */
+    /* Finite slabs (d = 3 of the study, reference: Cases, and thinner/thicker ones, all with d >
+     * z_r where the model applies): R and T settle as pairs are added (the change from 2n to 2n + 2
+     * extra pairs shrinks and ends below 1e-6), stay in [0, 1] and R + T <= 1 (energy: alpha' <= 1
+     * of the power is scattered into the sources). */
     const double d[] = {1.5, 3.0, 30.0};
     const double albedo[] = {0.95, 0.475, 0.99};
     ppb_err err;
@@ -243,7 +243,7 @@ static void test_tube_mirror_and_belt(void **state)
     ppb_result out;
     run_mp(&cfg, &out);
     const ppb_layout *lo = &out.layout;
-    /* SPEC.md section 4 mirror map (g = 0, normal light, no step): S3 <-> S4, S1/S2 segment
+    /* The mirror map of reference: Bins (g = 0, normal light, no step): S3 <-> S4, S1/S2 segment
      * i <-> segments-1-i, phi bin k <-> phi_bins-1-k; mp is direction-independent. */
     for (int surf = 0; surf < PPB_NSURF; surf++) {
         int mirror = surf == PPB_S3 ? PPB_S4 : surf == PPB_S4 ? PPB_S3 : surf;

@@ -36,7 +36,7 @@ static void test_hg_normalised_with_mean_cosine_g(void **state)
     }
 }
 
-/* |Omega| P is symmetric (SPEC.md section 10) and every entry is positive, including the
+/* |Omega| P is symmetric (reference: Corrections) and every entry is positive, including the
  * strongly peaked |g| = 0.95 (the backward g = -0.95 included: phase.h obtains it from g = +0.95
  * through the antipodal partition) and the self terms, which phase.c sets to the row's residual
  * (|Omega| minus the integrated off-diagonal terms), so that rows sum to 1 by construction (not

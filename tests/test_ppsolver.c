@@ -141,7 +141,7 @@ static void test_totals_converge_in_m(void **state)
     assert_lt(err_prev, 2e-3);
 }
 
-/* One case of tests/data/ppslab_ref.csv: rms_rel of SPEC.md section 5 over both faces, weights
+/* One case of tests/data/ppslab_ref.csv: rms_rel (reference: Metrics) over both faces, weights
  * the projected solid angle of each reference direction. */
 typedef struct ref_case {
     double tau0, albedo, g, theta;

@@ -320,7 +320,7 @@ static double radiance_of(const char *csv, const char *method, const char *rest)
 
 /* mp+ss after mp and ss takes their results: ss is marched once (one "ss: ... rows" line, two
  * before), and mp+ss's rows are byte-identical to an mp+ss run alone, which computes both
- * itself. Its radiance is mp's plus ss's (SPEC.md section 7), to the CSV's 10 digits. */
+ * itself. Its radiance is mp's plus ss's (reference: Methods), to the CSV's 10 digits. */
 static void test_mp_ss_reuses_mp_and_ss(void **state)
 {
     (void)state;

@@ -182,7 +182,8 @@ static inline const char *tu_config(const char *name, const char *text)
     return path;
 }
 
-/* SPEC.md section 6's defaults: W = 10, H = 3, sigma_t = 1, alpha = 0.95, g = 0, normal light. */
+/* The study's defaults (reference: Cases): W = 10, H = 3, sigma_t = 1, alpha = 0.95, g = 0, normal
+ * light. */
 static inline ppb_scene tu_tube(void)
 {
     ppb_scene sc = {.geometry = PPB_GEOM_TUBE,

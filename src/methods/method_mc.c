@@ -435,7 +435,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     ppb_mc_trace_info info = {0};
     int status = 0;
     if (ctx->ref_cache && ppb_mc_cache_get(ctx, &t)) {
-        /* The same reference was traced before (SPEC 13): no photon is traced now. */
+        /* The same reference was traced before (docs/external.md): no photon is traced now. */
         fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n", cfg->name,
                 (unsigned long long)t.count, ctx->ref_cache);
     } else {

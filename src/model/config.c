@@ -844,7 +844,7 @@ static int validate(const ppb_config *cfg, ppb_err *err)
     if (slab && sc->step != PPB_STEP_NONE)
         return ppb_config_key_fail(
             cfg, "medium", "step", err,
-            "steps are refused in slab mode (SPEC.md 2; geometry = slab from %s)",
+            "steps are refused in slab mode (docs/reference.md, Geometry; geometry = slab from %s)",
             origin_of(cfg, "experiment", "geometry", where, sizeof where));
     if (!slab && sc->step != PPB_STEP_NONE && fabs(sc->step_x) >= 0.5 * sc->width)
         return ppb_config_key_fail(

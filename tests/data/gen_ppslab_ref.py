@@ -10,7 +10,7 @@ and the outgoing direction are both directions of travel, so the beam at phi0 = 
 toward +x. Radiance is per unit E_perp (I0 = 1). Rows: the S1 (tau = 0, mu > 0) and S2
 (tau = tau0, mu < 0) quadrature directions times phi = 0..180 deg every 30 deg; mu_out is the
 cosine to the face's outward normal and weight the projected solid angle the row stands for
-(mu w_mu dphi, trapezoid in phi), used by the RMS of SPEC.md section 5.
+(mu w_mu dphi, trapezoid in phi), used by the RMS (docs/reference.md, Metrics).
 """
 import csv
 import os
