@@ -1,4 +1,4 @@
-/* test_rte2d.c: `rte2d` (SPEC.md section 12) and its GMRES, each check with its source:
+/* test_rte2d.c: `rte2d` (reference: Methods) and its GMRES, each check with its source:
  * - GMRES against LAPACK's LU solve of the same small non-symmetric system (an independent
  *   direct solver);
  * - slab mode against `ppslab` on the same direction cells: the eigen solution of the same
@@ -8,7 +8,7 @@
  *   grid spacing;
  * - the tube against the Monte Carlo within its noise: a chi-square over every bin of every
  *   surface, with the MC's batch standard errors;
- * - the tube's mirror symmetry x -> -x at normal incidence (SPEC.md section 4);
+ * - the tube's mirror symmetry x -> -x at normal incidence (reference: Bins);
  * - refinements = K: the paper's iteration from I_pp approaches the converged answer as K grows
  *   (Eq. 5 converges like alpha^K);
  * - the refinement study (rte2d_refinements.csv) against separate `refinements = K` runs scored
@@ -145,7 +145,7 @@ static double balance(const ppb_totals *t)
     return t->R + t->T + t->sides + t->absorbed + t->ballistic - 1.0;
 }
 
-/* Slab mode reproduces ppslab to 1e-3 in every bin and in R and T (SPEC.md section 12), at
+/* Slab mode reproduces ppslab to 1e-3 in every bin and in R and T (reference: Methods), at
  * g = 0 normal incidence and g = 0.5 at 30 degrees, on the same 48 cells per hemisphere. */
 static void test_slab_matches_ppslab(void **state)
 {
@@ -221,7 +221,7 @@ static ppb_config small_tube(void)
     return cfg;
 }
 
-/* The tube against the Monte Carlo (SPEC.md section 7's reference) within its noise: the
+/* The tube against the Monte Carlo, the reference (reference: Methods), within its noise: the
  * chi-square of (rte2d - mc) / se over every bin of every surface, normal and 45 degree light,
  * must be a plausible draw (upper tail p > 1e-4; rte2d's own discretisation error, about 0.5 %
  * at this spacing and 64 cells, is well below the 4-15 % per-bin noise of 5e5 photons). */
@@ -257,7 +257,7 @@ static void test_tube_matches_mc(void **state)
     }
 }
 
-/* The tube's mirror symmetry x -> -x at normal incidence (SPEC.md section 4): S3's segment k
+/* The tube's mirror symmetry x -> -x at normal incidence (reference: Bins): S3's segment k
  * is S4's segment k and S1's segment k is S1's segment nseg - 1 - k, mirrored, and the bins of a
  * segment, with their direction samples, map onto the bins of its image as a set; so the sum
  * over a segment's bins must agree with its image's to rounding. Exact only where the direction
@@ -304,7 +304,7 @@ static void test_tube_mirror_symmetry(void **state)
     }
 }
 
-/* refinements = K (SPEC.md section 12): Eq. 5's plain iteration from I_pp. Its error against
+/* refinements = K (reference: Methods): Eq. 5's plain iteration from I_pp. Its error against
  * the converged answer shrinks with K (each step multiplies it by at most the medium's
  * albedo, 0.95, times what escapes); K = 1 is the paper's one step from I_pp. */
 static void test_refinements_approach_converged(void **state)
