@@ -19,6 +19,7 @@
  *   x = sigma_t h, a = 1 - e^{-x}; exact for a source linear along the step whatever its
  *   optical length (directions close to z cross many mfp in a short planar distance). */
 #include "march_params.h"
+#include "ppb_fresnel.h"
 #include "rte2d_params.h"
 
 /* (e^z - 1) / z, stable at z = 0. */
@@ -45,11 +46,34 @@ inline double rte_w1(double x, double a)
     return a / x - 1.0 + a;
 }
 
+/* n > 1: the radiance entering at the wall the ray from (px, py) along (mx, my) reaches after
+ * length lfar and optical depth d, reflected: e^{-d} F I(mirror, q), I the field rad of the
+ * direction mirrored in that face at the wall point q (bilinear), F the cell-averaged
+ * reflectance (bnd[4 + face]) in the sweep, exact for the direction (wx, wy) at the exit. This
+ * is the boundary condition I_in = F I_out(mirror) of a smooth dielectric face (reference:
+ * Medium), so the walls' reflections are part of the operator GMRES inverts. */
+inline double rte_wall(const ppb_rte_params *P, __global const double *rad,
+                       __global const double *bnd, int exact, double px, double py, double mx,
+                       double my, double wx, double wy, double lfar, double d)
+{
+    double ly = my > 0.0 ? -py / my : (my < 0.0 ? (-P->height - py) / my : INFINITY);
+    double lx = INFINITY;
+    if (P->tube)
+        lx = mx > 0.0 ? (0.5 * P->width - px) / mx
+                      : (mx < 0.0 ? (-0.5 * P->width - px) / mx : INFINITY);
+    int face = lx < ly ? (mx > 0.0 ? PPB_S4 : PPB_S3) : (my > 0.0 ? PPB_S1 : PPB_S2);
+    double F = exact ? ppb_fresnel(fabs(face >= PPB_S3 ? wx : wy), 1.0 / P->n) : bnd[4 + face];
+    int slot = (int)bnd[face];
+    double qx = px + lfar * mx, qy = py + lfar * my;
+    return exp(-d) * F * ppb_rte_lookup(P, rad + (long)slot * ppb_rte_nnodes(P), qx, qy);
+}
+
 /* Radiance leaving (px, py) in direction w = (wx, wy, .) (3-D unit vector; the march advances
  * (-wx, -wy) in the plane per unit length): grid source from plane (if P->diffuse) plus the beam
  * term with coefficient C (if P->beam). */
 inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane, double C,
-                           double px, double py, double wx, double wy)
+                           double Cup, __global const double *rad, __global const double *bnd,
+                           int exact, double px, double py, double wx, double wy)
 {
     double mx = -wx, my = -wy;
     /* A direction in a wall's plane must run along it: the cells centred at phi = pi/2 have
@@ -63,9 +87,10 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
     double lfar = ppb_exit_length(P->tube, P->width, P->height, px, py, mx, my);
     double sig_min =
         P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
+    int wall = P->refl && !(lfar > P->d_cap / sig_min);
     lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
     if (lfar <= 0.0)
-        return 0.0;
+        return wall ? rte_wall(P, rad, bnd, exact, px, py, mx, my, wx, wy, 0.0, 0.0) : 0.0;
 
     double brk[7];
     int nb = 0;
@@ -128,7 +153,20 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
                 double slope = Db - Da;
                 Da -= 0.5 * slope;
                 Db += 0.5 * slope;
-                sum += C * sigma_t * len * rte_beam_factor(-(d + Da), -(sigma_t * len + Db - Da));
+                if (P->n > 1.0) {
+                    /* The refracted beam and its reflection off S2 (optical depth 2 D_b - D),
+                     * every further round trip S2 -> S1 -> S2 summed: 1 / (1 - F_b^2 e^{-2 D_b})
+                     * (as march.cl's ppb_piece_fresnel; D_b the column's: the slab, or the
+                     * tube at normal incidence, where the beam stays in its column). */
+                    double db = sigma_t * P->height / P->cos_theta_l;
+                    double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
+                    sum += e * C * sigma_t * len *
+                           rte_beam_factor(-(d + Da), -(sigma_t * len + Db - Da));
+                    sum += e * P->beam_fb * Cup * sigma_t * len *
+                           rte_beam_factor(-(d + 2.0 * db - Da), -(sigma_t * len - Db + Da));
+                } else
+                    sum +=
+                        C * sigma_t * len * rte_beam_factor(-(d + Da), -(sigma_t * len + Db - Da));
             }
         }
         if (P->diffuse) {
@@ -152,6 +190,8 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         L += alpha * sum;
         d += sigma_t * len;
     }
+    if (wall && d < P->d_cap)
+        L += rte_wall(P, rad, bnd, exact, px, py, mx, my, wx, wy, lfar, d);
     return L;
 }
 
@@ -159,20 +199,22 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
  * wx = 0) would see one side's medium and light along its whole length, whichever the rounding
  * chose: it takes the mean of the two sides, as the node's bilinear hat straddles both. (Taking
  * the right side alone moved R_x0, at the step, by 0.1-0.2 % in albedo_step and shadow_step.) */
-inline double rte_ray(const ppb_rte_params *P, __global const double *plane, double C, double px,
+inline double rte_ray(const ppb_rte_params *P, __global const double *plane, double C, double Cup,
+                      __global const double *rad, __global const double *bnd, int exact, double px,
                       double py, double wx, double wy)
 {
     if (P->tube && P->step_kind != PPB_STEP_NONE && px == P->step_x && fabs(wx) < 1e-12) {
         double e = 1e-9 * P->width;
-        return 0.5 * (rte_ray_side(P, plane, C, px - e, py, wx, wy) +
-                      rte_ray_side(P, plane, C, px + e, py, wx, wy));
+        return 0.5 * (rte_ray_side(P, plane, C, Cup, rad, bnd, exact, px - e, py, wx, wy) +
+                      rte_ray_side(P, plane, C, Cup, rad, bnd, exact, px + e, py, wx, wy));
     }
-    return rte_ray_side(P, plane, C, px, py, wx, wy);
+    return rte_ray_side(P, plane, C, Cup, rad, bnd, exact, px, py, wx, wy);
 }
 
 /* One work-item per (direction cell, node): the cell's radiance at the node. */
 __kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
-                            __global const double *src, __global double *out)
+                            __global const double *src, __global double *out,
+                            __global const double *rad, __global const double *bnd)
 {
     int nn = ppb_rte_nnodes(&P);
     int gid = (int)get_global_id(0);
@@ -182,13 +224,16 @@ __kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
     int i = node % P.nx, j = node / P.nx;
     double px = ppb_rte_node_x(&P, i), py = ppb_rte_node_y(&P, j);
     __global const double *dc = dirs + 4 * cell;
-    out[gid] = rte_ray(&P, src + (long)cell * nn, dc[3], px, py, dc[0], dc[1]);
+    __global const double *bc = bnd + 9 * (P.n > 1.0 ? cell : 0);
+    out[gid] = rte_ray(&P, src + (long)cell * nn, dc[3], P.n > 1.0 ? bc[8] : 0.0, rad, bc, 0, px,
+                       py, dc[0], dc[1]);
 }
 
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
  * and the bin's direction samples (reference: Bins), as march.cl's ppb_march_kernel. */
 __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
-                           __global const double *src, __global double *out)
+                           __global const double *src, __global double *out,
+                           __global const double *rad, __global const double *bnd)
 {
     (void)dirs;
     int nbins = ppb_bin_count(P.ntheta, P.nphi);
@@ -208,8 +253,20 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                 double wx, wy, wz;
                 ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
                 int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
+                if (P.n > 1.0) {
+                    /* Air-side sample w: inside along Snell's direction, (1 - F) / n^2 times
+                     * the inside radiance (the n^2 law, reference: Medium). */
+                    double v[3] = {wx, wy, wz};
+                    double ca = ppb_inside_dir(surf, P.n, v);
+                    double wt = (1.0 - ppb_fresnel(ca, P.n)) / (P.n * P.n);
+                    double C = ppb_hg_phase(P.g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l);
+                    double Cu = ppb_hg_phase(P.g, v[0] * P.sin_theta_l + v[1] * P.cos_theta_l);
+                    sum += wt * rte_ray(&P, src + (long)dir * nn, C, Cu, rad, bnd + 4 * dir, 1, px,
+                                        py, v[0], v[1]);
+                    continue;
+                }
                 double C = ppb_hg_phase(P.g, wx * P.sin_theta_l - wy * P.cos_theta_l);
-                sum += rte_ray(&P, src + (long)dir * nn, C, px, py, wx, wy);
+                sum += rte_ray(&P, src + (long)dir * nn, C, 0.0, rad, bnd, 0, px, py, wx, wy);
             }
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);

@@ -6,7 +6,8 @@
  * the cross-section (node positions, the split of the x nodes at the step, the bilinear lookup of
  * a source plane) and the exact direct beam at a point (optical depth D along the light path and
  * whether S1's lit part is seen, reference: Light), which both the grid's first-scattering
- * source and the exit march use, so the beam's first scattering is exact (as in `ss`).
+ * source and the exit march use, so the beam's first scattering is exact (as in `ss`). At
+ * n > 1 the light fields are the refracted beam's inside (rte2d_grid.h).
  *
  * Grid: nodes x_i, y_j (j = 0 on S1, ny - 1 on S2, y_j = -j hy without layers). In y, a
  * boundary layer under S1 and over S2 has nyl rows whose spacings double away from the face,
@@ -39,7 +40,11 @@ enum {
     PPB_RTE_ARG_SRC = 2,    /* source planes J [nplanes][nnodes] (sweep: per cell; exit: per
                                exit direction sample) */
     PPB_RTE_ARG_OUT = 3,    /* sweep: I [ncell][nnodes]; exit: radiance [rows][nbins] */
-    PPB_RTE_NARGS = 4
+    PPB_RTE_ARG_RAD = 4,    /* n > 1: the field I [ncell][nnodes] the walls reflect */
+    PPB_RTE_ARG_BND = 5,    /* n > 1, sweep: [ncell][9] = slot of the cell's mirror at S1..S4,
+                               its cell-averaged F there, the upward beam's coefficient; exit:
+                               [ndir][4] = slot of the sample's mirror at S1..S4 */
+    PPB_RTE_NARGS = 6
 };
 
 /* Parameters of one launch. All doubles first, then an even number of ints (host asserts). */
@@ -52,6 +57,9 @@ typedef struct ppb_rte_params {
     double hyf, dlay;                             /* y: boundary-layer spacing and depth */
     double hstep;                                 /* march step length in the x-y plane, mfp */
     double d_cap;                                 /* optical distance where a march stops */
+    double n;       /* refractive index (reference: Medium); the light fields above are inside */
+    double beam_in; /* n > 1: perpendicular irradiance of the refracted beam (ppb_fresnel.h) */
+    double beam_fb; /* n > 1: F the beam meets at S2 and S1 from inside */
     int tube, step_kind;
     int nx, ny, nl; /* nodes in x (nl cells left of the split) and y */
     int ncell;      /* sweep: direction cells marched */
@@ -60,7 +68,7 @@ typedef struct ppb_rte_params {
     int ntheta, nphi, nsamp, npts;
     int row0;      /* exit: first segment row of this launch */
     int nyl, nym;  /* y: rows per boundary layer (0: uniform), rows between the layers */
-    int pad;       /* unused: keeps the count of ints even */
+    int refl;      /* 1: a ray reaching a wall adds F x the mirror cell's radiance there (n > 1) */
     int nseg[4];   /* exit: segments per surface (slab: 1, 1, 0, 0) */
     int offset[4]; /* exit: first row of each surface */
 } ppb_rte_params;

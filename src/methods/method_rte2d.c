@@ -12,13 +12,14 @@
 #include "base/memory.h"
 #include "base/progress.h"
 #include "kernels/march_params.h"
+#include "kernels/ppb_fresnel.h"
 #include "methods/march.h"
 #include "methods/result_check.h"
 #include "model/metrics.h"
 #include "physics/gmres.h"
 #include "physics/rte2d_grid.h"
 
-_Static_assert(sizeof(ppb_rte_params) == 18 * sizeof(double) + 24 * sizeof(int),
+_Static_assert(sizeof(ppb_rte_params) == 21 * sizeof(double) + 24 * sizeof(int),
                "ppb_rte_params: doubles first, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
@@ -29,6 +30,7 @@ _Static_assert(sizeof(ppb_rte_params) == 18 * sizeof(double) + 24 * sizeof(int),
 typedef struct rte_exit {
     int nsamp, npts, ndir;
     double *Fx; /* [ndir][nc] */
+    double *bx; /* n > 1: [ndir][4] slots of the samples' mirrors (PPB_RTE_ARG_BND); else NULL */
 } rte_exit;
 
 typedef struct rte_solver {
@@ -37,16 +39,17 @@ typedef struct rte_solver {
     cl_program prog;
     cl_kernel sweep, exitk;
     cl_mem dirs, src, out;
-    size_t nvec; /* nc x nnodes */
-    double *J;   /* [nc][nnodes] scratch */
+    cl_mem radb, bnd; /* n > 1: the field the walls reflect, the cells' walls (else NULL) */
+    size_t nvec;      /* nc x nnodes */
+    double *J;        /* [nc][nnodes] scratch */
     int sweeps;
     double t_sweeps;
 } rte_solver;
 
 static void solver_free(rte_solver *s)
 {
-    cl_mem bufs[] = {s->dirs, s->src, s->out};
-    for (size_t i = 0; i < 3; i++)
+    cl_mem bufs[] = {s->dirs, s->src, s->out, s->radb, s->bnd};
+    for (size_t i = 0; i < 5; i++)
         if (bufs[i])
             clReleaseMemObject(bufs[i]);
     if (s->sweep)
@@ -75,8 +78,16 @@ static cl_mem buffer(ppb_ocl *ocl, cl_mem_flags flags, size_t n, const double *h
 }
 
 static int set_args(cl_kernel k, const ppb_rte_params *P, cl_mem dirs, cl_mem src, cl_mem out,
-                    ppb_err *err)
+                    cl_mem rad, cl_mem bnd, ppb_err *err)
 {
+    /* n = 1: the kernels read neither; any buffer keeps the arguments set. */
+    rad = rad ? rad : dirs;
+    bnd = bnd ? bnd : dirs;
+    if (ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_RAD, sizeof(cl_mem), &rad),
+                     "clSetKernelArg(rte2d)", err) ||
+        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_BND, sizeof(cl_mem), &bnd),
+                     "clSetKernelArg(rte2d)", err))
+        return -1;
     if (ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_PARAMS, sizeof *P, P), "clSetKernelArg(rte2d)",
                      err) ||
         ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_DIRS, sizeof(cl_mem), &dirs),
@@ -89,9 +100,11 @@ static int set_args(cl_kernel k, const ppb_rte_params *P, cl_mem dirs, cl_mem sr
     return 0;
 }
 
-/* out = T (sigma_s J + beam): one march from every node in every transported cell. J NULL: the
- * beam's first scattering alone; beam 0: the grid source alone. */
-static int sweep(rte_solver *s, const double *J, int beam, double *out, ppb_err *err)
+/* out = T (sigma_s J + beam) (+ B x at n > 1: the walls' reflection of the field x that J was
+ * scattered from): one march from every node in every transported cell. J NULL: the beam's
+ * first scattering alone; beam 0: the grid source alone. */
+static int sweep(rte_solver *s, const double *J, int beam, const double *x, double *out,
+                 ppb_err *err)
 {
     if (ppb_interrupted())
         return ppb_fail(err, "rte2d: interrupted");
@@ -99,12 +112,17 @@ static int sweep(rte_solver *s, const double *J, int beam, double *out, ppb_err 
     ppb_rte_params P = s->G.P;
     P.beam = beam;
     P.diffuse = J != NULL;
+    P.refl = P.refl && x != NULL;
     cl_command_queue q = s->ocl->queue;
     size_t bytes = s->nvec * sizeof(double), global = s->nvec;
     if (J && ppb_cl_check(clEnqueueWriteBuffer(q, s->src, CL_TRUE, 0, bytes, J, 0, NULL, NULL),
                           "clEnqueueWriteBuffer(rte2d source)", err))
         return -1;
-    if (set_args(s->sweep, &P, s->dirs, s->src, s->out, err) ||
+    if (P.refl &&
+        ppb_cl_check(clEnqueueWriteBuffer(q, s->radb, CL_TRUE, 0, bytes, x, 0, NULL, NULL),
+                     "clEnqueueWriteBuffer(rte2d field)", err))
+        return -1;
+    if (set_args(s->sweep, &P, s->dirs, s->src, s->out, s->radb, s->bnd, err) ||
         ppb_cl_check(clEnqueueNDRangeKernel(q, s->sweep, 1, NULL, &global, NULL, 0, NULL, NULL),
                      "clEnqueueNDRangeKernel(rte2d sweep)", err) ||
         ppb_cl_check(clEnqueueReadBuffer(q, s->out, CL_TRUE, 0, bytes, out, 0, NULL, NULL),
@@ -120,7 +138,7 @@ static int matvec(void *ctx, const double *x, double *y, ppb_err *err)
 {
     rte_solver *s = ctx;
     ppb_rte_scatter(&s->G, x, s->J);
-    if (sweep(s, s->J, 0, y, err))
+    if (sweep(s, s->J, 0, x, y, err))
         return -1;
     for (size_t i = 0; i < s->nvec; i++)
         y[i] = x[i] - y[i];
@@ -150,6 +168,13 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_
         s->src = buffer(ocl, CL_MEM_READ_ONLY, planes * s->G.nnodes, NULL, "rte2d source", err);
     if (s->src)
         s->out = buffer(ocl, CL_MEM_WRITE_ONLY, outn, NULL, "rte2d output", err);
+    if (s->out && s->G.bnd) {
+        s->radb = buffer(ocl, CL_MEM_READ_ONLY, s->nvec, NULL, "rte2d field", err);
+        if (s->radb)
+            s->bnd =
+                buffer(ocl, CL_MEM_READ_ONLY, 9 * (size_t)s->G.nc, s->G.bnd, "rte2d walls", err);
+        return s->bnd ? 0 : -1;
+    }
     return s->out ? 0 : -1;
 }
 
@@ -165,7 +190,8 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
     ex->ndir = ppb_march_ndir(nsurf, nbins, nsamp);
     double *w = malloc(sizeof(double) * 3 * ex->ndir);
     ex->Fx = malloc(sizeof(double) * (size_t)ex->ndir * s->G.nc);
-    if (!w || !ex->Fx) {
+    ex->bx = sc->n > 1.0 ? malloc(sizeof(double) * 4 * (size_t)ex->ndir) : NULL;
+    if (!w || !ex->Fx || (sc->n > 1.0 && !ex->bx)) {
         free(w);
         return ppb_fail(err, "rte2d: out of memory (exit source)");
     }
@@ -176,6 +202,16 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
                     int d = ppb_march_dir_index(surf, bin, a, b, nsamp, nbins);
                     ppb_march_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[3 * d],
                                   &w[3 * d + 1], &w[3 * d + 2]);
+                    if (sc->n > 1.0) {
+                        /* Inside along Snell's direction (the exit kernel maps it the same
+                         * way); its mirrors in each face for the wall term. */
+                        double *v = &w[3 * d];
+                        ppb_inside_dir(surf, sc->n, v);
+                        double my[3] = {v[0], -v[1], v[2]}, mx[3] = {-v[0], v[1], v[2]};
+                        double *bx = ex->bx + 4 * d;
+                        bx[PPB_S1] = bx[PPB_S2] = s->G.slot[pp_dirs_cell_of(&s->G.dirs, my)];
+                        bx[PPB_S3] = bx[PPB_S4] = s->G.slot[pp_dirs_cell_of(&s->G.dirs, mx)];
+                    }
                 }
     int rc = ppb_rte_exit_coeffs(&s->G, sc->g, w, ex->ndir, ex->Fx, err);
     free(w);
@@ -200,6 +236,15 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
                           "clEnqueueWriteBuffer(rte2d exit source)", err);
     }
     free(Jx);
+    cl_mem bx = NULL;
+    if (!rc && ex->bx) {
+        rc = ppb_cl_check(clEnqueueWriteBuffer(s->ocl->queue, s->radb, CL_TRUE, 0,
+                                               sizeof(double) * s->nvec, rad, 0, NULL, NULL),
+                          "clEnqueueWriteBuffer(rte2d field)", err);
+        if (!rc && !(bx = buffer(s->ocl, CL_MEM_READ_ONLY, 4 * (size_t)ndir, ex->bx,
+                                 "rte2d exit walls", err)))
+            rc = -1;
+    }
     ppb_rte_params P = s->G.P;
     P.beam = P.diffuse = 1;
     P.ntheta = sc->ntheta;
@@ -219,7 +264,7 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
         }
         P.row0 = row0;
         size_t global = (size_t)(rows - row0 < chunk ? rows - row0 : chunk) * nbins;
-        rc = set_args(s->exitk, &P, s->dirs, s->src, s->out, err) ||
+        rc = set_args(s->exitk, &P, s->dirs, s->src, s->out, s->radb, bx, err) ||
              ppb_cl_check(clEnqueueNDRangeKernel(s->ocl->queue, s->exitk, 1, NULL, &global, NULL, 0,
                                                  NULL, NULL),
                           "clEnqueueNDRangeKernel(rte2d exit)", err) ||
@@ -229,6 +274,8 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
         rc = ppb_cl_check(clEnqueueReadBuffer(s->ocl->queue, s->out, CL_TRUE, 0,
                                               lo->ncells * sizeof(double), radiance, 0, NULL, NULL),
                           "clEnqueueReadBuffer(rte2d radiance)", err);
+    if (bx)
+        clReleaseMemObject(bx);
     return rc;
 }
 
@@ -277,7 +324,7 @@ static int record_refinements(rte_solver *s, const ppb_config *cfg, const ppb_la
     int npts = cfg->samples_seg < 1 ? 1 : cfg->samples_seg;
     nsamp = nsamp < RTE_LADDER_SAMPLES ? nsamp : RTE_LADDER_SAMPLES;
     npts = npts < RTE_LADDER_SAMPLES ? npts : RTE_LADDER_SAMPLES;
-    rte_exit ex = {0, 0, 0, NULL};
+    rte_exit ex = {0, 0, 0, NULL, NULL};
     ppb_result r, rc_conv;
     int ok_r = 0, ok_c = 0;
     double *rad = malloc(sizeof(double) * s->nvec);
@@ -298,7 +345,7 @@ static int record_refinements(rte_solver *s, const ppb_config *cfg, const ppb_la
     for (int rung = 0, k = 1; !rc && rung < RTE_LADDER_N; rung++) {
         for (; !rc && k < rte_ladder[rung]; k++) {
             ppb_rte_scatter(&s->G, rad, s->J);
-            rc = sweep(s, s->J, 0, rad, err);
+            rc = sweep(s, s->J, 0, rad, rad, err);
             for (size_t i = 0; !rc && i < s->nvec; i++)
                 rad[i] += b[i];
         }
@@ -324,6 +371,7 @@ static int record_refinements(rte_solver *s, const ppb_config *cfg, const ppb_la
     if (ok_c)
         ppb_result_free(&rc_conv);
     free(ex.Fx);
+    free(ex.bx);
     free(rad);
     free(pts);
     return rc;
@@ -365,10 +413,11 @@ static int rte2d_solve(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats
     int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
     size_t planes = (size_t)ppb_march_ndir(lo->nsurf, lo->nbins, nsamp);
     rte_solver s;
-    rte_exit ex = {0, 0, 0, NULL};
+    rte_exit ex = {0, 0, 0, NULL, NULL};
     if (solver_init(&s, ocl, cfg, planes, lo->ncells, err) ||
         exit_setup(&s, cfg, lo, nsamp, cfg->samples_seg < 1 ? 1 : cfg->samples_seg, &ex, err)) {
         free(ex.Fx);
+        free(ex.bx);
         solver_free(&s);
         return -1;
     }
@@ -380,7 +429,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats
     int rc = (rad && b && phi && (K || !record || ipp)) ? 0 : ppb_fail(err, "rte2d: out of memory");
     /* I_1: the exact first scattering marched to every node; I_pp: the start. */
     if (!rc)
-        rc = sweep(&s, NULL, 1, b, err);
+        rc = sweep(&s, NULL, 1, NULL, b, err);
     if (!rc)
         rc = ppb_rte_initial_pp(&s.G, sc, rad, err);
     if (!rc && ipp)
@@ -398,7 +447,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats
     /* K > 0: K - 1 plain refinements I <- T S I + I_1; the exit march is the K-th. */
     for (int k = 1; !rc && k < K; k++) {
         ppb_rte_scatter(&s.G, rad, s.J);
-        rc = sweep(&s, s.J, 0, rad, err);
+        rc = sweep(&s, s.J, 0, rad, rad, err);
         for (size_t i = 0; !rc && i < s.nvec; i++)
             rad[i] += b[i];
     }
@@ -452,6 +501,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats
                 st.t_total);
     free(ipp);
     free(ex.Fx);
+    free(ex.bx);
     free(rad);
     free(b);
     free(phi);
@@ -471,7 +521,13 @@ int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     return rte2d_solve(ctx, out, NULL, 1, err);
 }
 
+/* n > 1 (reference: Medium): the slab, and the tube at normal incidence, where the refracted
+ * beam bounces between S2 and S1 in its column; oblique light in the tube would meet the side
+ * walls too (ss's mirror images), which the beam term here does not follow yet. */
 int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
 {
-    return ppb_method_refuse_refractive(cfg, "rte2d", err);
+    const ppb_scene *sc = &cfg->scene;
+    if (sc->n > 1.0 && sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0)
+        return ppb_method_refuse_refractive(cfg, "rte2d", err);
+    return 0;
 }

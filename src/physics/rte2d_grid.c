@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/quadrature.h"
+#include "kernels/ppb_fresnel.h"
 #include "physics/maps.h"
 #include "physics/phase.h"
 #include "physics/ppsolver.h"
@@ -70,6 +72,78 @@ static double row_wy(const ppb_rte_params *P, int j)
     return 0.5 * ((j > 0 ? row_dy(P, j - 1) : 0.0) + (j < P->ny - 1 ? row_dy(P, j) : 0.0));
 }
 
+/* Flux-weighted mean of F over a cell's |mu| range [lo, hi] (ppsolver.c's cell_reflectance):
+ * F = 1 below the critical cosine, above it in the air-side cosine t (mu dmu = t dt / n^2),
+ * where the integrand is smooth, by Gauss-Legendre. */
+#define RTE_FRESNEL_GAUSS 16
+static double ring_reflectance(double lo, double hi, double n)
+{
+    double mu_c = sqrt(1.0 - 1.0 / (n * n)), x[RTE_FRESNEL_GAUSS], wq[RTE_FRESNEL_GAUSS];
+    ppb_gauss_legendre(RTE_FRESNEL_GAUSS, x, wq);
+    double num = 0.0, den = 0.5 * (hi * hi - lo * lo);
+    if (lo < mu_c) {
+        double top = fmin(hi, mu_c);
+        num += 0.5 * (top * top - lo * lo);
+    }
+    double a = fmax(lo, mu_c);
+    if (hi > a) {
+        double ta = sqrt(fmax(0.0, 1.0 - n * n * (1.0 - a * a)));
+        double tb = sqrt(fmax(0.0, 1.0 - n * n * (1.0 - hi * hi))), half = 0.5 * (tb - ta);
+        for (int j = 0; j < RTE_FRESNEL_GAUSS; j++) {
+            double t = ta + half * (1.0 + x[j]);
+            num += half * wq[j] * ppb_fresnel(t, n) * t / (n * n);
+        }
+    }
+    return fmin(1.0, num / den);
+}
+
+/* The walls at n > 1 (rte2d_grid.h): G->bnd. Fl is the row of p(w . w_L) cell integrals. */
+static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, ppb_err *err)
+{
+    (void)Fl;
+    const ppb_rte_params *P = &G->P;
+    int m = 2 * G->dirs.n;
+    double *Fu = malloc(sizeof(double) * m);
+    G->bnd = malloc(sizeof(double) * 9 * G->nc);
+    if (!Fu || !G->bnd) {
+        free(Fu);
+        return ppb_fail(err, "rte2d: out of memory (walls)");
+    }
+    double wu[3] = {P->sin_theta_l, P->cos_theta_l, 0.0};
+    if (pp_phase_row(&G->dirs, sc->g, wu, Fu, err)) {
+        free(Fu);
+        return -1;
+    }
+    const int q = 8;
+    for (int a = 0; a < G->nc; a++) {
+        int i = G->rep[a];
+        double *b = G->bnd + 9 * a;
+        const double *c = G->dirs.centre + 3 * i;
+        double my[3] = {c[0], -c[1], c[2]}, mx[3] = {-c[0], c[1], c[2]};
+        b[PPB_S1] = b[PPB_S2] = G->slot[pp_dirs_cell_of(&G->dirs, my)];
+        b[PPB_S3] = b[PPB_S4] = G->slot[pp_dirs_cell_of(&G->dirs, mx)];
+        double lo, hi, plo, phi;
+        pp_dirs_bounds(&G->dirs, i, &lo, &hi, &plo, &phi);
+        double alo = fmin(fabs(lo), fabs(hi)), ahi = fmax(fabs(lo), fabs(hi));
+        b[4 + PPB_S1] = b[4 + PPB_S2] = ring_reflectance(alo, ahi, sc->n);
+        const double *nd = pp_dirs_nodes(&G->dirs, i, q, err);
+        if (!nd) {
+            free(Fu);
+            return -1;
+        }
+        double num = 0.0, den = 0.0;
+        for (int k = 0; k < q * q; k++) {
+            double ax = fabs(nd[4 * k]), w = nd[4 * k + 3] * ax;
+            num += w * ppb_fresnel(ax, 1.0 / sc->n);
+            den += w;
+        }
+        b[4 + PPB_S3] = b[4 + PPB_S4] = den > 0.0 ? num / den : 1.0;
+        b[8] = Fu[i] / G->dirs.solid;
+    }
+    free(Fu);
+    return 0;
+}
+
 double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart)
 {
     int nl = 0, nr = 0, nx = 1;
@@ -106,6 +180,16 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     P->sin_theta_l = ppb_scene_sin_theta_l(sc);
     P->cos_theta_l = ppb_scene_cos_theta_l(sc);
     P->tan_theta_l = ppb_scene_tan_theta_l(sc);
+    P->n = sc->n;
+    if (sc->n > 1.0) { /* inside, the refracted beam (ppb_fresnel.h) */
+        ppb_fresnel_beam b = ppb_fresnel_beam_in(P->cos_theta_l, sc->n);
+        P->sin_theta_l = b.sin_t;
+        P->cos_theta_l = b.cos_t;
+        P->tan_theta_l = b.sin_t / b.cos_t;
+        P->beam_in = b.irradiance;
+        P->beam_fb = b.f_inside;
+        P->refl = 1;
+    }
     (void)th;
     P->hstep = hstep;
     P->d_cap = 40.0;
@@ -123,8 +207,10 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     grid_y(sc, spacing, P);
     G->nnodes = P->nx * P->ny;
 
-    int rc = sc->g < 0 ? pp_dirs_make_antipodal(directions, &G->dirs, err)
-                       : pp_dirs_make(directions, &G->dirs, err);
+    int rc = sc->n > 1.0 ? pp_dirs_make_snap(directions, sc->g < 0,
+                                             sqrt(1.0 - 1.0 / (sc->n * sc->n)), &G->dirs, err)
+             : sc->g < 0 ? pp_dirs_make_antipodal(directions, &G->dirs, err)
+                         : pp_dirs_make(directions, &G->dirs, err);
     if (rc)
         return -1;
     int m = 2 * G->dirs.n;
@@ -181,6 +267,8 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
             }
         }
     }
+    if (!rc && sc->n > 1.0)
+        rc = grid_walls(G, sc, F, err);
     free(Pfull);
     free(F);
     if (rc)
@@ -197,6 +285,7 @@ void ppb_rte_grid_free(ppb_rte_grid *G)
     free(G->dir4);
     free(G->Pf);
     free(G->wnode);
+    free(G->bnd);
     memset(G, 0, sizeof *G);
 }
 
@@ -239,8 +328,10 @@ int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, 
         double al =
             c ? (P->step_kind == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo) : sc->albedo;
         tau0[c] = st * sc->height;
-        pp_params pp = {tau0[c], al, sc->g, P->cos_theta_l, G->dirs.n};
-        if (pp_solve_ex(&pp, c ? s[0] : NULL, &s[c], NULL, err)) {
+        /* n > 1: the Fresnel slab, on the same snapped partition as the grid's. */
+        pp_params pp = {tau0[c], al, sc->g,
+                        sc->n > 1.0 ? ppb_scene_cos_theta_l(sc) : P->cos_theta_l, G->dirs.n};
+        if (pp_solve_fresnel(&pp, sc->n > 1.0 ? sc->n : 1.0, c ? s[0] : NULL, &s[c], NULL, err)) {
             pp_free(s[0]);
             return -1;
         }
@@ -291,21 +382,24 @@ void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *rad, double flux
     for (int a = 0; a < G->nc; a++) {
         const double *row = rad + (size_t)a * nn;
         double w = G->mult[a] * G->dirs.solid, ky = G->dirs.k[G->rep[a]], kx = G->dir4[4 * a];
+        /* n > 1: what leaves is 1 - F of what reaches the face (rte2d_grid.h). */
+        double ty = G->bnd ? 1.0 - G->bnd[9 * a + 4 + PPB_S1] : 1.0;
+        double tx = G->bnd ? 1.0 - G->bnd[9 * a + 4 + PPB_S3] : 1.0;
         for (int i = 0; i < P->nx; i++) {
             double wx = P->nx == 1 ? 1.0 : G->wnode[i] / row_wy(P, 0);
             if (ky > 0.0)
-                flux[PPB_S1] += w * ky * wx * row[i];
+                flux[PPB_S1] += ty * (w * ky * wx * row[i]);
             else
-                flux[PPB_S2] -= w * ky * wx * row[(P->ny - 1) * P->nx + i];
+                flux[PPB_S2] -= ty * (w * ky * wx * row[(P->ny - 1) * P->nx + i]);
         }
         if (P->nx == 1)
             continue;
         for (int j = 0; j < P->ny; j++) {
             double wy = row_wy(P, j);
             if (kx < 0.0)
-                flux[PPB_S3] -= w * kx * wy * row[j * P->nx];
+                flux[PPB_S3] -= tx * (w * kx * wy * row[j * P->nx]);
             else if (kx > 0.0)
-                flux[PPB_S4] += w * kx * wy * row[j * P->nx + P->nx - 1];
+                flux[PPB_S4] += tx * (w * kx * wy * row[j * P->nx + P->nx - 1]);
         }
     }
 }
@@ -363,9 +457,31 @@ static double path_absorbed(const ppb_scene *sc, double x_entry, void *arg)
     return beam_path_absorbed(sc, x_entry);
 }
 
+/* n > 1: absorbed power of the refracted beam's passes in the column at x_e, per unit power
+ * entering (rte2d_grid.h); arg: F_b and cos theta_t. */
+static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
+{
+    const double *fc = arg;
+    double st = sc->geometry == PPB_GEOM_TUBE
+                    ? ppb_sigma_t_at(xe, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right)
+                    : sc->sigma_t;
+    double al = sc->geometry == PPB_GEOM_TUBE
+                    ? ppb_albedo_at(xe, sc->step, sc->step_x, sc->albedo, sc->albedo_right)
+                    : sc->albedo;
+    double e = exp(-st * sc->height / fc[1]);
+    return (1.0 - al) * (1.0 - e) / (1.0 - fc[0] * e);
+}
+
 double ppb_rte_absorbed_beam(const ppb_scene *sc)
 {
     double c = ppb_scene_cos_theta_l(sc);
+    if (sc->n > 1.0) {
+        ppb_fresnel_beam b = ppb_fresnel_beam_in(c, sc->n);
+        double fc[2] = {b.f_inside, b.cos_t}, width;
+        if (sc->geometry == PPB_GEOM_SLAB)
+            return c * (1.0 - b.specular) * fresnel_path_absorbed(sc, 0.0, fc);
+        return c * (1.0 - b.specular) * ppb_lit_integral(sc, fresnel_path_absorbed, fc, &width);
+    }
     if (sc->geometry == PPB_GEOM_SLAB)
         return c * beam_path_absorbed(sc, 0.0);
     /* Over the lit strip as ppb_ballistic_fraction integrates its own beam (maps.h). */

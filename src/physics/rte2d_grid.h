@@ -36,7 +36,15 @@ typedef struct ppb_rte_grid {
     double *dir4;  /* [nc][4]: centre (x, y, z) and the cell average of p(w.w_L) */
     double *Pf;    /* [nc][nc] row-major: folded phase matrix */
     double *wnode; /* [nnodes]: trapezoid area weights (per unit z; slab: per unit area) */
+    double *bnd;   /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
 } ppb_rte_grid;
+
+/* At n > 1 (reference: Medium) the partition has a collar edge at the critical cosine, as
+ * ppsolver.c's, the light fields of P are the refracted beam's, and bnd holds each transported
+ * cell's walls: the slot of its mirror in S1..S4 (the cell of the mirrored centre), its
+ * reflectance there, flux-weighted over the cell (S1, S2: ppsolver.c's mean over the mu range;
+ * S3, S4: over the cell's Gauss nodes, weight |w_x|), and the cell average of p(w . w_up) of
+ * the beam reflected at S2. */
 
 /* Builds the grid with node spacing about `spacing` mfp (each part of the x range, and y, get
  * ceil(length / spacing) cells), `directions` cells per hemisphere and march step hstep mfp. */
@@ -63,11 +71,11 @@ int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, 
 void ppb_rte_fluence(const ppb_rte_grid *G, const double *rad, double *phi);
 
 /* Scattered power leaving through each surface (PPB_S1..S4; per unit z, slab: per unit area):
- * the outgoing cells' flux |Omega| (w.n) I at the boundary nodes (w.n = the cell's exact mean
- * cosine k_i on S1 and S2, its centre's on S3 and S4), trapezoid along the surface. The totals
- * come from it as ppslab's come from its cell field: the same discrete field the absorption is
- * taken from, so R + T + sides + absorbed + ballistic = 1 measures the scheme's conservation,
- * not the bins' quadrature. */
+ * the outgoing cells' flux |Omega| (w.n) I (n > 1: times 1 - F of the cell) at the boundary nodes
+ * (w.n = the cell's exact mean cosine k_i on S1 and S2, its centre's on S3 and S4), trapezoid along
+ * the surface. The totals come from it as ppslab's come from its cell field: the same discrete
+ * field the absorption is taken from, so R + T + sides + absorbed + ballistic = 1 measures the
+ * scheme's conservation, not the bins' quadrature. */
 void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *rad, double flux[4]);
 
 /* Power absorbed from the scattered light, integral of sigma_a(x) phi over the cross-section
@@ -77,7 +85,9 @@ double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *phi);
 /* Power absorbed from the unscattered beam, exact: along every entry point's path the
  * piecewise-constant (1 - alpha)(e^{-tau_a} - e^{-tau_b}), over the lit entry points by
  * Gauss-Legendre panels between the entry points where the path's pieces change; per unit z
- * (slab: per unit area), E_perp = 1. */
+ * (slab: per unit area), E_perp = 1. n > 1 (slab, or the tube at normal incidence): the
+ * refracted beam's passes S1 -> S2 -> S1 .., (1 - F_L)(1 - alpha)(1 - a) / (1 - F_b a) per
+ * column, a = e^{-sigma_t H / cos theta_t}. */
 double ppb_rte_absorbed_beam(const ppb_scene *sc);
 
 #endif
