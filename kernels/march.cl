@@ -318,6 +318,59 @@ inline double ppb_piece_fresnel(const ppb_march_params *P, __global const double
     return alpha * sum;
 }
 
+/* pp at n > 1: the S2-reflected beam of the column's slab solution over one piece [la, lb],
+ * cup e^{-(D_b - D)} with cup interpolated in the albedo nodes at abar (ppb_coef, as ppb_piece
+ * reads the downward beam's C), D_b = db the column's sigma_t H / cos theta_t and D clamped to
+ * [0, D_b]: the point reads its own column's slab at tau = D cos theta_L clamped to that slab, as
+ * the tables do (Eq. 13-14). Where a density step lies across the light path D can exceed the
+ * column's D_b; unclamped, e^{-(D_b - D)} would exceed the slab's own value at its floor. One
+ * closed form over a regular piece (clamped D linear, lit and abar constant), else step by step;
+ * advances *d. Without a step this is ppb_piece_fresnel's upward term (D <= D_b there). */
+inline double ppb_piece_up(const ppb_march_params *P, __global const double *map, ppb_mcol col,
+                           __global const double *cup, int ndir, int dir, double px, double py,
+                           double mx, double my, double la, double lb, double sigma_t, double alpha,
+                           double db, double *d)
+{
+    double len = lb - la, eps = 1e-9 * len;
+    ppb_msample a = ppb_sample(P, map, col.tau0, px, py, mx, my, la + eps);
+    ppb_msample b = ppb_sample(P, map, col.tau0, px, py, mx, my, lb - eps);
+    ppb_msample m = ppb_sample(P, map, col.tau0, px, py, mx, my, 0.5 * (la + lb));
+    double Da = clamp(a.D, 0.0, db), Db = clamp(b.D, 0.0, db), Dm = clamp(m.D, 0.0, db);
+    double tolD = 1e-9 * (1.0 + a.D + b.D);
+    int regular =
+        fabs(a.lit - b.lit) <= 1e-12 && fabs(a.lit - m.lit) <= 1e-12 &&
+        (P->nalb < 2 || (fabs(a.abar - b.abar) <= 1e-12 && fabs(a.abar - m.abar) <= 1e-12)) &&
+        fabs(Dm - 0.5 * (Da + Db)) <= tolD;
+    double d0 = *d;
+    *d = d0 + sigma_t * len;
+    if (regular) {
+        if (a.lit <= 0.0)
+            return 0.0;
+        double c_up = ppb_coef(cup, ndir, dir, ppb_albedo_nodes(P, a.abar));
+        return alpha * a.lit *
+               ppb_beam_step(c_up, sigma_t, len, -(d0 + db - Da), -(sigma_t * len - Db + Da));
+    }
+    int n = max(1, (int)ceil(len / P->step));
+    double h = len / n, sum = 0.0, D1 = Da;
+    for (int i = 0; i < n; i++) {
+        double d1 = d0 + sigma_t * h * i;
+        if (d1 > P->d_cap)
+            break;
+        double l1 = la + h * i;
+        double D2 = i + 1 == n
+                        ? Db
+                        : clamp(ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + h).D, 0.0, db);
+        ppb_msample sm = ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + 0.5 * h);
+        if (sm.lit > 0.0) {
+            double c_up = ppb_coef(cup, ndir, dir, ppb_albedo_nodes(P, sm.abar));
+            sum +=
+                sm.lit * ppb_beam_step(c_up, sigma_t, h, -(d1 + db - D1), -(sigma_t * h - D2 + D1));
+        }
+        D1 = D2;
+    }
+    return alpha * sum;
+}
+
 /* The tube at oblique incidence (n > 1): the beam meets the side walls too. Unfolded by the
  * cross-section's mirror images (tile (k, j), k >= 0 along x, j >= 0 in depth, mirrored when k
  * or j is odd: x' = kW +- x, depth' = jH + d or jH + H - d), every beam is a straight line from
@@ -326,7 +379,30 @@ inline double ppb_piece_fresnel(const ppb_march_params *P, __global const double
  * sigma_t depth' / cos theta_t, entry point x_e = x' - depth' tan theta_t, which must lie on S1's
  * lit part, and direction (+-sin theta_t, -+cos theta_t) in the real tube. Along a piece x' and
  * depth' are linear in l, so each image's lit part is one interval and its integral one closed
- * form (ppb_beam_step). Uniform sigma_t only (ss's check refuses a density step here). */
+ * form (ppb_beam_step). With a density step (x >= step_x: sigma_t_right) the beam's optical
+ * depth is integrated through the step's images instead: ppb_image_depth. */
+/* The unfolded tube's right medium (ppb_piece_images): tile (k, j) holds the cross-section
+ * mirrored in x when k is odd, so the real x >= step_x = s is x' >= kW + s in an even tile and
+ * x' <= kW - s in an odd one; the two join into one interval per pair of tiles, [2mW + s,
+ * 2mW + W - s] for every integer m (the tile edge between them is a mirror, not a step), of
+ * period 2W. Measure of the right medium on x' < x, up to a constant: G(x). */
+inline double ppb_image_right(double x, double s, double W)
+{
+    double len = W - 2.0 * s, m = floor((x - s) / (2.0 * W));
+    return m * len + clamp(x - s - m * 2.0 * W, 0.0, len);
+}
+
+/* Optical depth of the unfolded beam from its entry x_e on S1 to the image point (x', depth'):
+ * a straight line along (sin theta_t, down), so its length is depth' / cos theta_t, of which
+ * (G(x') - G(x_e)) / sin theta_t lies in the right medium's images (ppb_image_right). */
+inline double ppb_image_depth(const ppb_march_params *P, double xp, double xe, double dp)
+{
+    double W = P->width, s = P->step_x;
+    return P->sigma_t * dp / P->cos_theta_l +
+           (P->sigma_t_right - P->sigma_t) / P->light_x *
+               (ppb_image_right(xp, s, W) - ppb_image_right(xe, s, W));
+}
+
 inline double ppb_piece_images(const ppb_march_params *P, double px, double py, double mx,
                                double my, double vx, double vy, double la, double lb,
                                double sigma_t, double alpha, double *d)
@@ -339,9 +415,11 @@ inline double ppb_piece_images(const ppb_march_params *P, double px, double py, 
         return 0.0;
     double pdn[2] = {ppb_hg_phase(P->g, vx * st - vy * ct), ppb_hg_phase(P->g, -vx * st - vy * ct)};
     double pup[2] = {ppb_hg_phase(P->g, vx * st + vy * ct), ppb_hg_phase(P->g, -vx * st + vy * ct)};
-    /* Image j's beam has come at least j H / cos theta_t; with the ray's own d0 beyond d_cap
-     * it counts for nothing. */
-    int jmax = (int)ceil((P->d_cap - d0) * ct / (sigma_t * H));
+    /* Image j's beam has come at least j H / cos theta_t, through the lesser sigma_t at worst;
+     * with the ray's own d0 beyond d_cap it counts for nothing. */
+    int step = P->step_kind == PPB_STEP_DENSITY && P->sigma_t_right != P->sigma_t;
+    double sig_beam = step ? fmin(P->sigma_t, P->sigma_t_right) : sigma_t;
+    int jmax = (int)ceil((P->d_cap - d0) * ct / (sig_beam * H));
     double sum = 0.0, fj = 1.0;
     for (int j = 0; j <= jmax; j++, fj *= P->beam_fb) {
         int jodd = j & 1;
@@ -365,9 +443,30 @@ inline double ppb_piece_images(const ppb_march_params *P, double px, double py, 
             if (!(l2 > l1))
                 continue;
             double C = P->beam_in * fj * fk * (jodd ? pup[kodd] : pdn[kodd]);
-            double D1 = sigma_t * (dp0 + l1 * dpl) / ct, D2 = sigma_t * (dp0 + l2 * dpl) / ct;
-            double e_a = -(d0 + sigma_t * (l1 - la) + D1), z = -(sigma_t * (l2 - l1) + D2 - D1);
-            sum += ppb_beam_step(C, sigma_t, l2 - l1, e_a, z);
+            if (!step) {
+                double D1 = sigma_t * (dp0 + l1 * dpl) / ct, D2 = sigma_t * (dp0 + l2 * dpl) / ct;
+                double e_a = -(d0 + sigma_t * (l1 - la) + D1), z = -(sigma_t * (l2 - l1) + D2 - D1);
+                sum += ppb_beam_step(C, sigma_t, l2 - l1, e_a, z);
+                continue;
+            }
+            /* Density step: along the piece x' = xp0 + l xpl stays on one side of the step's
+             * image (the piece lies in one medium, inside tile k), and x_e on S1 (tile 0) crosses
+             * the step at most once, at ls: D is linear on either side of it. */
+            double xp0 = k * W + (kodd ? -px : px), xpl = kodd ? -mx : mx;
+            double cut[3] = {l1, l2, l2};
+            int ncut = 2;
+            if (xel != 0.0) {
+                double ls = (P->step_x - xe0) / xel;
+                if (ls > l1 && ls < l2)
+                    cut[1] = ls, ncut = 3;
+            }
+            for (int q = 0; q + 1 < ncut; q++) {
+                double u1 = cut[q], u2 = cut[q + 1];
+                double D1 = ppb_image_depth(P, xp0 + u1 * xpl, xe0 + u1 * xel, dp0 + u1 * dpl);
+                double D2 = ppb_image_depth(P, xp0 + u2 * xpl, xe0 + u2 * xel, dp0 + u2 * dpl);
+                double e_a = -(d0 + sigma_t * (u1 - la) + D1), z = -(sigma_t * (u2 - u1) + D2 - D1);
+                sum += ppb_beam_step(C, sigma_t, u2 - u1, e_a, z);
+            }
         }
     }
     return alpha * sum;
@@ -421,13 +520,17 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
             /* pp: the Fresnel slab solution's field, tabulated along this leg's direction
              * variant dirv (march_tables.c), read by ppb_piece with the downward beam's whole
              * coefficient (its single scattering, series and entry included); the upward
-             * beam's coefficient multiplies e^{-(D_b - D)}. One column, one albedo node
-             * (pp's check). */
+             * beam's coefficient multiplies e^{-(D_b - D)} (ppb_piece_up). Both read the
+             * piece's column slab and the albedo nodes at abar, as at n = 1 (ppb_march_ray):
+             * db is that column's D_b. */
+            int c = P->ncols > 1 && sigma_t != P->sigma_t;
+            ppb_mcol col = ppb_column(P, ndir, c);
             double dpp = *d;
-            L += ppb_piece(P, map, tabR, tabS, coefC, ppb_column(P, ndir, 0), ndir, dirv, vy, px,
-                           py, mx, my, la, lb, sigma_t, alpha, &dpp);
-            double cup = coefC[(long)P->ncols * P->nalb * ndir + dirv];
-            L += ppb_piece_fresnel(P, map, px, py, mx, my, la, lb, sigma_t, alpha, 0.0, cup, db, d);
+            L += ppb_piece(P, map, tabR, tabS, coefC, col, ndir, dirv, vy, px, py, mx, my, la, lb,
+                           sigma_t, alpha, &dpp);
+            __global const double *cup = coefC + (long)P->ncols * P->nalb * ndir + col.coef_off;
+            L += ppb_piece_up(P, map, col, cup, ndir, dirv, px, py, mx, my, la, lb, sigma_t, alpha,
+                              db, d);
         } else if (P->tube && P->tan_theta_l > 0.0)
             L += ppb_piece_images(P, px, py, mx, my, vx, vy, la, lb, sigma_t, alpha, d);
         else

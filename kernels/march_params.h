@@ -27,7 +27,8 @@ enum {
     PPB_MARCH_ARG_MAP = 1,    /* map cells, PPB_MAP_STRIDE doubles each */
     PPB_MARCH_ARG_TAB_R = 2,  /* R table [ncols][nalb][ndir][ntau[col]] (paper Eq. 15) */
     PPB_MARCH_ARG_TAB_S = 3,  /* S table, same layout (paper Eq. 16-17, corrected) */
-    PPB_MARCH_ARG_COEF_C = 4, /* [ncols][nalb][ndir]: coefficient of exp(-D) in the source */
+    PPB_MARCH_ARG_COEF_C = 4, /* [ncols][nalb][ndir]: coefficient of exp(-D) in the source;
+                               * pp at n > 1: then as many of exp(-(D_b - D)) (march_tables.h) */
     PPB_MARCH_ARG_OUT = 5,    /* radiance [rows][nbins] */
     PPB_MARCH_NARGS = 6
 };

@@ -445,6 +445,102 @@ static void test_pp_vs_ppslab(void **state)
     }
 }
 
+/* The tube's steps at n > 1 (W = 10, H = 3, g = 0, step at x = 0, 45 deg light, so the refracted
+ * beam crosses the step and meets the side walls): a density step (sigma_t 1 -> 0.5), where
+ * ss's mirror images carry the step's images into the beam's optical depth, and an albedo step
+ * (0.95 -> 0.475). Same chi-square as test_ss_vs_mc1_tube, 3e6 photons; measured as printed. */
+static void test_ss_vs_mc1_steps(void **state)
+{
+    (void)state;
+    const char *steps[2] = {"step = density\nsigma_t_right = 0.5\n",
+                            "step = albedo\nalbedo_right = 0.475\n"};
+    for (int i = 0; i < 2; i++) {
+        char name[64], body[1024];
+        snprintf(name, sizeof name, "fresnel_ss_step%d", i);
+        snprintf(body, sizeof body,
+                 "[experiment]\nname = %s\ngeometry = tube\nmethods = mc, ss\n[tube]\n"
+                 "width = 10\nheight = 3\nsegments_top = 32\nsegments_side = 12\n[medium]\n"
+                 "albedo = 0.95\ng = 0\nn = 1.4\n%sstep_x = 0\n[light]\ntheta_deg = 45\n[mc]\n"
+                 "photons = 3e6\n",
+                 name, steps[i]);
+        double chi2;
+        double p = ss_vs_mc1(name, body, 4, &chi2);
+        assert_true(p > 1e-3);
+    }
+}
+
+/* pp's S1 rows with segment centre s > smin: values in file order into v (cap entries). */
+static int read_s1_beyond(const char *path, const char *method, double smin, double *v, int cap)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        fail_msg("%s: cannot open", path);
+    char line[512], m[64], surf[8];
+    int n = 0, seg, it, ip;
+    double s0, val, err;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "%63[^,],%7[^,],%d,%lf,%d,%d,%lf,%lf", m, surf, &seg, &s0, &it, &ip, &val,
+                   &err) == 8 &&
+            !strcmp(m, method) && !strcmp(surf, "S1") && s0 > smin && n < cap)
+            v[n++] = val;
+    fclose(f);
+    return n;
+}
+
+/* pp at n > 1 with a step reads, at every point, its own column's Fresnel slab solution at its
+ * own albedo node (Eq. 13-14, Sec. 3.3), downward and S2-reflected beams alike. At normal
+ * incidence the beam stays in its column, so far from the step (step_x = -15 in a tube of
+ * W = 40, H = 3) the marched radiance differs from that of the uniform right medium only by the
+ * viewing rays that reach the step: inside, a ray leaving S1 is within asin(1/n) = 45.6 deg of
+ * the normal (Snell), so from s > 10 it needs a path of at least 25 / sin(45.6 deg) = 35 mfp of
+ * sigma_t 0.5 to get there, a weight below e^{-17.5} = 2.5e-8 (its reflections only lengthen
+ * the way); the right column's tables are built exactly as the uniform run's (same sigma_t, tau
+ * grid and albedo, to an ulp of the node). So every S1 bin there must equal the uniform run's to
+ * 1e-6 relative (the sources' ratio between the sides is below 10; measured: 0, to the CSV's
+ * ten digits). The density case, sigma_t 1 -> 0.5 against uniform 0.5; the albedo case, 0.475 ->
+ * 0.95 (the upper node) against uniform 0.95. The kernel from before this test (column 0 for
+ * every piece, the S2-reflected beam at albedo node 0) misses by 7.7e-2 and 5.3e-5. */
+static void test_pp_step_columns(void **state)
+{
+    (void)state;
+    const char *step[2] = {"sigma_t = 1\nalbedo = 0.95\nstep = density\nstep_x = -15\n"
+                           "sigma_t_right = 0.5\n",
+                           "sigma_t = 1\nalbedo = 0.475\nstep = albedo\nstep_x = -15\n"
+                           "albedo_right = 0.95\n"};
+    const char *unif[2] = {"sigma_t = 0.5\nalbedo = 0.95\n", "sigma_t = 1\nalbedo = 0.95\n"};
+    for (int c = 0; c < 2; c++) {
+        static double v[2][4096];
+        int nv[2];
+        for (int u = 0; u < 2; u++) {
+            char name[64];
+            snprintf(name, sizeof name, "fresnel_pp_step%d_%d", c, u);
+            const char *dir = tu_scratch(name);
+            char ini[1400], csv[1300], text[2400];
+            snprintf(ini, sizeof ini, "%s/a.ini", dir);
+            snprintf(text, sizeof text,
+                     "[experiment]\nname = %s\ngeometry = tube\nmethods = pp\n[tube]\n"
+                     "width = 40\nheight = 3\nsegments_top = 16\nsegments_side = 2\n[medium]\n"
+                     "g = 0\nn = 1.4\n%s[light]\ntheta_deg = 0\n[output]\ndir = %s/out\n",
+                     name, u ? unif[c] : step[c], dir);
+            tu_write_file(ini, text);
+            assert_int_equal(tu_sh("%s run %s > %s/log 2>&1", tu_bin(), ini, dir), 0);
+            snprintf(csv, sizeof csv, "%s/out/radiance.csv", dir);
+            nv[u] = read_s1_beyond(csv, "pp", 10.0, v[u], 4096);
+        }
+        assert_int_equal(nv[0], nv[1]);
+        assert_true(nv[0] >= 64);
+        double worst = 0;
+        for (int k = 0; k < nv[0]; k++) {
+            assert_true(isfinite(v[0][k]) && v[1][k] > 0);
+            worst = fmax(worst, fabs(v[0][k] - v[1][k]) / v[1][k]);
+        }
+        printf("# pp step %d at n = 1.4: S1 beyond s = 10, %d bins, largest relative difference "
+               "from the uniform right medium %.2e\n",
+               c, nv[0], worst);
+        assert_lt(worst, 1e-6);
+    }
+}
+
 /* At n > 1 a photon's path still depends only on the seed and its index: the same tallies
  * whatever the work-group size, the chunking or the split into shards (the reflect-or-leave
  * choice comes from the photon's own Philox stream). The tube, oblique light and a density
@@ -499,7 +595,7 @@ static void test_bit_identical_n(void **state)
 
 /* Methods without refractive boundaries yet are refused at n > 1 (exit 2, before any work, by
  * the method's check hook in the registry), not run as if n were 1; mc, ppslab, ss and pp
- * are accepted. */
+ * are accepted, with steps too. */
 static void test_config_refuses_other_methods(void **state)
 {
     (void)state;
@@ -508,13 +604,13 @@ static void test_config_refuses_other_methods(void **state)
     snprintf(path, sizeof path, "%s/a.ini", dir);
     const char *texts[3] = {
         "[experiment]\ngeometry = slab\nmethods = mc, ppslab, ss, pp\n[medium]\nn = 1.4\n",
-        /* pp marches one column slab at one albedo node: a step that needs two is refused */
+        /* pp's columns and albedo nodes at n > 1 (test_pp_step_columns) */
         "[experiment]\ngeometry = tube\nmethods = mc, pp\n[medium]\nn = 1.4\nstep = albedo\n"
         "albedo_right = 0.5\n",
-        /* ss's mirror images assume one sigma_t: oblique light with a density step is refused */
-        "[experiment]\ngeometry = tube\nmethods = ss\n[medium]\nn = 1.4\nstep = density\n"
+        /* ss's mirror images through a density step (test_ss_vs_mc1_steps) */
+        "[experiment]\ngeometry = tube\nmethods = ss, pp\n[medium]\nn = 1.4\nstep = density\n"
         "sigma_t_right = 2\n[light]\ntheta_deg = 30\n"};
-    const char *refused[3] = {NULL, "method pp", "method ss"};
+    const char *refused[3] = {NULL, NULL, NULL};
     for (int i = 0; i < 3; i++) {
         FILE *f = fopen(path, "w");
         assert_non_null(f);
@@ -542,6 +638,8 @@ int main(void)
         cmocka_unit_test(test_ss_vs_mc1_slab),
         cmocka_unit_test(test_ss_vs_mc1_tube),
         cmocka_unit_test(test_pp_vs_ppslab),
+        cmocka_unit_test(test_ss_vs_mc1_steps),
+        cmocka_unit_test(test_pp_step_columns),
         cmocka_unit_test(test_config_refuses_other_methods),
         cmocka_unit_test(test_bit_identical_n),
         cmocka_unit_test(test_mc_vs_adding_doubling),

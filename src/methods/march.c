@@ -248,8 +248,10 @@ static double fresnel_unscattered(const ppb_scene *sc, double x_entry, void *arg
 }
 
 /* The tube at oblique incidence: the beam from x_e followed through its reflections off all four
- * faces (one sigma_t: ss refuses a density step there), adding at each face the part that
- * leaves, (1 - F) of what arrives, until what is left is below 1e-16. */
+ * faces, adding at each face the part that leaves, (1 - F) of what arrives, until what is left
+ * is below 1e-16. With a density step a leg's optical depth counts its part at x >= step_x with
+ * sigma_t_right: a straight leg's x is monotone, so that part is the overlap of its x range with
+ * [step_x, W/2], over |dx|. */
 static double fresnel_walk(const ppb_scene *sc, const ppb_fresnel_beam *b, double x_e)
 {
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
@@ -258,8 +260,13 @@ static double fresnel_walk(const ppb_scene *sc, const ppb_fresnel_beam *b, doubl
         double ly = dy > 0.0 ? -y / dy : (-H - y) / dy;
         double lx = dx > 0.0 ? (0.5 * W - x) / dx : (-0.5 * W - x) / dx;
         double l = fmin(lx, ly), f = lx < ly ? fs : b->f_inside;
-        tau += sc->sigma_t * l;
-        x += l * dx, y += l * dy;
+        double x1 = x + l * dx;
+        if (sc->step == PPB_STEP_DENSITY && sc->sigma_t_right != sc->sigma_t) {
+            double right = fmax(0.0, fmax(x, x1) - fmax(sc->step_x, fmin(x, x1)));
+            tau += sc->sigma_t * l + (sc->sigma_t_right - sc->sigma_t) * right / fabs(dx);
+        } else
+            tau += sc->sigma_t * l;
+        x = x1, y += l * dy;
         out += w * (1.0 - f) * exp(-tau);
         w *= f;
         if (lx < ly)
