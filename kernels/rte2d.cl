@@ -46,6 +46,52 @@ inline double rte_w1(double x, double a)
     return a / x - 1.0 + a;
 }
 
+/* n > 1, the tube at oblique incidence: the refracted beam meets the side walls too. As
+ * march.cl's ppb_piece_images: unfolded by the cross-section's mirror images (tile (k, j), k
+ * along x, j in depth, mirrored when odd), the beam reaching q through image (k, j) has weight
+ * F_b^j F_s^k, optical depth sigma_t depth' / cos theta_t, entry point x' - depth' tan theta_t
+ * on S1's lit part, and direction (+-sin, -+cos): cb = the phase coefficients of (+sin, down),
+ * (+sin, up), (-sin, down), (-sin, up). Each image's lit part of the piece [la, lb] is one
+ * interval, integrated in closed form. Uniform sigma_t only (rte2d's check). Returns the sum
+ * before the albedo; d0 is the optical distance at la. */
+inline double rte_beam_images(const ppb_rte_params *P, const double *cb, double px, double py,
+                              double mx, double my, double la, double lb, double sigma_t, double d0)
+{
+    double W = P->width, H = P->height, ct = P->cos_theta_l, tn = P->tan_theta_l;
+    double lo = -0.5 * W, hi = P->step_kind == PPB_STEP_SHADOW ? fmin(0.5 * W, P->step_x) : 0.5 * W;
+    if (!(hi > lo))
+        return 0.0;
+    int jmax = (int)ceil((P->d_cap - d0) * ct / (sigma_t * H));
+    double sum = 0.0, fj = 1.0;
+    for (int j = 0; j <= jmax; j++, fj *= P->beam_fb) {
+        int jodd = j & 1;
+        double dp0 = jodd ? (j + 1) * H + py : j * H - py, dpl = jodd ? my : -my;
+        int kmin = max(0, (int)ceil((j * H * tn - W) / W));
+        int kmax = (int)floor(1.0 + (j + 1) * H * tn / W);
+        double fk = pown(P->beam_fs, kmin);
+        for (int k = kmin; k <= kmax; k++, fk *= P->beam_fs) {
+            int kodd = k & 1;
+            double xe0 = k * W + (kodd ? -px : px) - dp0 * tn, xel = (kodd ? -mx : mx) - dpl * tn;
+            double l1 = la, l2 = lb;
+            if (xel == 0.0) {
+                if (xe0 < lo || xe0 >= hi)
+                    continue;
+            } else {
+                double a = (lo - xe0) / xel, b = (hi - xe0) / xel;
+                l1 = fmax(l1, fmin(a, b));
+                l2 = fmin(l2, fmax(a, b));
+            }
+            if (!(l2 > l1))
+                continue;
+            double C = P->beam_in * fj * fk * cb[2 * kodd + jodd];
+            double D1 = sigma_t * (dp0 + l1 * dpl) / ct, D2 = sigma_t * (dp0 + l2 * dpl) / ct;
+            double e_a = -(d0 + sigma_t * (l1 - la) + D1), z = -(sigma_t * (l2 - l1) + D2 - D1);
+            sum += C * sigma_t * (l2 - l1) * rte_beam_factor(e_a, z);
+        }
+    }
+    return sum;
+}
+
 /* n > 1: the radiance entering at the wall the ray from (px, py) along (mx, my) reaches after
  * length lfar and optical depth d, reflected: e^{-d} F I(mirror, q), I the field rad of the
  * direction mirrored in that face at the wall point q (bilinear), F the cell-averaged
@@ -71,10 +117,11 @@ inline double rte_wall(const ppb_rte_params *P, __global const double *rad,
 /* Radiance leaving (px, py) in direction w = (wx, wy, .) (3-D unit vector; the march advances
  * (-wx, -wy) in the plane per unit length): grid source from plane (if P->diffuse) plus the beam
  * term with coefficient C (if P->beam). */
-inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane, double C,
-                           double Cup, __global const double *rad, __global const double *bnd,
-                           int exact, double px, double py, double wx, double wy)
+inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane, const double *cb,
+                           __global const double *rad, __global const double *bnd, int exact,
+                           double px, double py, double wx, double wy)
 {
+    double C = cb[0];
     double mx = -wx, my = -wy;
     /* A direction in a wall's plane must run along it: the cells centred at phi = pi/2 have
      * wx = cos(pi/2) ~ 6e-17, not 0, and that sign made lfar = 0 at the nodes of S3 alone, so
@@ -137,7 +184,9 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
                            ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
                            : P->albedo;
         double sum = 0.0;
-        if (P->beam && C != 0.0) {
+        if (P->beam && P->n > 1.0 && P->tube && P->tan_theta_l > 0.0) {
+            sum += rte_beam_images(P, cb, px, py, mx, my, la, lb, sigma_t, d);
+        } else if (P->beam && C != 0.0) {
             double Dm, Da, Db;
             int lit, la_lit, lb_lit;
             ppb_rte_light(P, xm, ym, &Dm, &lit);
@@ -162,7 +211,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
                     double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
                     sum += e * C * sigma_t * len *
                            rte_beam_factor(-(d + Da), -(sigma_t * len + Db - Da));
-                    sum += e * P->beam_fb * Cup * sigma_t * len *
+                    sum += e * P->beam_fb * cb[1] * sigma_t * len *
                            rte_beam_factor(-(d + 2.0 * db - Da), -(sigma_t * len - Db + Da));
                 } else
                     sum +=
@@ -199,16 +248,16 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
  * wx = 0) would see one side's medium and light along its whole length, whichever the rounding
  * chose: it takes the mean of the two sides, as the node's bilinear hat straddles both. (Taking
  * the right side alone moved R_x0, at the step, by 0.1-0.2 % in albedo_step and shadow_step.) */
-inline double rte_ray(const ppb_rte_params *P, __global const double *plane, double C, double Cup,
+inline double rte_ray(const ppb_rte_params *P, __global const double *plane, const double *cb,
                       __global const double *rad, __global const double *bnd, int exact, double px,
                       double py, double wx, double wy)
 {
     if (P->tube && P->step_kind != PPB_STEP_NONE && px == P->step_x && fabs(wx) < 1e-12) {
         double e = 1e-9 * P->width;
-        return 0.5 * (rte_ray_side(P, plane, C, Cup, rad, bnd, exact, px - e, py, wx, wy) +
-                      rte_ray_side(P, plane, C, Cup, rad, bnd, exact, px + e, py, wx, wy));
+        return 0.5 * (rte_ray_side(P, plane, cb, rad, bnd, exact, px - e, py, wx, wy) +
+                      rte_ray_side(P, plane, cb, rad, bnd, exact, px + e, py, wx, wy));
     }
-    return rte_ray_side(P, plane, C, Cup, rad, bnd, exact, px, py, wx, wy);
+    return rte_ray_side(P, plane, cb, rad, bnd, exact, px, py, wx, wy);
 }
 
 /* One work-item per (direction cell, node): the cell's radiance at the node. */
@@ -224,9 +273,11 @@ __kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
     int i = node % P.nx, j = node / P.nx;
     double px = ppb_rte_node_x(&P, i), py = ppb_rte_node_y(&P, j);
     __global const double *dc = dirs + 4 * cell;
-    __global const double *bc = bnd + 9 * (P.n > 1.0 ? cell : 0);
-    out[gid] = rte_ray(&P, src + (long)cell * nn, dc[3], P.n > 1.0 ? bc[8] : 0.0, rad, bc, 0, px,
-                       py, dc[0], dc[1]);
+    __global const double *bc = bnd + PPB_RTE_BND * (P.n > 1.0 ? cell : 0);
+    double cb[4] = {dc[3], 0.0, 0.0, 0.0};
+    if (P.n > 1.0)
+        cb[1] = bc[8], cb[2] = bc[9], cb[3] = bc[10];
+    out[gid] = rte_ray(&P, src + (long)cell * nn, cb, rad, bc, 0, px, py, dc[0], dc[1]);
 }
 
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
@@ -259,14 +310,18 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                     double v[3] = {wx, wy, wz};
                     double ca = ppb_inside_dir(surf, P.n, v);
                     double wt = (1.0 - ppb_fresnel(ca, P.n)) / (P.n * P.n);
-                    double C = ppb_hg_phase(P.g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l);
-                    double Cu = ppb_hg_phase(P.g, v[0] * P.sin_theta_l + v[1] * P.cos_theta_l);
-                    sum += wt * rte_ray(&P, src + (long)dir * nn, C, Cu, rad, bnd + 4 * dir, 1, px,
-                                        py, v[0], v[1]);
+                    double st = P.sin_theta_l, ct = P.cos_theta_l;
+                    double cb[4] = {ppb_hg_phase(P.g, v[0] * st - v[1] * ct),
+                                    ppb_hg_phase(P.g, v[0] * st + v[1] * ct),
+                                    ppb_hg_phase(P.g, -v[0] * st - v[1] * ct),
+                                    ppb_hg_phase(P.g, -v[0] * st + v[1] * ct)};
+                    sum += wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, 1, px, py,
+                                        v[0], v[1]);
                     continue;
                 }
-                double C = ppb_hg_phase(P.g, wx * P.sin_theta_l - wy * P.cos_theta_l);
-                sum += rte_ray(&P, src + (long)dir * nn, C, 0.0, rad, bnd, 0, px, py, wx, wy);
+                double cb[4] = {ppb_hg_phase(P.g, wx * P.sin_theta_l - wy * P.cos_theta_l), 0.0,
+                                0.0, 0.0};
+                sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, 0, px, py, wx, wy);
             }
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);

@@ -41,11 +41,15 @@ enum {
                                exit direction sample) */
     PPB_RTE_ARG_OUT = 3,    /* sweep: I [ncell][nnodes]; exit: radiance [rows][nbins] */
     PPB_RTE_ARG_RAD = 4,    /* n > 1: the field I [ncell][nnodes] the walls reflect */
-    PPB_RTE_ARG_BND = 5,    /* n > 1, sweep: [ncell][9] = slot of the cell's mirror at S1..S4,
-                               its cell-averaged F there, the upward beam's coefficient; exit:
-                               [ndir][4] = slot of the sample's mirror at S1..S4 */
+    PPB_RTE_ARG_BND = 5,    /* n > 1, sweep: [ncell][PPB_RTE_BND] = slot of the cell's mirror
+                               at S1..S4, its cell-averaged F there, the beam coefficients of
+                               (+sin, up), (-sin, down), (-sin, up) (dirs has (+sin, down));
+                               exit: [ndir][4] = slot of the sample's mirror at S1..S4 */
     PPB_RTE_NARGS = 6
 };
+
+/* Doubles per transported cell in the sweep's PPB_RTE_ARG_BND buffer. */
+#define PPB_RTE_BND 11
 
 /* Parameters of one launch. All doubles first, then an even number of ints (host asserts). */
 typedef struct ppb_rte_params {
@@ -60,6 +64,7 @@ typedef struct ppb_rte_params {
     double n;       /* refractive index (reference: Medium); the light fields above are inside */
     double beam_in; /* n > 1: perpendicular irradiance of the refracted beam (ppb_fresnel.h) */
     double beam_fb; /* n > 1: F the beam meets at S2 and S1 from inside */
+    double beam_fs; /* n > 1: F the beam meets at S3 and S4 from inside (oblique light) */
     int tube, step_kind;
     int nx, ny, nl; /* nodes in x (nl cells left of the split) and y */
     int ncell;      /* sweep: direction cells marched */

@@ -19,7 +19,7 @@
 #include "physics/gmres.h"
 #include "physics/rte2d_grid.h"
 
-_Static_assert(sizeof(ppb_rte_params) == 21 * sizeof(double) + 24 * sizeof(int),
+_Static_assert(sizeof(ppb_rte_params) == 22 * sizeof(double) + 24 * sizeof(int),
                "ppb_rte_params: doubles first, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
@@ -171,8 +171,8 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_
     if (s->out && s->G.bnd) {
         s->radb = buffer(ocl, CL_MEM_READ_ONLY, s->nvec, NULL, "rte2d field", err);
         if (s->radb)
-            s->bnd =
-                buffer(ocl, CL_MEM_READ_ONLY, 9 * (size_t)s->G.nc, s->G.bnd, "rte2d walls", err);
+            s->bnd = buffer(ocl, CL_MEM_READ_ONLY, PPB_RTE_BND * (size_t)s->G.nc, s->G.bnd,
+                            "rte2d walls", err);
         return s->bnd ? 0 : -1;
     }
     return s->out ? 0 : -1;
@@ -521,13 +521,14 @@ int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     return rte2d_solve(ctx, out, NULL, 1, err);
 }
 
-/* n > 1 (reference: Medium): the slab, and the tube at normal incidence, where the refracted
- * beam bounces between S2 and S1 in its column; oblique light in the tube would meet the side
- * walls too (ss's mirror images), which the beam term here does not follow yet. */
+/* n > 1 (reference: Medium): oblique light in the tube follows the beam through the
+ * cross-section's mirror images (kernels/rte2d.cl, as ss), which assume one sigma_t: a density
+ * step there is refused, as ss refuses it. */
 int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
-    if (sc->n > 1.0 && sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0)
+    if (sc->n > 1.0 && sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0 &&
+        sc->step == PPB_STEP_DENSITY && sc->sigma_t_right != sc->sigma_t)
         return ppb_method_refuse_refractive(cfg, "rte2d", err);
     return 0;
 }

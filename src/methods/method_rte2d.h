@@ -11,10 +11,11 @@
  * `pp` averages its bins. So K = 1 is the paper's method (one march from I_pp) on the grid.
  * Totals: R, T, sides from the bins (march.h), ballistic exact, and absorbed tracked: the beam's
  * exact and sigma_a times the converged scattered fluence.
- * n > 1 (reference: Medium; the slab and the tube at normal incidence): I_1 is the refracted
- * beam's with its S2 -> S1 round trips, T includes the walls' reflection (a march reaching a
- * face adds F times the mirror cell's radiance there, so GMRES iterates it with the
- * scattering), and the exit march maps each air-side sample inside by Snell, (1 - F) / n^2. */
+ * n > 1 (reference: Medium): I_1 is the refracted beam's with its S2 -> S1 round trips (in
+ * the oblique tube, off all four faces by the mirror images, as ss), T includes the walls'
+ * reflection (a march reaching a face adds F times the mirror cell's radiance there, so GMRES
+ * iterates it with the scattering), and the exit march maps each air-side sample inside by Snell,
+ * (1 - F) / n^2. */
 #ifndef PPB_METHOD_RTE2D_H
 #define PPB_METHOD_RTE2D_H
 

@@ -103,21 +103,24 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
     (void)Fl;
     const ppb_rte_params *P = &G->P;
     int m = 2 * G->dirs.n;
-    double *Fu = malloc(sizeof(double) * m);
-    G->bnd = malloc(sizeof(double) * 9 * G->nc);
+    double *Fu = malloc(sizeof(double) * 3 * m);
+    G->bnd = malloc(sizeof(double) * PPB_RTE_BND * G->nc);
     if (!Fu || !G->bnd) {
         free(Fu);
         return ppb_fail(err, "rte2d: out of memory (walls)");
     }
-    double wu[3] = {P->sin_theta_l, P->cos_theta_l, 0.0};
-    if (pp_phase_row(&G->dirs, sc->g, wu, Fu, err)) {
-        free(Fu);
-        return -1;
-    }
+    /* The beam's other directions: (+sin, up), (-sin, down), (-sin, up). */
+    double s = P->sin_theta_l, c = P->cos_theta_l;
+    double wu[3][3] = {{s, c, 0.0}, {-s, -c, 0.0}, {-s, c, 0.0}};
+    for (int k = 0; k < 3; k++)
+        if (pp_phase_row(&G->dirs, sc->g, wu[k], Fu + (size_t)k * m, err)) {
+            free(Fu);
+            return -1;
+        }
     const int q = 8;
     for (int a = 0; a < G->nc; a++) {
         int i = G->rep[a];
-        double *b = G->bnd + 9 * a;
+        double *b = G->bnd + PPB_RTE_BND * a;
         const double *c = G->dirs.centre + 3 * i;
         double my[3] = {c[0], -c[1], c[2]}, mx[3] = {-c[0], c[1], c[2]};
         b[PPB_S1] = b[PPB_S2] = G->slot[pp_dirs_cell_of(&G->dirs, my)];
@@ -138,7 +141,8 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
             den += w;
         }
         b[4 + PPB_S3] = b[4 + PPB_S4] = den > 0.0 ? num / den : 1.0;
-        b[8] = Fu[i] / G->dirs.solid;
+        for (int k = 0; k < 3; k++)
+            b[8 + k] = Fu[(size_t)k * m + i] / G->dirs.solid;
     }
     free(Fu);
     return 0;
@@ -188,6 +192,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
         P->tan_theta_l = b.sin_t / b.cos_t;
         P->beam_in = b.irradiance;
         P->beam_fb = b.f_inside;
+        P->beam_fs = ppb_fresnel(b.sin_t, 1.0 / sc->n);
         P->refl = 1;
     }
     (void)th;
@@ -383,8 +388,8 @@ void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *rad, double flux
         const double *row = rad + (size_t)a * nn;
         double w = G->mult[a] * G->dirs.solid, ky = G->dirs.k[G->rep[a]], kx = G->dir4[4 * a];
         /* n > 1: what leaves is 1 - F of what reaches the face (rte2d_grid.h). */
-        double ty = G->bnd ? 1.0 - G->bnd[9 * a + 4 + PPB_S1] : 1.0;
-        double tx = G->bnd ? 1.0 - G->bnd[9 * a + 4 + PPB_S3] : 1.0;
+        double ty = G->bnd ? 1.0 - G->bnd[PPB_RTE_BND * a + 4 + PPB_S1] : 1.0;
+        double tx = G->bnd ? 1.0 - G->bnd[PPB_RTE_BND * a + 4 + PPB_S3] : 1.0;
         for (int i = 0; i < P->nx; i++) {
             double wx = P->nx == 1 ? 1.0 : G->wnode[i] / row_wy(P, 0);
             if (ky > 0.0)
@@ -472,6 +477,42 @@ static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
     return (1.0 - al) * (1.0 - e) / (1.0 - fc[0] * e);
 }
 
+/* n > 1, the tube at oblique incidence (one sigma_t): the refracted beam from x_e followed
+ * through its reflections off all four faces (as march.c's ballistic walk), adding on each leg
+ * (1 - alpha) of what it loses, the leg split at an albedo step, until what is left is below
+ * 1e-16; per unit power entering. */
+static double fresnel_walk_absorbed(const ppb_scene *sc, const ppb_fresnel_beam *b, double x_e)
+{
+    double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
+    double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, out = 0.0;
+    for (int hit = 0; hit < 100000 && w > 1e-16; hit++) {
+        double ly = dy > 0.0 ? -y / dy : (-H - y) / dy;
+        double lx = dx > 0.0 ? (0.5 * W - x) / dx : (-0.5 * W - x) / dx;
+        double l = fmin(lx, ly), f = lx < ly ? fs : b->f_inside;
+        double cut[3] = {0.0, l, l};
+        int nc = 2;
+        if (sc->step == PPB_STEP_ALBEDO && dx != 0.0) {
+            double ls = (sc->step_x - x) / dx;
+            if (ls > 0.0 && ls < l)
+                cut[1] = ls, nc = 3;
+        }
+        for (int k = 0; k + 1 < nc; k++) {
+            double xm = x + 0.5 * (cut[k] + cut[k + 1]) * dx;
+            double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+            double lost = -expm1(-sc->sigma_t * (cut[k + 1] - cut[k]));
+            out += w * (1.0 - al) * lost;
+            w *= 1.0 - lost;
+        }
+        w *= f;
+        x += l * dx, y += l * dy;
+        if (lx < ly)
+            dx = -dx, x = dx < 0.0 ? 0.5 * W : -0.5 * W;
+        else
+            dy = -dy, y = dy > 0.0 ? -H : 0.0;
+    }
+    return out;
+}
+
 double ppb_rte_absorbed_beam(const ppb_scene *sc)
 {
     double c = ppb_scene_cos_theta_l(sc);
@@ -480,6 +521,19 @@ double ppb_rte_absorbed_beam(const ppb_scene *sc)
         double fc[2] = {b.f_inside, b.cos_t}, width;
         if (sc->geometry == PPB_GEOM_SLAB)
             return c * (1.0 - b.specular) * fresnel_path_absorbed(sc, 0.0, fc);
+        if (sc->theta_deg != 0.0) {
+            /* Midpoints over the lit part of S1 (2e4, as march.c's ballistic). */
+            double a = -0.5 * sc->width, hi = 0.5 * sc->width;
+            if (sc->step == PPB_STEP_SHADOW)
+                hi = fmin(hi, sc->step_x);
+            if (!(hi > a))
+                return 0.0;
+            const int np = 20000;
+            double sum = 0.0;
+            for (int i = 0; i < np; i++)
+                sum += fresnel_walk_absorbed(sc, &b, a + (i + 0.5) * (hi - a) / np);
+            return c * (1.0 - b.specular) * sum * (hi - a) / np;
+        }
         return c * (1.0 - b.specular) * ppb_lit_integral(sc, fresnel_path_absorbed, fc, &width);
     }
     if (sc->geometry == PPB_GEOM_SLAB)
