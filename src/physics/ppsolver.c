@@ -185,31 +185,37 @@ static double air_cos(double mu, double nrel)
     return sqrt(fmax(0.0, 1.0 - nrel * nrel * (1.0 - mu * mu)));
 }
 
-/* R_i = int F mu dmu / int mu dmu over the cell's mu range: F = 1 below the critical cosine
+/* R = int F mu dmu / int mu dmu over [lo, hi] (ppsolver.h): F = 1 below the critical cosine
  * mu_c = sqrt(1 - 1/n^2); above it the substitution t = air-side cosine (mu dmu = t dt / n^2)
  * makes the integrand smooth (F(mu) = ppb_fresnel(t, n) by reciprocity), so Gauss-Legendre of
  * order FRESNEL_GAUSS is exact to rounding for practical purposes. */
+double pp_fresnel_ring_mean(double lo, double hi, double nr)
+{
+    double mu_c = sqrt(1.0 - 1.0 / (nr * nr)), x[FRESNEL_GAUSS], wq[FRESNEL_GAUSS];
+    ppb_gauss_legendre(FRESNEL_GAUSS, x, wq);
+    double num = 0.0, den = 0.5 * (hi * hi - lo * lo);
+    if (lo < mu_c) {
+        double top = fmin(hi, mu_c);
+        num += 0.5 * (top * top - lo * lo);
+    }
+    double a = fmax(lo, mu_c);
+    if (hi > a) {
+        double ta = air_cos(a, nr), tb = air_cos(hi, nr), half = 0.5 * (tb - ta);
+        for (int j = 0; j < FRESNEL_GAUSS; j++) {
+            double t = ta + half * (1.0 + x[j]);
+            num += half * wq[j] * ppb_fresnel(t, nr) * t / (nr * nr);
+        }
+    }
+    return fmin(1.0, num / den);
+}
+
+/* R_i of every direction cell: the mean over its mu range (the cells are mu rings x phi). */
 static void cell_reflectance(pp_solution *s)
 {
-    double nr = s->nrel, mu_c = sqrt(1.0 - 1.0 / (nr * nr)), x[FRESNEL_GAUSS], wq[FRESNEL_GAUSS];
-    ppb_gauss_legendre(FRESNEL_GAUSS, x, wq);
     for (int i = 0; i < s->n; i++) {
         double lo, hi, plo, phi;
         pp_dirs_bounds(&s->dirs, i, &lo, &hi, &plo, &phi);
-        double num = 0.0, den = 0.5 * (hi * hi - lo * lo);
-        if (lo < mu_c) {
-            double top = fmin(hi, mu_c);
-            num += 0.5 * (top * top - lo * lo);
-        }
-        double a = fmax(lo, mu_c);
-        if (hi > a) {
-            double ta = air_cos(a, nr), tb = air_cos(hi, nr), half = 0.5 * (tb - ta);
-            for (int j = 0; j < FRESNEL_GAUSS; j++) {
-                double t = ta + half * (1.0 + x[j]);
-                num += half * wq[j] * ppb_fresnel(t, nr) * t / (nr * nr);
-            }
-        }
-        s->Rc[i] = fmin(1.0, num / den);
+        s->Rc[i] = pp_fresnel_ring_mean(lo, hi, s->nrel);
     }
 }
 

@@ -89,6 +89,11 @@ int pp_solve_fresnel(const pp_params *p, double n, const pp_solution *share, pp_
                      pp_timing *t, ppb_err *err);
 void pp_free(pp_solution *s);
 
+/* The flux-weighted mean Fresnel reflectance, int F mu dmu / int mu dmu, of the inside cosines
+ * [lo, hi] (0 <= lo < hi <= 1) at index n: 1 under total internal reflection. The boundary
+ * condition of a direction cell at n > 1, here and in rte2d's walls (rte2d_grid.c). */
+double pp_fresnel_ring_mean(double lo, double hi, double n);
+
 /* mu0 as used inside (see the resonance note above; the refracted cosine at n > 1). */
 double pp_mu0(const pp_solution *s);
 

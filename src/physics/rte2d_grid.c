@@ -72,31 +72,6 @@ static double row_wy(const ppb_rte_params *P, int j)
     return 0.5 * ((j > 0 ? row_dy(P, j - 1) : 0.0) + (j < P->ny - 1 ? row_dy(P, j) : 0.0));
 }
 
-/* Flux-weighted mean of F over a cell's |mu| range [lo, hi] (ppsolver.c's cell_reflectance):
- * F = 1 below the critical cosine, above it in the air-side cosine t (mu dmu = t dt / n^2),
- * where the integrand is smooth, by Gauss-Legendre. */
-#define RTE_FRESNEL_GAUSS 16
-static double ring_reflectance(double lo, double hi, double n)
-{
-    double mu_c = sqrt(1.0 - 1.0 / (n * n)), x[RTE_FRESNEL_GAUSS], wq[RTE_FRESNEL_GAUSS];
-    ppb_gauss_legendre(RTE_FRESNEL_GAUSS, x, wq);
-    double num = 0.0, den = 0.5 * (hi * hi - lo * lo);
-    if (lo < mu_c) {
-        double top = fmin(hi, mu_c);
-        num += 0.5 * (top * top - lo * lo);
-    }
-    double a = fmax(lo, mu_c);
-    if (hi > a) {
-        double ta = sqrt(fmax(0.0, 1.0 - n * n * (1.0 - a * a)));
-        double tb = sqrt(fmax(0.0, 1.0 - n * n * (1.0 - hi * hi))), half = 0.5 * (tb - ta);
-        for (int j = 0; j < RTE_FRESNEL_GAUSS; j++) {
-            double t = ta + half * (1.0 + x[j]);
-            num += half * wq[j] * ppb_fresnel(t, n) * t / (n * n);
-        }
-    }
-    return fmin(1.0, num / den);
-}
-
 /* The walls at n > 1 (rte2d_grid.h): G->bnd. Fl is the row of p(w . w_L) cell integrals. */
 static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, ppb_err *err)
 {
@@ -128,7 +103,7 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
         double lo, hi, plo, phi;
         pp_dirs_bounds(&G->dirs, i, &lo, &hi, &plo, &phi);
         double alo = fmin(fabs(lo), fabs(hi)), ahi = fmax(fabs(lo), fabs(hi));
-        b[4 + PPB_S1] = b[4 + PPB_S2] = ring_reflectance(alo, ahi, sc->n);
+        b[4 + PPB_S1] = b[4 + PPB_S2] = pp_fresnel_ring_mean(alo, ahi, sc->n);
         const double *nd = pp_dirs_nodes(&G->dirs, i, q, err);
         if (!nd) {
             free(Fu);
