@@ -330,7 +330,7 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     if (ppb_images_write(dir, &ex->cfg->scene, &meta, ex->res, ex->n,
                          ref ? (int)(ref - ex->res) : -1, err))
         return -1;
-    return ppb_plots_write(dir, err); /* last: the figures read the files above */
+    return ppb_plots_write(dir, ex->cfg->name, err); /* last: the figures read the files above */
 }
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)

@@ -26,7 +26,7 @@ const char *ppb_plots_script_dir(void)
  * outside. S3_all is drawn wide, as S4_all (the same at normal incidence) lies on it. */
 #define REF_CELLS 6
 #define REF_ROWS  64
-static int draw_refinements(const char *dir, ppb_err *err)
+static int draw_refinements(const char *dir, const char *name, ppb_err *err)
 {
     static const char *const cells[REF_CELLS] = {"R_x0",   "T_x0",   "S1_all",
                                                  "S2_all", "S3_all", "S4_all"};
@@ -77,14 +77,16 @@ static int draw_refinements(const char *dir, ppb_err *err)
                 fprintf(gp, "%d %.6g\n", K[c][i], 100.0 * v[c][i]);
             fprintf(gp, "EOD\n");
         }
-        fprintf(gp, "set logscale xy\nset grid\nset xrange [0.8:*]\n"
-                    "set key outside right top vertical title 'cell'\n"
-                    "set title 'rte2d: exit radiance after K refinements of Eq. 5 from I_pp, RMS "
-                    "against the converged solve'\n"
-                    "set xlabel 'refinements K'\nset ylabel 'RMS (%%)'\n"
-                    "set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 "
-                    "lc rgb '#444444'\n"
-                    "plot keyentry with lines dt 2 lc rgb '#444444' title '1 %%'");
+        fprintf(gp,
+                "set logscale xy\nset grid\nset xrange [0.8:*]\n"
+                "set key outside right top vertical title 'cell'\n"
+                "set title '%s: rte2d exit radiance after K refinements of Eq. 5 from I_pp, "
+                "RMS against the converged solve'\n"
+                "set xlabel 'refinements K'\nset ylabel 'RMS (%%)'\n"
+                "set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 "
+                "lc rgb '#444444'\n"
+                "plot keyentry with lines dt 2 lc rgb '#444444' title '1 %%'",
+                name); /* config names are [A-Za-z0-9_.+-] */
         for (int c = 0; c < REF_CELLS; c++)
             if (n[c])
                 fprintf(gp, ", $c%d using 1:2 with linespoints lw %g pt %d lc rgb '%s' title '%s'",
@@ -100,7 +102,7 @@ static int draw_refinements(const char *dir, ppb_err *err)
     return 0;
 }
 
-int ppb_plots_write(const char *dir, ppb_err *err)
+int ppb_plots_write(const char *dir, const char *name, ppb_err *err)
 {
     char script[4096];
     snprintf(script, sizeof script, "%s/plots.sh", ppb_plots_script_dir());
@@ -124,5 +126,5 @@ int ppb_plots_write(const char *dir, ppb_err *err)
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
         return ppb_fail(err, "%s %s failed (exit %d; is gnuplot installed?)", script, dir,
                         WIFEXITED(status) ? WEXITSTATUS(status) : -1);
-    return draw_refinements(dir, err);
+    return draw_refinements(dir, name, err);
 }

@@ -13,8 +13,8 @@
 const char *ppb_plots_script_dir(void);
 
 /* Draws the figures of the output set in dir (already holding its CSVs, provenance.txt and
- * images); fails, naming the script, when it cannot be started or exits non-zero, and when
- * gnuplot fails on the refinements figure. */
-int ppb_plots_write(const char *dir, ppb_err *err);
+ * images) of the experiment called name (the figures' titles); fails, naming the script, when
+ * it cannot be started or exits non-zero, and when gnuplot fails on the refinements figure. */
+int ppb_plots_write(const char *dir, const char *name, ppb_err *err);
 
 #endif
