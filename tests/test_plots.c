@@ -6,65 +6,8 @@
  * its third key and a 1-D sweep gets a line plot. */
 #include "testutil.h"
 
-#include <stdarg.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
-
-/* A shell command built like printf; its exit code, -1 when it did not exit. */
-static int pl_sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int pl_sh(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-/* The binary under test: $PPBENCH (make sets it), else ./ppbench. */
-static const char *pl_bin(void)
-{
-    const char *b = getenv("PPBENCH");
-    return b ? b : "./ppbench";
-}
-
-/* A fresh absolute scratch directory under $TMPDIR for one test; a static buffer. */
-static const char *pl_scratch(const char *name)
-{
-    static char dir[1024];
-    char *base = realpath(getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", NULL);
-    snprintf(dir, sizeof dir, "%s/ppbench-%s-%d", base ? base : "/tmp", name, (int)getpid());
-    free(base);
-    if (pl_sh("rm -rf '%s' && mkdir -p '%s'", dir, dir) != 0)
-        fail_msg("cannot make %s", dir);
-    return dir;
-}
-
-static void pl_write(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    if (!f)
-        fail_msg("cannot write %s", path);
-    fputs(text, f);
-    fclose(f);
-}
-
-/* The first 64 KiB of a file ("" when it cannot be read); a static buffer. */
-static char *pl_read(const char *path)
-{
-    static char buf[1 << 16];
-    buf[0] = '\0';
-    FILE *f = fopen(path, "r");
-    if (f) {
-        size_t n = fread(buf, 1, sizeof buf - 1, f);
-        buf[n] = '\0';
-        fclose(f);
-    }
-    return buf;
-}
 
 static int exists(const char *dir, const char *name)
 {
@@ -99,15 +42,15 @@ static const char *small = "--quiet --set mc.photons=2e4 --set pp.directions=16 
 static void test_run_draws_every_figure(void **state)
 {
     (void)state;
-    const char *dir = pl_scratch("plots_run");
+    const char *dir = tu_scratch("plots_run");
     char out[1200], keep[1200], path[2048];
     snprintf(out, sizeof out, "%s/out", dir);
     snprintf(keep, sizeof keep, "%s/gp", dir);
-    assert_int_equal(pl_sh("mkdir -p '%s'", keep), 0);
+    assert_int_equal(tu_sh("mkdir -p '%s'", keep), 0);
     /* the density step: step_x = 0, sigma_t = 1, so the markers sit at 0 and +-2 */
-    assert_int_equal(pl_sh("PPB_PLOTS_KEEP='%s' %s run %s --set experiment.methods=mc,pp,mp "
+    assert_int_equal(tu_sh("PPB_PLOTS_KEEP='%s' %s run %s --set experiment.methods=mc,pp,mp "
                            "--out '%s' configs/density_step.ini",
-                           keep, pl_bin(), small, out),
+                           keep, tu_bin(), small, out),
                      0);
     const char *files[] = {"plots/rms_vs_x",  "plots/angular_x0", "plots/angular_x0_polar",
                            "images/all",      "images/error_pp",  "images/error_mp",
@@ -120,10 +63,10 @@ static void test_run_draws_every_figure(void **state)
         }
     assert_false(exists(out, "images/error_mc.png")); /* the reference has none */
     /* no staging left beside it: the plots were drawn before the set was put in place */
-    assert_int_equal(pl_sh("ls -d '%s'.tmp.* 2>/dev/null | grep -q .", out), 1);
+    assert_int_equal(tu_sh("ls -d '%s'.tmp.* 2>/dev/null | grep -q .", out), 1);
 
     snprintf(path, sizeof path, "%s/rms_vs_x.gp", keep);
-    char *gp = pl_read(path);
+    char *gp = tu_read_text(path);
     for (int s = 1; s <= 4; s++) {
         char t[16];
         snprintf(t, sizeof t, "'S%d (", s);
@@ -144,16 +87,16 @@ static void test_run_draws_every_figure(void **state)
     assert_string_equal(ra, rb);
 
     snprintf(path, sizeof path, "%s/angular_x0.gp", keep);
-    gp = pl_read(path);
+    gp = tu_read_text(path);
     assert_has(gp, "with yerrorbars");
     assert_has(gp, "red dotted line");
     if (strstr(gp, "arrow:"))
         fail_msg("a dotted line labelled as an arrow:\n%.2000s", gp);
     snprintf(path, sizeof path, "%s/angular_x0_polar.gp", keep);
-    assert_has(pl_read(path), "set polar");
+    assert_has(tu_read_text(path), "set polar");
 
     snprintf(path, sizeof path, "%s/all.gp", keep);
-    gp = pl_read(path);
+    gp = tu_read_text(path);
     const char *ids[] = {"mc", "mc1", "pp", "mp"};
     for (int i = 0; i < 4; i++) {
         char t[64];
@@ -161,7 +104,7 @@ static void test_run_draws_every_figure(void **state)
         assert_has(gp, t);
     }
     snprintf(path, sizeof path, "%s/error_pp.gp", keep);
-    gp = pl_read(path);
+    gp = tu_read_text(path);
     assert_has(gp, "pp vs mc");
     assert_has(gp, "'-50%%' -50, '-25%%' -25, '0' 0, '+25%%' 25, '+50%%' 50");
     snprintf(path, sizeof path, "%s/images/all.png", out);
@@ -175,12 +118,12 @@ static void test_run_draws_every_figure(void **state)
 static void test_without_mc(void **state)
 {
     (void)state;
-    const char *dir = pl_scratch("plots_nomc");
+    const char *dir = tu_scratch("plots_nomc");
     char out[1200];
     snprintf(out, sizeof out, "%s/out", dir);
-    assert_int_equal(pl_sh("%s run %s --set experiment.methods=pp,ss --out '%s' "
+    assert_int_equal(tu_sh("%s run %s --set experiment.methods=pp,ss --out '%s' "
                            "configs/uniform_g0_normal.ini",
-                           pl_bin(), small, out),
+                           tu_bin(), small, out),
                      0);
     assert_true(exists(out, "plots/angular_x0.png"));
     assert_true(exists(out, "plots/angular_x0_polar.pdf"));
@@ -201,7 +144,7 @@ static void write_sweep(const char *path, const char *lists, const char *out)
              "[experiment]\nname = s\ngeometry = slab\nmethods = mc, ss\n%s[mc]\nphotons = "
              "2e3\n[pp]\ndirections = 16\n[output]\ndir = %s\n",
              lists, out);
-    pl_write(path, text);
+    tu_write_file(path, text);
 }
 
 /* Three swept keys: a row of (R, T) panels per value of the third, so the PNG is 60 + 330 x 3
@@ -209,13 +152,13 @@ static void write_sweep(const char *path, const char *lists, const char *out)
 static void test_sweep_plots(void **state)
 {
     (void)state;
-    const char *dir = pl_scratch("plots_sweep");
+    const char *dir = tu_scratch("plots_sweep");
     char ini[1200], out[1200], path[2048];
     snprintf(ini, sizeof ini, "%s/s3.ini", dir);
     snprintf(out, sizeof out, "%s/s3", dir);
     write_sweep(ini, "[medium]\ng = 0, 0.5\nalbedo = 0.5, 0.9\n[light]\ntheta_deg = 0, 30, 60\n",
                 out);
-    assert_int_equal(pl_sh("%s sweep --quiet '%s' > /dev/null 2>&1", pl_bin(), ini), 0);
+    assert_int_equal(tu_sh("%s sweep --quiet '%s' > /dev/null 2>&1", tu_bin(), ini), 0);
     assert_true(exists(out, "heatmap_ss.png"));
     assert_true(exists(out, "heatmap_ss.pdf"));
     assert_false(exists(out, "heatmap_mc.png"));
@@ -227,7 +170,7 @@ static void test_sweep_plots(void **state)
     snprintf(ini, sizeof ini, "%s/s1.ini", dir);
     snprintf(out, sizeof out, "%s/s1", dir);
     write_sweep(ini, "[medium]\ng = 0, 0.5, 0.8\n", out);
-    assert_int_equal(pl_sh("%s sweep --quiet '%s' > /dev/null 2>&1", pl_bin(), ini), 0);
+    assert_int_equal(tu_sh("%s sweep --quiet '%s' > /dev/null 2>&1", tu_bin(), ini), 0);
     assert_true(exists(out, "sweep_rms.png"));
     assert_true(exists(out, "sweep_rms.pdf"));
     assert_false(exists(out, "heatmap_ss.png"));

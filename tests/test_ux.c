@@ -24,18 +24,6 @@
 #include "base/progress.h"
 #include "model/config.h"
 
-static int sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int sh(const char *fmt, ...)
-{
-    char cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
-    va_end(ap);
-    int st = system(cmd);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 static char *slurp(const char *path, size_t *len)
 {
     FILE *f = fopen(path, "rb");
@@ -105,11 +93,12 @@ static void test_config_ini_repeats_run(void **state)
     for (size_t i = 0; i < sizeof result_files / sizeof result_files[0]; i++) {
         /* config.ini names its output directory: the repeat's holds --out's, the rest is equal. */
         if (!strcmp(result_files[i], "config.ini"))
-            assert_int_equal(sh("grep -v '^dir = ' '%s/config.ini' > '%s.ini' && grep -v '^dir = ' "
-                                "'%s/config.ini' > '%s.ini' && cmp -s '%s.ini' '%s.ini'",
-                                a, a, b, b, a, b),
-                             0);
-        else if (sh("cmp -s '%s/%s' '%s/%s'", a, result_files[i], b, result_files[i]))
+            assert_int_equal(
+                tu_sh("grep -v '^dir = ' '%s/config.ini' > '%s.ini' && grep -v '^dir = ' "
+                      "'%s/config.ini' > '%s.ini' && cmp -s '%s.ini' '%s.ini'",
+                      a, a, b, b, a, b),
+                0);
+        else if (tu_sh("cmp -s '%s/%s' '%s/%s'", a, result_files[i], b, result_files[i]))
             fail_msg("%s differs between a run and its repeat from config.ini", result_files[i]);
     }
     char path[1400];
