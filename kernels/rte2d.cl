@@ -19,22 +19,17 @@
  *   x = sigma_t h, a = 1 - e^{-x}; exact for a source linear along the step whatever its
  *   optical length (directions close to z cross many mfp in a short planar distance). */
 #include "march_params.h"
+#include "ppb_beam_images.h"
 #include "ppb_fresnel.h"
 #include "rte2d_params.h"
 
-/* (e^z - 1) / z, stable at z = 0. */
-inline double rte_phi1(double z)
-{
-    return fabs(z) < 1e-300 ? 1.0 : expm1(z) / z;
-}
-
 /* exp(e_a) phi1(z) with e_b = e_a + z <= 0, in the scaled form where exp(e_a) underflows (as
- * march.cl's ppb_beam_step). */
+ * ppb_beam_step, ppb_beam_images.h, in another association). */
 inline double rte_beam_factor(double e_a, double z)
 {
     if (e_a < -700.0 && z > 0.0)
         return exp(e_a + z) * (-expm1(-z) / z);
-    return exp(e_a) * rte_phi1(z);
+    return exp(e_a) * ppb_phi1(z);
 }
 
 /* Weight of the slope term: (1 - e^{-x}) / x - e^{-x}, i.e. a / x - 1 + a, with its series where
@@ -46,50 +41,28 @@ inline double rte_w1(double x, double a)
     return a / x - 1.0 + a;
 }
 
-/* n > 1, the tube at oblique incidence: the refracted beam meets the side walls too. As
- * march.cl's ppb_piece_images: unfolded by the cross-section's mirror images (tile (k, j), k
- * along x, j in depth, mirrored when odd), the beam reaching q through image (k, j) has weight
- * F_b^j F_s^k, optical depth sigma_t depth' / cos theta_t, entry point x' - depth' tan theta_t
- * on S1's lit part, and direction (+-sin, -+cos): cb = the phase coefficients of (+sin, down),
- * (+sin, up), (-sin, down), (-sin, up). Each image's lit part of the piece [la, lb] is one
- * interval, integrated in closed form. Uniform sigma_t only (rte2d's check). Returns the sum
- * before the albedo; d0 is the optical distance at la. */
+/* n > 1, the tube at oblique incidence: the refracted beam meets the side walls too, unfolded
+ * over the cross-section's mirror images as in `ss` (ppb_beam_images.h), through the step's
+ * images with a density step. cb: the phase coefficients of (+sin, down), (+sin, up),
+ * (-sin, down), (-sin, up). Returns the sum before the albedo; d0 is the optical distance at
+ * la. */
 inline double rte_beam_images(const ppb_rte_params *P, const double *cb, double px, double py,
                               double mx, double my, double la, double lb, double sigma_t, double d0)
 {
-    double W = P->width, H = P->height, ct = P->cos_theta_l, tn = P->tan_theta_l;
-    double lo = -0.5 * W, hi = P->step_kind == PPB_STEP_SHADOW ? fmin(0.5 * W, P->step_x) : 0.5 * W;
-    if (!(hi > lo))
-        return 0.0;
-    int jmax = (int)ceil((P->d_cap - d0) * ct / (sigma_t * H));
-    double sum = 0.0, fj = 1.0;
-    for (int j = 0; j <= jmax; j++, fj *= P->beam_fb) {
-        int jodd = j & 1;
-        double dp0 = jodd ? (j + 1) * H + py : j * H - py, dpl = jodd ? my : -my;
-        int kmin = max(0, (int)ceil((j * H * tn - W) / W));
-        int kmax = (int)floor(1.0 + (j + 1) * H * tn / W);
-        double fk = pown(P->beam_fs, kmin);
-        for (int k = kmin; k <= kmax; k++, fk *= P->beam_fs) {
-            int kodd = k & 1;
-            double xe0 = k * W + (kodd ? -px : px) - dp0 * tn, xel = (kodd ? -mx : mx) - dpl * tn;
-            double l1 = la, l2 = lb;
-            if (xel == 0.0) {
-                if (xe0 < lo || xe0 >= hi)
-                    continue;
-            } else {
-                double a = (lo - xe0) / xel, b = (hi - xe0) / xel;
-                l1 = fmax(l1, fmin(a, b));
-                l2 = fmin(l2, fmax(a, b));
-            }
-            if (!(l2 > l1))
-                continue;
-            double C = P->beam_in * fj * fk * cb[2 * kodd + jodd];
-            double D1 = sigma_t * (dp0 + l1 * dpl) / ct, D2 = sigma_t * (dp0 + l2 * dpl) / ct;
-            double e_a = -(d0 + sigma_t * (l1 - la) + D1), z = -(sigma_t * (l2 - l1) + D2 - D1);
-            sum += C * sigma_t * (l2 - l1) * rte_beam_factor(e_a, z);
-        }
-    }
-    return sum;
+    ppb_beam_tube B = {.width = P->width,
+                       .height = P->height,
+                       .step_x = P->step_x,
+                       .sigma_t = P->sigma_t,
+                       .sigma_t_right = P->sigma_t_right,
+                       .sin_t = P->sin_theta_l,
+                       .cos_t = P->cos_theta_l,
+                       .tan_t = P->tan_theta_l,
+                       .beam_in = P->beam_in,
+                       .beam_fb = P->beam_fb,
+                       .beam_fs = P->beam_fs,
+                       .d_cap = P->d_cap,
+                       .step_kind = P->step_kind};
+    return ppb_beam_images(&B, cb, px, py, mx, my, la, lb, sigma_t, d0);
 }
 
 /* n > 1: the radiance entering at the wall the ray from (px, py) along (mx, my) reaches after
