@@ -395,7 +395,9 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
                               double py, double vx, double vy, double vz, double lfar, double *d)
 {
     double mx = -vx, my = -vy;
-    double brk[4];
+    /* 0, at most three breaks, lfar: brk[4] was one short, and a leg crossing the step plane
+     * and both light lines (oblique light, density or albedo step) wrote past it. */
+    double brk[5];
     int nb = 0;
     brk[nb++] = 0.0;
     if (P->tube) {
