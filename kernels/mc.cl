@@ -12,10 +12,11 @@
  * additions.
  *
  * Layout: each work-item runs PPB_MC_LANES photons side by side in OpenCL vector types (one
- * photon per lane; a lane whose photon leaves or dies takes the work-item's next photon). On a
- * CPU this is what makes the kernel SIMD: a photon's loop has a data-dependent trip count, so
- * no compiler vectorises across work-items. The host picks 8 lanes on CPUs and 2 on GPUs; a
- * photon's path never depends on its lane, work-item or launch.
+ * photon per lane; a lane whose photon leaves or dies waits, and once PPB_MC_REFILL lanes wait
+ * they are tallied and take the work-item's next photons together). On a CPU this is what
+ * makes the kernel SIMD: a photon's loop has a data-dependent trip count, so no compiler
+ * vectorises across work-items. The host picks 8 lanes on CPUs and 2 on GPUs; a photon's path
+ * never depends on its lane, work-item or launch.
  *
  * Random numbers: Philox4x32-10 (Random123; Salmon et al., SC'11, the same bijection as
  * Random123's philox4x32, evaluated on a vector of counters) keyed by the seed. Photon i's
@@ -52,6 +53,7 @@ typedef PPB_VEC(uint) vuint;
 #define VLOAD          PPB_CAT(vload, PPB_MC_LANES)
 #define VSTORE         PPB_CAT(vstore, PPB_MC_LANES)
 #define AS_VINT        PPB_CAT(as_int, PPB_MC_LANES)
+#define AS_VUINT       PPB_CAT(as_uint, PPB_MC_LANES)
 #define AS_VFLOAT      PPB_CAT(as_float, PPB_MC_LANES)
 #define CONVERT_VFLOAT PPB_CAT(convert_float, PPB_MC_LANES)
 #define CONVERT_VINT   PPB_CAT(convert_int, PPB_MC_LANES)
@@ -224,71 +226,109 @@ inline void ppb_mc_flush(ppb_mc_pending *pend, __global ulong *base, __global ul
         atom_add(spare, 0UL);
 }
 
-/* The state of every lane, kept in private arrays so that one lane can be finished and
- * restarted on its own; the step loads them into vectors. */
-typedef struct ppb_mc_lanes {
-    float x[LANES], y[LANES], wx[LANES], wy[LANES], wz[LANES];
-    float weight[LANES], capture[LANES], rgain[LANES], rloss[LANES], tau[LANES];
-    uint ctr0[LANES], ctr1[LANES], step[LANES];
-    int nscat[LANES], need_tau[LANES], active[LANES], done[LANES], left[LANES], side[LANES];
-    int capped[LANES]; /* roulettes forced by the event cap */
-} ppb_mc_lanes;
+/* The lanes' indices, for lane bits (ppb_mc_bits) and ranks (ppb_mc_refill). */
+#if LANES == 2
+#define PPB_MC_IOTA ((vuint)(0, 1))
+#elif LANES == 4
+#define PPB_MC_IOTA ((vuint)(0, 1, 2, 3))
+#elif LANES == 8
+#define PPB_MC_IOTA ((vuint)(0, 1, 2, 3, 4, 5, 6, 7))
+#elif LANES == 16
+#define PPB_MC_IOTA ((vuint)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+#else
+#error "PPB_MC_LANES must be 2, 4, 8 or 16"
+#endif
 
-/* The entry words (Philox word 0 of the counter (i mod 2^32, i / 2^32, 0, 1)) of the photons
- * photon0 + j stride, j = 0 .. LANES - 1, a work-item's next LANES photons, by one vector
- * Philox: a scalar one per photon was a tenth of the kernel's time (issue 21). The same words
- * as Random123's philox4x32 (tests/test_mc.c checks the vector Philox against it). */
-inline void ppb_mc_entry_words(const ppb_mc_params *p, ulong photon0, ulong stride, uint *w)
+/* The true lanes of a mask as the bits of an integer, bit l for lane l, by an OR over halves:
+ * PoCL's any() tests lane after lane, a branch each. */
+PPB_MC_HOT uint ppb_mc_bits(vint mask)
 {
-    uint c0[LANES], c1[LANES];
-    for (int l = 0; l < LANES; l++) {
-        ulong photon = photon0 + stride * (ulong)l;
-        c0[l] = (uint)photon, c1[l] = (uint)(photon >> 32);
-    }
-    ppb_mc_vctr c = {VLOAD(0, c0), VLOAD(0, c1), (vuint)0, (vuint)1};
-    c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
-    VSTORE(c.v0, 0, w);
+    vuint b = AS_VUINT(mask) & ((vuint)1 << PPB_MC_IOTA);
+#if LANES == 16
+    uint8 b8 = b.lo | b.hi;
+    uint4 b4 = b8.lo | b8.hi;
+    uint2 b2 = b4.lo | b4.hi;
+#elif LANES == 8
+    uint4 b4 = b.lo | b.hi;
+    uint2 b2 = b4.lo | b4.hi;
+#elif LANES == 4
+    uint2 b2 = b.lo | b.hi;
+#else
+    uint2 b2 = b;
+#endif
+    return b2.x | b2.y;
 }
 
-/* Starts photon `photon` in lane l: entry on S1 (y = 0) along w_L, at the point its entry word
- * (ppb_mc_entry_words) gives in the tube. */
-PPB_MC_HOT void ppb_mc_start(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ulong photon,
-                             uint entry_word)
+/* The lowest lane of a nonzero set of lane bits (ctz is OpenCL 2.0). */
+inline int ppb_mc_low_lane(uint bits)
 {
-    s->ctr0[l] = (uint)photon, s->ctr1[l] = (uint)(photon >> 32), s->step[l] = 0;
-    float x = 0.0f;
-    if (p->tube)
-        x = p->enter_x0 + p->enter_width * ppb_mc_uniform1(entry_word);
-    s->x[l] = x, s->y[l] = 0.0f;
-    s->wx[l] = p->light_x, s->wy[l] = p->light_y, s->wz[l] = 0.0f;
-    s->weight[l] = p->entry_weight, s->capture[l] = s->rgain[l] = s->rloss[l] = 0.0f,
-    s->tau[l] = 0.0f;
-    s->nscat[l] = 0, s->need_tau[l] = -1, s->active[l] = -1, s->capped[l] = 0;
+    return 31 - (int)clz(bits & (0u - bits));
 }
+
+/* The state of every lane as vectors, which stay in registers from step to step (issue 21:
+ * kept in private arrays, it was loaded and stored whole every step and written lane by lane
+ * at every photon's start, and the vector loads that followed those scalar stores stalled). A
+ * lane whose photon has finished keeps its final state (done; masked out of every update) until
+ * ppb_mc_refill tallies and replaces it, together with the other finished lanes. */
+typedef struct ppb_mc_state {
+    vfloat x, y, wx, wy, wz, weight, tau;
+    vfloat capture, rgain, rloss; /* weight removed by capture, won and lost by roulette */
+    vuint ctr0, ctr1, step;       /* the Philox counter: photon index (two words), step */
+    vint nscat, capped;           /* scatterings; roulettes forced by the event cap */
+    vint need_tau;                /* the next leg draws a new optical depth */
+    vint active;                  /* the lane flies a photon */
+    vint done, left, side;        /* finished; by leaving (else it died); through a side wall */
+} ppb_mc_state;
 
 /* The work-item's photons in order: the m-th is first + off + batches m, m = q0, q0 + P, ...
- * Entry words are made LANES photons at a time. */
+ * (n: the end). */
 typedef struct ppb_mc_queue {
     ulong m, n, step, base, stride; /* next m, end, P, first + off, batches */
-    uint word[LANES];
-    int used;
 } ppb_mc_queue;
 
-/* Starts the next photon in lane l, or marks the lane idle when none is left. */
-PPB_MC_HOT void ppb_mc_next(const ppb_mc_params *p, ppb_mc_lanes *s, int l, ppb_mc_queue *q)
+/* Refill finished lanes only once this many have finished (or none flies): a photon takes
+ * about six steps, so with 8 lanes some lane finishes on three steps in four, and a refill (the
+ * tallies, exit bins, ranks and entry Philox, all on every lane) then ran almost every step;
+ * waiting for a quarter of the lanes idles a few lanes for a step or two instead. Which lane
+ * traces a photon never changes its path. */
+#ifndef PPB_MC_REFILL
+#define PPB_MC_REFILL (LANES >= 8 ? LANES / 4 : 1)
+#endif
+
+/* Restarts every finished lane (bits: s->done as lane bits) with the queue's next photons, in
+ * lane order (a lane's rank: the finished lanes below it), or idles it when the queue is empty.
+ * A photon enters on S1 (y = 0) along w_L, at the point its entry word (Philox word 0 of the
+ * counter (i mod 2^32, i / 2^32, 0, 1)) gives in the tube. Returns the restarted lanes' bits. */
+PPB_MC_HOT uint ppb_mc_refill(const ppb_mc_params *p, ppb_mc_state *s, ppb_mc_queue *q, uint bits)
 {
-    if (q->m >= q->n) {
-        s->active[l] = 0;
-        return;
+    vuint below = ((vuint)1 << PPB_MC_IOTA) - 1u;
+    vulong m = (vulong)q->m + CONVERT_VULONG(popcount((vuint)bits & below)) * q->step;
+    q->m += (ulong)popcount(bits) * q->step;
+    vint start = s->done & CONVERT_VINT(m < (vulong)q->n);
+    vulong photon = (vulong)q->base + (vulong)q->stride * m;
+    vuint c0 = CONVERT_VUINT(photon), c1 = CONVERT_VUINT(photon >> 32);
+    vfloat x = (vfloat)0.0f;
+    if (p->tube) {
+        ppb_mc_vctr c = {c0, c1, (vuint)0, (vuint)1};
+        c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
+        x = p->enter_x0 + p->enter_width * ppb_mc_uniform(c.v0);
     }
-    ulong photon = q->base + q->stride * q->m;
-    if (q->used == LANES) {
-        if (p->tube)
-            ppb_mc_entry_words(p, photon, q->stride * q->step, q->word);
-        q->used = 0;
-    }
-    ppb_mc_start(p, s, l, photon, q->word[q->used++]);
-    q->m += q->step;
+    vfloat zero = (vfloat)0.0f;
+    s->x = select(s->x, x, start), s->y = select(s->y, zero, start);
+    s->wx = select(s->wx, (vfloat)p->light_x, start);
+    s->wy = select(s->wy, (vfloat)p->light_y, start);
+    s->wz = select(s->wz, zero, start);
+    s->weight = select(s->weight, (vfloat)p->entry_weight, start);
+    s->tau = select(s->tau, zero, start);
+    s->capture = select(s->capture, zero, start);
+    s->rgain = select(s->rgain, zero, start), s->rloss = select(s->rloss, zero, start);
+    s->ctr0 = select(s->ctr0, c0, start), s->ctr1 = select(s->ctr1, c1, start);
+    s->step = select(s->step, (vuint)0, start);
+    s->nscat = select(s->nscat, (vint)0, start), s->capped = select(s->capped, (vint)0, start);
+    s->need_tau |= start;
+    s->active = select(s->active, start, s->done);
+    s->done = s->left = s->side = (vint)0;
+    return ppb_mc_bits(start);
 }
 
 /* The cell (before the tally's offset) of one exit by the scalar double code: the exit's
@@ -357,45 +397,47 @@ PPB_MC_HOT vint ppb_mc_vbins(const ppb_mc_params *p, const ppb_mc_edges *e, vint
     return (off + seg) * nbins + kt * p->nphi + kp;
 }
 
-/* Tallies every lane whose photon has left (s->left) or died (s->done) this step: the totals
- * as lane vectors, the cell additions of the scattered exits queued (ppb_mc_pending). Returns
- * the mask of those lanes. */
-PPB_MC_HOT vint ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_mc_lanes *s,
-                              ppb_mc_pending *pend, ppb_mc_sums *sums, __global ulong *base,
-                              __global ulong *spare)
+/* Tallies every finished lane (s->done), before ppb_mc_refill replaces it: the totals as lane
+ * vectors, the cell additions of the scattered exits queued (ppb_mc_pending). */
+PPB_MC_HOT void ppb_mc_tally(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_mc_state *s,
+                             ppb_mc_pending *pend, ppb_mc_sums *sums, __global ulong *base,
+                             __global ulong *spare)
 {
-    vint done = VLOAD(0, s->done) & VLOAD(0, s->active);
-    if (!any(done))
-        return done;
-    vint left = VLOAD(0, s->left) & done;
-    vint nscat = VLOAD(0, s->nscat);
+    vint done = s->done, left = s->left & done, nscat = s->nscat;
     vulong zero = (vulong)0;
-    vulong q = ppb_mc_vfixed(VLOAD(0, s->weight));
+    vulong q = ppb_mc_vfixed(s->weight);
     vlong ldone = CONVERT_VLONG(done);
     sums->ballistic += select(zero, q, CONVERT_VLONG(left & (nscat == 0)));
-    sums->capture += select(zero, ppb_mc_vfixed(VLOAD(0, s->capture)), ldone);
-    sums->rgain += select(zero, ppb_mc_vfixed(VLOAD(0, s->rgain)), ldone);
-    sums->rloss += select(zero, ppb_mc_vfixed(VLOAD(0, s->rloss)), ldone);
+    sums->capture += select(zero, ppb_mc_vfixed(s->capture), ldone);
+    sums->rgain += select(zero, ppb_mc_vfixed(s->rgain), ldone);
+    sums->rloss += select(zero, ppb_mc_vfixed(s->rloss), ldone);
     sums->events += select(zero, CONVERT_VULONG(nscat), ldone);
-    sums->capped += select(zero, CONVERT_VULONG(VLOAD(0, s->capped)), ldone);
+    sums->capped += select(zero, CONVERT_VULONG(s->capped), ldone);
 
     vint scat = left & (nscat != 0);
-    if (!any(scat))
-        return done;
+    uint sbits = ppb_mc_bits(scat);
+    if (!sbits)
+        return;
     vint exact;
-    vint cellv = ppb_mc_vbins(p, e, VLOAD(0, s->side), VLOAD(0, s->x), VLOAD(0, s->y),
-                              VLOAD(0, s->wx), VLOAD(0, s->wy), VLOAD(0, s->wz), &exact);
-    int cells[LANES], ex[LANES], sc[LANES], ns[LANES];
+    vint cellv = ppb_mc_vbins(p, e, s->side, s->x, s->y, s->wx, s->wy, s->wz, &exact);
+    int cells[LANES], ns[LANES];
     ulong qs[LANES];
-    VSTORE(cellv, 0, cells), VSTORE(exact, 0, ex), VSTORE(scat, 0, sc), VSTORE(nscat, 0, ns);
-    VSTORE(q, 0, qs);
-    for (int l = 0; l < LANES; l++) {
-        if (!sc[l])
-            continue;
-        size_t cell = (size_t)(uint)cells[l];
-        if (ex[l])
-            cell =
-                ppb_mc_exit_cell(p, e, s->side[l], s->x[l], s->y[l], s->wx[l], s->wy[l], s->wz[l]);
+    VSTORE(cellv, 0, cells), VSTORE(nscat, 0, ns), VSTORE(q, 0, qs);
+    uint xbits = ppb_mc_bits(exact & scat);
+    size_t exact_cell[LANES];
+    if (xbits) { /* rare: an exit within float's rounding of an edge */
+        float x[LANES], y[LANES], wx[LANES], wy[LANES], wz[LANES];
+        int side[LANES];
+        VSTORE(s->x, 0, x), VSTORE(s->y, 0, y), VSTORE(s->wx, 0, wx), VSTORE(s->wy, 0, wy);
+        VSTORE(s->wz, 0, wz), VSTORE(s->side, 0, side);
+        for (uint b = xbits; b; b &= b - 1) {
+            int l = ppb_mc_low_lane(b);
+            exact_cell[l] = ppb_mc_exit_cell(p, e, side[l], x[l], y[l], wx[l], wy[l], wz[l]);
+        }
+    }
+    for (uint b = sbits; b; b &= b - 1) {
+        int l = ppb_mc_low_lane(b);
+        size_t cell = (xbits >> l) & 1 ? exact_cell[l] : (size_t)(uint)cells[l];
         pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = qs[l];
         /* mc1's addition, kept only for a once-scattered photon (no branch to mispredict) */
         pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n] = qs[l];
@@ -403,52 +445,68 @@ PPB_MC_HOT vint ppb_mc_finish(const ppb_mc_params *p, const ppb_mc_edges *e, con
         if (pend->n > PPB_MC_PEND - 2)
             ppb_mc_flush(pend, base, spare);
     }
-    return done;
 }
 
-/* n > 1: lane l's photon has reached a wall (s->left; s->side: a side wall). With probability
- * F(cos theta_i) (r, the step's unused fourth word) it is reflected specularly and flies on; else
- * it leaves along the refracted air-side direction (tangential components times n, Snell), which
- * ppb_mc_finish bins. Total internal reflection has F = 1. */
-inline void ppb_mc_boundary(const ppb_mc_params *p, ppb_mc_lanes *s, int l, uint r)
+/* n > 1: a photon that has reached a wall (left; side: a side wall), in the scalar state of its
+ * lane. With probability F(cos theta_i) (r, the step's unused fourth word) it is reflected
+ * specularly and flies on (*left = 0); else it leaves along the refracted air-side direction
+ * (tangential components times n, Snell), which ppb_mc_tally bins. Total internal reflection
+ * has F = 1. */
+inline void ppb_mc_boundary(const ppb_mc_params *p, int side, uint r, float *wx, float *wy,
+                            float *wz, int *left)
 {
-    int side = s->side[l];
-    double wn = side ? (double)s->wx[l] : (double)s->wy[l];
+    double wn = side ? (double)*wx : (double)*wy;
     double cos_i = fabs(wn), inv_n = 1.0 / p->n_in;
     double cos_t = ppb_refract_cos(cos_i, inv_n);
     if (cos_t < 0.0 || (double)ppb_mc_uniform1(r) < ppb_fresnel(cos_i, inv_n)) {
         if (side)
-            s->wx[l] = -s->wx[l];
+            *wx = -*wx;
         else
-            s->wy[l] = -s->wy[l];
-        s->left[l] = 0, s->done[l] = 0;
+            *wy = -*wy;
+        *left = 0;
         return;
     }
-    double n = p->n_in, ta = n * (double)s->wx[l], tb = n * (double)s->wy[l];
-    double tz = n * (double)s->wz[l], out = copysign(cos_t, wn);
+    double n = p->n_in, ta = n * (double)*wx, tb = n * (double)*wy;
+    double tz = n * (double)*wz, out = copysign(cos_t, wn);
     if (side)
         ta = out;
     else
         tb = out;
-    s->wx[l] = (float)ta, s->wy[l] = (float)tb, s->wz[l] = (float)tz;
+    *wx = (float)ta, *wy = (float)tb, *wz = (float)tz;
 }
 
-/* One step of every lane: a flight leg to the next interaction, the step plane or a wall,
- * then (at an interaction) implicit capture, HG scattering and roulette. A leg that reaches
- * the step plane stops there with its remaining optical depth; a straight line crosses the
- * plane at most once, so a flight takes at most two legs. */
-PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float *medium)
+/* ppb_mc_boundary for every lane in *left, lane by lane (n > 1 only). */
+PPB_MC_HOT void ppb_mc_boundaries(const ppb_mc_params *p, ppb_mc_state *s, vint *left, vint side,
+                                  vuint r)
+{
+    float wx[LANES], wy[LANES], wz[LANES];
+    int lf[LANES], sd[LANES];
+    uint rr[LANES];
+    VSTORE(s->wx, 0, wx), VSTORE(s->wy, 0, wy), VSTORE(s->wz, 0, wz);
+    VSTORE(*left, 0, lf), VSTORE(side, 0, sd), VSTORE(r, 0, rr);
+    for (int l = 0; l < LANES; l++)
+        if (lf[l])
+            ppb_mc_boundary(p, sd[l], rr[l], wx + l, wy + l, wz + l, lf + l);
+    s->wx = VLOAD(0, wx), s->wy = VLOAD(0, wy), s->wz = VLOAD(0, wz);
+    *left = VLOAD(0, lf);
+}
+
+/* One step of every flying lane: a flight leg to the next interaction, the step plane or a
+ * wall, then (at an interaction) implicit capture, HG scattering and roulette. A leg that
+ * reaches the step plane stops there with its remaining optical depth; a straight line crosses
+ * the plane at most once, so a flight takes at most two legs. A lane that finishes (leaves or
+ * dies) is marked done and keeps its state. */
+PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float *medium)
 {
     const float half_w = 0.5f * p->width, sx = p->step_x;
-    vint active = VLOAD(0, s->active);
-    vfloat x = VLOAD(0, s->x), y = VLOAD(0, s->y);
-    vfloat wx = VLOAD(0, s->wx), wy = VLOAD(0, s->wy), wz = VLOAD(0, s->wz);
-    vuint step = VLOAD(0, s->step);
+    vint active = s->active;
+    vfloat x = s->x, y = s->y;
+    vfloat wx = s->wx, wy = s->wy, wz = s->wz;
 
-    ppb_mc_vctr c = {VLOAD(0, s->ctr0), VLOAD(0, s->ctr1), step, (vuint)0};
+    ppb_mc_vctr c = {s->ctr0, s->ctr1, s->step, (vuint)0};
     c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
-    VSTORE(step + 1, 0, s->step);
-    vfloat tau = select(VLOAD(0, s->tau), -ppb_mc_log(ppb_mc_uniform(c.v0)), VLOAD(0, s->need_tau));
+    s->step += 1u;
+    vfloat tau = select(s->tau, -ppb_mc_log(ppb_mc_uniform(c.v0)), s->need_tau);
 
     /* Distances to the walls (tube sides only in tube mode) and to the step plane. Lanes
      * moving parallel to a wall divide by zero; select() discards those values. */
@@ -477,8 +535,8 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float
     x += go * wx;
     y += go * wy;
     x = select(x, (vfloat)sx, cross); /* exactly on the plane: the side test sees the crossing */
-    VSTORE(select(tau, fmax(0.0f, tau - d_leg * sigma), cross), 0, s->tau);
-    VSTORE(~cross, 0, s->need_tau);
+    s->tau = select(tau, fmax(0.0f, tau - d_leg * sigma), cross);
+    s->need_tau = ~cross;
     vint side = left & (dx <= dy);
     x = select(x, select((vfloat)-half_w, (vfloat)half_w, wx > 0.0f), side);
     y = select(y, select((vfloat)-p->height, (vfloat)0.0f, wy > 0.0f), left & ~side);
@@ -487,12 +545,11 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float
     vfloat alpha = (vfloat)medium[4];
     if (p->step == PPB_STEP_ALBEDO)
         alpha = select(alpha, (vfloat)medium[5], x >= sx);
-    vfloat weight = VLOAD(0, s->weight);
-    VSTORE(VLOAD(0, s->capture) + select((vfloat)0.0f, weight * (1.0f - alpha), inter), 0,
-           s->capture);
+    vfloat weight = s->weight;
+    s->capture = s->capture + select((vfloat)0.0f, weight * (1.0f - alpha), inter);
     weight = select(weight, weight * alpha, inter);
-    vint nscat = VLOAD(0, s->nscat) - inter;
-    VSTORE(nscat, 0, s->nscat);
+    vint nscat = s->nscat - inter;
+    s->nscat = nscat;
 
     vfloat ct = ppb_mc_hg_cos(p->g, 0.5f / p->g, ppb_mc_uniform(c.v1));
     vfloat cp, sp = ppb_mc_sincos2pi(ppb_mc_uniform(c.v2), &cp);
@@ -508,37 +565,31 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_lanes *s, const float
     ny = select(ny, st * sp, pole);
     nz = select(nz, copysign(ct, wz), pole);
     vfloat renorm = 1.5f - 0.5f * (nx * nx + ny * ny + nz * nz);
-    wx = select(wx, nx * renorm, inter);
-    wy = select(wy, ny * renorm, inter);
-    wz = select(wz, nz * renorm, inter);
+    s->wx = select(wx, nx * renorm, inter);
+    s->wy = select(wy, ny * renorm, inter);
+    s->wz = select(wz, nz * renorm, inter);
 
     /* Russian roulette: survive with probability 1/M at M times the weight (M = 8, so the test
      * u < 1/M on the 2^-23 grid has probability exactly 1/M). alpha = 0 ends a photon too.
      * Past the event cap every interaction is a roulette (mc_params.h). */
     vint over_cap = inter & (nscat > PPB_MC_EVENT_CAP) & (weight < PPB_MC_CAP_WMAX);
-    VSTORE(VLOAD(0, s->capped) - over_cap, 0, s->capped);
+    s->capped = s->capped - over_cap;
     vint roulette = inter & ((weight < PPB_MC_ROULETTE_W) | over_cap);
     vint survive = ppb_mc_uniform(c.v3) < 1.0f / PPB_MC_ROULETTE_M;
-    VSTORE(VLOAD(0, s->rgain) +
-               select((vfloat)0.0f, weight * (PPB_MC_ROULETTE_M - 1.0f), roulette & survive),
-           0, s->rgain);
-    VSTORE(VLOAD(0, s->rloss) + select((vfloat)0.0f, weight, roulette & ~survive), 0, s->rloss);
+    s->rgain =
+        s->rgain + select((vfloat)0.0f, weight * (PPB_MC_ROULETTE_M - 1.0f), roulette & survive);
+    s->rloss = s->rloss + select((vfloat)0.0f, weight, roulette & ~survive);
     weight = select(weight, select((vfloat)0.0f, weight * PPB_MC_ROULETTE_M, survive), roulette);
     vint dead = inter & (weight <= 0.0f);
 
-    VSTORE(x, 0, s->x), VSTORE(y, 0, s->y);
-    VSTORE(wx, 0, s->wx), VSTORE(wy, 0, s->wy), VSTORE(wz, 0, s->wz);
-    VSTORE(weight, 0, s->weight);
-    VSTORE(left | dead, 0, s->done);
-    VSTORE(left, 0, s->left);
-    VSTORE(side, 0, s->side);
-    if (p->n_in > 1.0) {
-        uint r[LANES];
-        VSTORE(c.v3, 0, r);
-        for (int l = 0; l < LANES; l++)
-            if (s->left[l])
-                ppb_mc_boundary(p, s, l, r[l]);
-    }
+    /* A finished lane stays where it left (the step moved it by its wall distance). */
+    s->x = select(s->x, x, active), s->y = select(s->y, y, active);
+    s->weight = weight;
+    if (p->n_in > 1.0 && ppb_mc_bits(left))
+        ppb_mc_boundaries(p, s, &left, side, c.v3);
+    vint finished = left | dead;
+    s->done |= finished, s->left |= left, s->side |= side & left;
+    s->active &= ~finished;
 }
 
 /* The global size is batches x P, P a multiple of the work-group size L (the host makes it
@@ -582,25 +633,18 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     ppb_mc_pending pend;
     pend.n = 0;
     __global ulong *spare = totals + (size_t)batch * PPB_MC_NTOT + PPB_MC_NTOT - 1;
-    ppb_mc_lanes s;
+    ppb_mc_state s = {0};
+    s.done = (vint)-1; /* every lane finished: the first refill fills them all */
     ppb_mc_queue queue = {q0, n, per_batch, p.first + off, batches};
-    queue.used = LANES;
-    for (int l = 0; l < LANES; l++)
-        ppb_mc_next(&p, &s, l, &queue);
-    for (;;) {
+    uint flying = ppb_mc_refill(&p, &s, &queue, (1u << LANES) - 1u);
+    while (flying) {
         ppb_mc_step(&p, &s, medium);
-        vint done = ppb_mc_finish(&p, &edges, &s, &pend, &sums, base, spare);
-        if (!any(done))
-            continue; /* every active lane is still flying */
-        int dn[LANES], busy = 0;
-        VSTORE(done, 0, dn);
-        for (int l = 0; l < LANES; l++) {
-            if (dn[l])
-                ppb_mc_next(&p, &s, l, &queue);
-            busy |= s.active[l];
-        }
-        if (!busy)
-            break;
+        uint done = ppb_mc_bits(s.done);
+        flying &= ~done;
+        if (popcount(done) < PPB_MC_REFILL && flying)
+            continue;
+        ppb_mc_tally(&p, &edges, &s, &pend, &sums, base, spare);
+        flying |= ppb_mc_refill(&p, &s, &queue, done);
     }
 
     ppb_mc_flush(&pend, base, spare);

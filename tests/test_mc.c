@@ -300,6 +300,17 @@ static void test_bit_identical(void **state)
         ppb_mc_tallies_free(&t);
     }
     f.cfg.mc.workgroup = 0;
+    /* Lanes per work-item (method_mc.c device_shape; 8 on a CPU): finished lanes are refilled
+     * in groups whose size depends on it, which must not change a photon's path. */
+    const char *lanes[3] = {"2", "4", "16"};
+    for (int i = 0; i < 3; i++) {
+        setenv("PPBENCH_MC_LANES", lanes[i], 1);
+        trace(&f, 0, n, &t);
+        unsetenv("PPBENCH_MC_LANES");
+        if (!same_tallies(&ref, &t))
+            fail_msg("tallies differ with %s lanes", lanes[i]);
+        ppb_mc_tallies_free(&t);
+    }
     f.cfg.mc.chunk = n / 4;
     trace(&f, 0, n, &t);
     if (!same_tallies(&ref, &t))

@@ -149,6 +149,15 @@ static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
     long long units = ocl->compute_units ? (long long)ocl->compute_units : 1;
     int cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
     shape->lanes = cpu ? 8 : 2;
+    /* $PPBENCH_MC_LANES (2, 4, 8 or 16) overrides the lane count: tests/test_mc.c checks that
+     * it never changes a tally, and benchmarks compare widths with it. */
+    const char *env = getenv("PPBENCH_MC_LANES");
+    if (env && *env) {
+        int lanes = atoi(env);
+        if (lanes != 2 && lanes != 4 && lanes != 8 && lanes != 16)
+            return ppb_fail(err, "mc: PPBENCH_MC_LANES must be 2, 4, 8 or 16 (got '%s')", env);
+        shape->lanes = lanes;
+    }
     shape->items = units * (cpu ? 1024 : 2048);
     return 0;
 }
