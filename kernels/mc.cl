@@ -78,24 +78,30 @@ typedef struct ppb_mc_vctr {
     vuint v0, v1, v2, v3;
 } ppb_mc_vctr;
 
+/* Each 32-bit word rides in the low half of a 64-bit lane, so that a round is two 32 x 32 ->
+ * 64-bit multiplies (vpmuludq, which reads only the low halves), two shifts for the high words
+ * and the XORs, with nothing repacked into 32-bit lanes (issue 21: repacking the products'
+ * halves, vpmulld for the low words and two permutes for the high ones, made a round half
+ * again as long; PoCL's vector mul_hi, in 16-bit pieces, was worse still). The high halves
+ * carry garbage that no low half ever sees: XOR is bitwise and the multiplies read the low
+ * halves only. Unrolled, the round keys k + r W are constants of the launch. The same words as
+ * Random123's philox4x32 (tests/test_mc.c checks them). */
 PPB_MC_HOT ppb_mc_vctr ppb_mc_philox(ppb_mc_vctr c, uint k0, uint k1)
 {
+    const vulong low = (vulong)0xffffffffUL;
+    vulong a0 = CONVERT_VULONG(c.v0), a1 = CONVERT_VULONG(c.v1);
+    vulong a2 = CONVERT_VULONG(c.v2), a3 = CONVERT_VULONG(c.v3);
+#pragma unroll
     for (int round = 0; round < 10; round++) {
-        if (round > 0) {
-            k0 += PHILOX_W32_0;
-            k1 += PHILOX_W32_1;
-        }
-        /* The 32 x 32 -> 64-bit products as such (one widening multiply per half of the
-         * lanes on x86, vpmuludq): PoCL's vector mul_hi splits into 16-bit pieces, which cost
-         * 40% of the step (issue 21). The same words. */
-        vulong p0 = CONVERT_VULONG(c.v0) * (ulong)PHILOX_M4x32_0;
-        vulong p1 = CONVERT_VULONG(c.v2) * (ulong)PHILOX_M4x32_1;
-        vuint lo0 = CONVERT_VUINT(p0), hi0 = CONVERT_VUINT(p0 >> 32);
-        vuint lo1 = CONVERT_VUINT(p1), hi1 = CONVERT_VUINT(p1 >> 32);
-        ppb_mc_vctr out = {hi1 ^ c.v1 ^ k0, lo1, hi0 ^ c.v3 ^ k1, lo0};
-        c = out;
+        vulong p0 = (a0 & low) * (ulong)PHILOX_M4x32_0;
+        vulong p1 = (a2 & low) * (ulong)PHILOX_M4x32_1;
+        a0 = (p1 >> 32) ^ a1 ^ (ulong)k0;
+        a2 = (p0 >> 32) ^ a3 ^ (ulong)k1;
+        a1 = p1, a3 = p0;
+        k0 += PHILOX_W32_0, k1 += PHILOX_W32_1;
     }
-    return c;
+    ppb_mc_vctr out = {CONVERT_VUINT(a0), CONVERT_VUINT(a1), CONVERT_VUINT(a2), CONVERT_VUINT(a3)};
+    return out;
 }
 
 /* Natural log of x in (0, 1], by the fdlibm/musl logf reduction (x = 2^k (1 + f),
