@@ -520,15 +520,3 @@ int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     return rte2d_solve(ctx, out, NULL, 1, err);
 }
-
-/* n > 1 (reference: Medium): oblique light in the tube follows the beam through the
- * cross-section's mirror images (kernels/rte2d.cl, as ss), which assume one sigma_t: a density
- * step there is refused, as ss refuses it. */
-int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
-{
-    const ppb_scene *sc = &cfg->scene;
-    if (sc->n > 1.0 && sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0 &&
-        sc->step == PPB_STEP_DENSITY && sc->sigma_t_right != sc->sigma_t)
-        return ppb_method_refuse_refractive(cfg, "rte2d", err);
-    return 0;
-}

@@ -39,9 +39,6 @@ typedef struct ppb_rte2d_stats {
 
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
-/* Whether rte2d has a meaning at cfg's point (the registry's check hook). */
-int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err);
-
 /* The same without the refinement study (tests, `make perf`), reporting what it took (stats may
  * be NULL). */
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);

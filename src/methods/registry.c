@@ -39,8 +39,7 @@ static const ppb_method methods[] = {
     {.id = "rte2d",
      .reference = 2, /* noise-free in the tube: summary_rte2d.csv (issue 19) */
      .summary = "the tube's transfer solved: the paper's refinement iterated",
-     .run = ppb_method_rte2d,
-     .check = ppb_rte2d_check},
+     .run = ppb_method_rte2d},
 };
 
 /* Every method a config defines ([method.NAME], model/config.h) is run by

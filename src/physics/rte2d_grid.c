@@ -452,10 +452,11 @@ static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
     return (1.0 - al) * (1.0 - e) / (1.0 - fc[0] * e);
 }
 
-/* n > 1, the tube at oblique incidence (one sigma_t): the refracted beam from x_e followed
- * through its reflections off all four faces (as march.c's ballistic walk), adding on each leg
- * (1 - alpha) of what it loses, the leg split at an albedo step, until what is left is below
- * 1e-16; per unit power entering. */
+/* n > 1, the tube at oblique incidence: the refracted beam from x_e followed through its
+ * reflections off all four faces (as march.c's ballistic walk), adding on each leg (1 - alpha)
+ * of what it loses, the leg split at the step plane (a straight leg crosses it at most once, so
+ * each part has one sigma_t and one alpha), until what is left is below 1e-16; per unit power
+ * entering. */
 static double fresnel_walk_absorbed(const ppb_scene *sc, const ppb_fresnel_beam *b, double x_e)
 {
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
@@ -466,15 +467,16 @@ static double fresnel_walk_absorbed(const ppb_scene *sc, const ppb_fresnel_beam 
         double l = fmin(lx, ly), f = lx < ly ? fs : b->f_inside;
         double cut[3] = {0.0, l, l};
         int nc = 2;
-        if (sc->step == PPB_STEP_ALBEDO && dx != 0.0) {
+        if ((sc->step == PPB_STEP_ALBEDO || sc->step == PPB_STEP_DENSITY) && dx != 0.0) {
             double ls = (sc->step_x - x) / dx;
             if (ls > 0.0 && ls < l)
                 cut[1] = ls, nc = 3;
         }
         for (int k = 0; k + 1 < nc; k++) {
             double xm = x + 0.5 * (cut[k] + cut[k + 1]) * dx;
+            double st = ppb_sigma_t_at(xm, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
             double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
-            double lost = -expm1(-sc->sigma_t * (cut[k + 1] - cut[k]));
+            double lost = -expm1(-st * (cut[k + 1] - cut[k]));
             out += w * (1.0 - al) * lost;
             w *= 1.0 - lost;
         }

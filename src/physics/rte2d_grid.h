@@ -88,7 +88,8 @@ double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *phi);
  * (slab: per unit area), E_perp = 1. n > 1 (slab, or the tube at normal incidence): the
  * refracted beam's passes S1 -> S2 -> S1 .., (1 - F_L)(1 - alpha)(1 - a) / (1 - F_b a) per
  * column, a = e^{-sigma_t H / cos theta_t}; the oblique tube: each entry point's beam walked
- * through its reflections off all four faces (2e4 midpoints over the lit part). */
+ * through its reflections off all four faces, each leg split at the step plane (2e4 midpoints
+ * over the lit part). */
 double ppb_rte_absorbed_beam(const ppb_scene *sc);
 
 #endif
