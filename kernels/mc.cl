@@ -15,8 +15,9 @@
  * photon per lane; a lane whose photon leaves or dies waits, and once PPB_MC_REFILL lanes wait
  * they are tallied and take the work-item's next photons together). On a CPU this is what
  * makes the kernel SIMD: a photon's loop has a data-dependent trip count, so no compiler
- * vectorises across work-items. The host picks 8 lanes on CPUs and 2 on GPUs; a photon's path
- * never depends on its lane, work-item or launch.
+ * vectorises across work-items. The host picks the CPU's native float vector width (16 with
+ * AVX-512, 8 with AVX2) and 2 on GPUs; a photon's path never depends on its lane, work-item or
+ * launch.
  *
  * Random numbers: Philox4x32-10 (Random123; Salmon et al., SC'11, the same bijection as
  * Random123's philox4x32, evaluated on a vector of counters) keyed by the seed. Photon i's

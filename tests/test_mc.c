@@ -300,10 +300,10 @@ static void test_bit_identical(void **state)
         ppb_mc_tallies_free(&t);
     }
     f.cfg.mc.workgroup = 0;
-    /* Lanes per work-item (method_mc.c device_shape; 8 on a CPU): finished lanes are refilled
-     * in groups whose size depends on it, which must not change a photon's path. */
-    const char *lanes[3] = {"2", "4", "16"};
-    for (int i = 0; i < 3; i++) {
+    /* Lanes per work-item (method_mc.c device_shape; 8 or 16 on a CPU): finished lanes are
+     * refilled in groups whose size depends on it, which must not change a photon's path. */
+    const char *lanes[4] = {"2", "4", "8", "16"};
+    for (int i = 0; i < 4; i++) {
         setenv("PPBENCH_MC_LANES", lanes[i], 1);
         trace(&f, 0, n, &t);
         unsetenv("PPBENCH_MC_LANES");
