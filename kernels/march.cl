@@ -355,24 +355,6 @@ inline double ppb_piece_up(const ppb_march_params *P, __global const double *map
 /* The tube at oblique incidence: the beam through the cross-section's mirror images
  * (ppb_beam_images.h), with the exact phase of the light travelling along v in each of the
  * beam's four directions; advances *d. */
-inline ppb_beam_tube ppb_march_beam_tube(const ppb_march_params *P)
-{
-    ppb_beam_tube B = {.width = P->width,
-                       .height = P->height,
-                       .step_x = P->step_x,
-                       .sigma_t = P->sigma_t,
-                       .sigma_t_right = P->sigma_t_right,
-                       .sin_t = P->light_x,
-                       .cos_t = P->cos_theta_l,
-                       .tan_t = P->tan_theta_l,
-                       .beam_in = P->beam_in,
-                       .beam_fb = P->beam_fb,
-                       .beam_fs = P->beam_fs,
-                       .d_cap = P->d_cap,
-                       .step_kind = P->step_kind};
-    return B;
-}
-
 inline double ppb_piece_images(const ppb_march_params *P, double px, double py, double mx,
                                double my, double vx, double vy, double la, double lb,
                                double sigma_t, double alpha, double *d)
@@ -382,7 +364,7 @@ inline double ppb_piece_images(const ppb_march_params *P, double px, double py, 
     double ct = P->cos_theta_l, st = P->light_x;
     double cb[4] = {ppb_hg_phase(P->g, vx * st - vy * ct), ppb_hg_phase(P->g, vx * st + vy * ct),
                     ppb_hg_phase(P->g, -vx * st - vy * ct), ppb_hg_phase(P->g, -vx * st + vy * ct)};
-    ppb_beam_tube B = ppb_march_beam_tube(P);
+    ppb_beam_tube B = PPB_BEAM_TUBE(P, light_x);
     return alpha * ppb_beam_images(&B, cb, px, py, mx, my, la, lb, sigma_t, d0);
 }
 

@@ -48,6 +48,23 @@ typedef struct ppb_beam_tube {
     int step_kind;
 } ppb_beam_tube;
 
+/* The beam of a kernel's launch parameters P (march_params.h, rte2d_params.h: the same field
+ * names but the sine of the beam's angle, SIN: light_x in march's, sin_theta_l in rte2d's). */
+#define PPB_BEAM_TUBE(P, SIN)                                                                      \
+    ((ppb_beam_tube){.width = (P)->width,                                                          \
+                     .height = (P)->height,                                                        \
+                     .step_x = (P)->step_x,                                                        \
+                     .sigma_t = (P)->sigma_t,                                                      \
+                     .sigma_t_right = (P)->sigma_t_right,                                          \
+                     .sin_t = (P)->SIN,                                                            \
+                     .cos_t = (P)->cos_theta_l,                                                    \
+                     .tan_t = (P)->tan_theta_l,                                                    \
+                     .beam_in = (P)->beam_in,                                                      \
+                     .beam_fb = (P)->beam_fb,                                                      \
+                     .beam_fs = (P)->beam_fs,                                                      \
+                     .d_cap = (P)->d_cap,                                                          \
+                     .step_kind = (P)->step_kind})
+
 /* The unfolded tube's right medium (ppb_beam_images): tile (k, j) holds the cross-section
  * mirrored in x when k is odd, so the real x >= step_x = s is x' >= kW + s in an even tile and
  * x' <= kW - s in an odd one; the two join into one interval per pair of tiles, [2mW + s,

@@ -49,19 +49,7 @@ inline double rte_w1(double x, double a)
 inline double rte_beam_images(const ppb_rte_params *P, const double *cb, double px, double py,
                               double mx, double my, double la, double lb, double sigma_t, double d0)
 {
-    ppb_beam_tube B = {.width = P->width,
-                       .height = P->height,
-                       .step_x = P->step_x,
-                       .sigma_t = P->sigma_t,
-                       .sigma_t_right = P->sigma_t_right,
-                       .sin_t = P->sin_theta_l,
-                       .cos_t = P->cos_theta_l,
-                       .tan_t = P->tan_theta_l,
-                       .beam_in = P->beam_in,
-                       .beam_fb = P->beam_fb,
-                       .beam_fs = P->beam_fs,
-                       .d_cap = P->d_cap,
-                       .step_kind = P->step_kind};
+    ppb_beam_tube B = PPB_BEAM_TUBE(P, sin_theta_l);
     return ppb_beam_images(&B, cb, px, py, mx, my, la, lb, sigma_t, d0);
 }
 

@@ -1,6 +1,6 @@
 /* test_maps.c: the light maps (src/physics/maps.h) against closed forms (reference: Medium,
- * Geometry, Light) for the uniform tube, the three step cases and oblique light, and the exact
- * ballistic fraction. */
+ * Geometry, Light) for the uniform tube, the three step cases and oblique light, the exact
+ * ballistic fraction and the midpoint rule over the lit part of S1. */
 #include "testutil.h"
 
 #include <math.h>
@@ -252,6 +252,42 @@ static void test_ballistic_oblique_density(void **state)
     assert_close(ppb_ballistic_fraction(&sc), sum / 10.0, 1e-13);
 }
 
+/* The midpoint sum over the lit part of S1 (maps.h, the Fresnel walks' rule): for a linear
+ * integrand the midpoint rule is exact, so sum * width / np is the integral to rounding, over
+ * [-5, 5] and, with a shadow step at 0, over [-5, 0]; for exp(-x / 3) its error is within the
+ * rule's bound (b - a) h^2 max |f''| / 24, h = (b - a) / np. */
+static double linear(const ppb_scene *sc, double x, void *arg)
+{
+    (void)sc, (void)arg;
+    return 2.0 + x;
+}
+static double decaying(const ppb_scene *sc, double x, void *arg)
+{
+    (void)sc, (void)arg;
+    return exp(-x / 3.0);
+}
+
+static void test_lit_midpoint_sum(void **state)
+{
+    (void)state;
+    ppb_scene sc = tu_tube();
+    const int np = PPB_LIT_MIDPOINTS;
+    double width, sum = ppb_lit_midpoint_sum(&sc, linear, NULL, np, &width);
+    assert_close(width, 10.0, 0.0);
+    assert_close(sum * width / np, 20.0, 1e-10); /* integral of 2 + x over [-5, 5] */
+    sum = ppb_lit_midpoint_sum(&sc, decaying, NULL, np, &width);
+    double exact = 3.0 * (exp(5.0 / 3.0) - exp(-5.0 / 3.0)), h = width / np;
+    double bound = width * h * h * exp(5.0 / 3.0) / 9.0 / 24.0;
+    assert_true(fabs(sum * width / np - exact) <= bound);
+    sc.step = PPB_STEP_SHADOW;
+    sum = ppb_lit_midpoint_sum(&sc, linear, NULL, np, &width);
+    assert_close(width, 5.0, 0.0);
+    assert_close(sum * width / np, -2.5, 1e-10); /* 10 - 12.5 over [-5, 0] */
+    sc.step_x = -5.0;                            /* nothing lit */
+    assert_close(ppb_lit_midpoint_sum(&sc, linear, NULL, np, &width), 0.0, 0.0);
+    assert_close(width, 0.0, 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -265,6 +301,7 @@ int main(void)
         cmocka_unit_test(test_slab),
         cmocka_unit_test(test_ballistic),
         cmocka_unit_test(test_ballistic_oblique_density),
+        cmocka_unit_test(test_lit_midpoint_sum),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -251,9 +251,10 @@ static double fresnel_unscattered(const ppb_scene *sc, double x_entry, void *arg
  * faces, adding at each face the part that leaves, (1 - F) of what arrives, until what is left
  * is below 1e-16. With a density step a leg's optical depth counts its part at x >= step_x with
  * sigma_t_right: a straight leg's x is monotone, so that part is the overlap of its x range with
- * [step_x, W/2], over |dx|. */
-static double fresnel_walk(const ppb_scene *sc, const ppb_fresnel_beam *b, double x_e)
+ * [step_x, W/2], over |dx|. arg: the ppb_fresnel_beam. */
+static double fresnel_walk(const ppb_scene *sc, double x_e, void *arg)
 {
+    const ppb_fresnel_beam *b = arg;
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
     double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, tau = 0.0, out = 0.0;
     for (int hit = 0; hit < 100000 && w * exp(-tau) > 1e-16; hit++) {
@@ -281,17 +282,9 @@ static double fresnel_ballistic(const ppb_scene *sc, const ppb_fresnel_beam *b)
 {
     double fb = b->f_inside, width;
     if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
-        /* Midpoints over the lit part of S1: the integrand is piecewise smooth (it kinks or
-         * jumps where the walk's first faces change), so 2e4 points put it within ~1e-5. */
-        double a = -0.5 * sc->width, hi = 0.5 * sc->width;
-        if (sc->step == PPB_STEP_SHADOW)
-            hi = fmin(hi, sc->step_x);
-        if (!(hi > a))
-            return 0.0;
-        const int np = 20000;
-        double sum = 0.0;
-        for (int i = 0; i < np; i++)
-            sum += fresnel_walk(sc, b, a + (i + 0.5) * (hi - a) / np);
+        /* The walk's mean over the lit part of S1, by midpoints (maps.h). */
+        const int np = PPB_LIT_MIDPOINTS;
+        double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, (void *)b, np, &width);
         return (1.0 - b->specular) * sum / np;
     }
     if (sc->geometry == PPB_GEOM_SLAB) {

@@ -199,6 +199,20 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
     return sum;
 }
 
+double ppb_lit_midpoint_sum(const ppb_scene *sc, ppb_entry_fn f, void *arg, int np, double *width)
+{
+    double a = -0.5 * sc->width, hi = 0.5 * sc->width;
+    if (sc->step == PPB_STEP_SHADOW)
+        hi = fmin(hi, sc->step_x);
+    *width = hi > a ? hi - a : 0.0;
+    if (!(hi > a))
+        return 0.0;
+    double sum = 0.0;
+    for (int i = 0; i < np; i++)
+        sum += f(sc, a + (i + 0.5) * (hi - a) / np, arg);
+    return sum;
+}
+
 static double unscattered(const ppb_scene *sc, double x_entry, void *arg)
 {
     (void)arg;

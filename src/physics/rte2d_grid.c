@@ -456,9 +456,10 @@ static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
  * reflections off all four faces (as march.c's ballistic walk), adding on each leg (1 - alpha)
  * of what it loses, the leg split at the step plane (a straight leg crosses it at most once, so
  * each part has one sigma_t and one alpha), until what is left is below 1e-16; per unit power
- * entering. */
-static double fresnel_walk_absorbed(const ppb_scene *sc, const ppb_fresnel_beam *b, double x_e)
+ * entering. arg: the ppb_fresnel_beam. */
+static double fresnel_walk_absorbed(const ppb_scene *sc, double x_e, void *arg)
 {
+    const ppb_fresnel_beam *b = arg;
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
     double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, out = 0.0;
     for (int hit = 0; hit < 100000 && w > 1e-16; hit++) {
@@ -499,17 +500,10 @@ double ppb_rte_absorbed_beam(const ppb_scene *sc)
         if (sc->geometry == PPB_GEOM_SLAB)
             return c * (1.0 - b.specular) * fresnel_path_absorbed(sc, 0.0, fc);
         if (sc->theta_deg != 0.0) {
-            /* Midpoints over the lit part of S1 (2e4, as march.c's ballistic). */
-            double a = -0.5 * sc->width, hi = 0.5 * sc->width;
-            if (sc->step == PPB_STEP_SHADOW)
-                hi = fmin(hi, sc->step_x);
-            if (!(hi > a))
-                return 0.0;
-            const int np = 20000;
-            double sum = 0.0;
-            for (int i = 0; i < np; i++)
-                sum += fresnel_walk_absorbed(sc, &b, a + (i + 0.5) * (hi - a) / np);
-            return c * (1.0 - b.specular) * sum * (hi - a) / np;
+            /* By midpoints over the lit part of S1, as march.c's ballistic (maps.h). */
+            const int np = PPB_LIT_MIDPOINTS;
+            double sum = ppb_lit_midpoint_sum(sc, fresnel_walk_absorbed, &b, np, &width);
+            return c * (1.0 - b.specular) * sum * width / np;
         }
         return c * (1.0 - b.specular) * ppb_lit_integral(sc, fresnel_path_absorbed, fc, &width);
     }
