@@ -139,6 +139,7 @@ static size_t total_bytes(const ppb_mc_tallies *t)
 typedef struct mc_shape {
     int lanes;
     long long items;
+    size_t local; /* work-group size when [mc] workgroup is 0 (pick_workgroup) */
 } mc_shape;
 
 static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
@@ -166,6 +167,7 @@ static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
         shape->lanes = lanes;
     }
     shape->items = units * (cpu ? 1024 : 2048);
+    shape->local = cpu ? 1 : 64;
     return 0;
 }
 
@@ -219,12 +221,16 @@ static int create_buffers(mc_run *r, ppb_err *err)
     return 0;
 }
 
-/* Work-group size 0 means ppbench picks: 64 work-items keep a group inside one batch and give
- * PoCL's CPU driver enough groups to balance its cores (its own choice is slower), and suit
- * GPUs too. A size the user asked for is never shrunk silently. */
-static int pick_workgroup(const ppb_config *cfg, const ppb_ocl *ocl, size_t *local, ppb_err *err)
+/* Work-group size 0 means ppbench picks (device_shape): 64 work-items on a GPU; 1 on a CPU,
+ * where PoCL then compiles the work-item as it stands, its state in registers from step to
+ * step, while a larger group runs its work-items in a loop that keeps every value carried
+ * from one step to the next in per-work-item arrays, stored each step (issue 21: a fifth of
+ * the kernel's time at 64). Either keeps a group inside one batch. A size the user asked for
+ * is never shrunk silently. */
+static int pick_workgroup(const ppb_config *cfg, const ppb_ocl *ocl, const mc_shape *shape,
+                          size_t *local, ppb_err *err)
 {
-    *local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 64;
+    *local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : shape->local;
     if (!cfg->mc.workgroup && *local > ocl->max_workgroup)
         *local = ocl->max_workgroup;
     if (*local > ocl->max_workgroup)
@@ -250,7 +256,7 @@ static int alloc_host_copy(const ppb_mc_tallies *t, ppb_mc_tallies *tmp, ppb_err
 /* Everything fixed for the whole trace, settled before the clock starts. */
 static int prepare_run(mc_run *r, ppb_err *err)
 {
-    if (create_buffers(r, err) || pick_workgroup(r->cfg, r->ocl, &r->local, err))
+    if (create_buffers(r, err) || pick_workgroup(r->cfg, r->ocl, r->shape, &r->local, err))
         return -1;
     r->chunk = r->cfg->mc.chunk > 0 ? r->cfg->mc.chunk : auto_chunk(r->shape);
     if (alloc_host_copy(r->t, &r->tmp, err))

@@ -104,7 +104,7 @@ static const key_def keys[] = {
      "independent batches for standard errors"},
     {"mc", "seed", K_LLONG, F(mc.seed), 0, 9.2e18, "1", NULL, "random seed (Philox key)"},
     {"mc", "workgroup", K_INT, F(mc.workgroup), 0, 4096, "0", NULL,
-     "work-group size, 0 = ppbench picks (64); results do not depend on it"},
+     "work-group size, 0 = ppbench picks (1 on a CPU, 64 on a GPU); results do not depend on it"},
     {"mc", "chunk", K_LLONG, F(mc.chunk), 0, 1e12, "0", NULL,
      "photons per kernel launch, 0 = sized to the device (results do not depend on it)"},
     {"mc", "first", K_LLONG, F(mc.first), 0, 1e13, "0", NULL,
