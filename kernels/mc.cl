@@ -211,8 +211,11 @@ inline ulong ppb_mc_hsum(const vulong *v)
 
 /* Cell-tally additions waiting to be made, flushed PPB_MC_PEND at a time (issue 21: the lock
  * add of each exit, made at once, was a sixth of the kernel's time, stalled behind the step's
- * pending stores and the cell's cache miss). A flush first reads every pending cell, so their
- * cache misses overlap, then adds; integer sums do not depend on the order of the additions. */
+ * pending stores and the cell's cache miss). Each cell is prefetched when its addition is
+ * queued (ppb_mc_tally), so that its miss overlaps the steps until the flush (a load there
+ * would hold up retirement until the line came); a flush first reads every pending cell, so
+ * the misses left overlap, then adds. Integer sums do not depend on the order of the
+ * additions. */
 #define PPB_MC_PEND 32
 typedef struct ppb_mc_pending {
     size_t cell[PPB_MC_PEND];
@@ -445,7 +448,12 @@ PPB_MC_HOT void ppb_mc_tally(const ppb_mc_params *p, const ppb_mc_edges *e, cons
     for (uint b = sbits; b; b &= b - 1) {
         int l = ppb_mc_low_lane(b);
         size_t cell = (xbits >> l) & 1 ? exact_cell[l] : (size_t)(uint)cells[l];
+        /* the cells' lines, for writing (ppb_mc_pending): clang's builtin, as OpenCL's
+         * prefetch() is a no-op in PoCL */
+        __builtin_prefetch(base + PPB_MC_TALLY_ALL * p->ncells + cell, 1, 3);
         pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = qs[l];
+        if (ns[l] == 1)
+            __builtin_prefetch(base + PPB_MC_TALLY_ONCE * p->ncells + cell, 1, 3);
         /* mc1's addition, kept only for a once-scattered photon (no branch to mispredict) */
         pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n] = qs[l];
         pend->n += ns[l] == 1;
