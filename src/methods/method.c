@@ -20,16 +20,6 @@ void ppb_ctx_close(ppb_run_ctx *ctx)
     ctx->ocl_open = 0;
 }
 
-int ppb_method_refuse_refractive(const ppb_config *cfg, const char *id, ppb_err *err)
-{
-    if (cfg->scene.n <= 1.0)
-        return 0;
-    return ppb_config_key_fail(cfg, "medium", "n", err,
-                               "n > 1 is not implemented by method %s yet (issue 18): it would "
-                               "ignore the refractive boundaries; leave %s out at n > 1",
-                               id, id);
-}
-
 const ppb_result *ppb_ctx_prior(const ppb_run_ctx *ctx, const char *id)
 {
     for (int i = 0; i < ctx->nprior; i++)

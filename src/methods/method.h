@@ -36,11 +36,6 @@ typedef struct ppb_run_ctx {
 int ppb_ctx_ocl(ppb_run_ctx *ctx, ppb_ocl **ocl, ppb_err *err);
 void ppb_ctx_close(ppb_run_ctx *ctx);
 
-/* Refuses [medium] n > 1 for a method whose model has no refractive boundaries (yet): run as
- * if n were 1 it would answer another question. A method's `check` hook calls it until the
- * method implements reference "Refractive boundaries". */
-int ppb_method_refuse_refractive(const ppb_config *cfg, const char *id, ppb_err *err);
-
 /* The complete (not partial) result `id` among ctx->prior, or NULL. */
 const ppb_result *ppb_ctx_prior(const ppb_run_ctx *ctx, const char *id);
 
