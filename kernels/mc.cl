@@ -291,14 +291,52 @@ typedef struct ppb_mc_state {
 } ppb_mc_state;
 
 /* The work-item's photons in order: the m-th is first + off + batches m, m = q0, q0 + P, ...
- * (n: the end). */
+ * (n: the end), with the entry words (Philox word 0 of the counter (i mod 2^32, i / 2^32, 0, 1),
+ * for photon i) of the next ones made LANES at a time: word[used + j] is the photon m + j P's. */
 typedef struct ppb_mc_queue {
     ulong m, n, step, base, stride; /* next m, end, P, first + off, batches */
+    uint word[2 * LANES];
+    int used;
 } ppb_mc_queue;
+
+/* The entry words of the photons m0 + j P, j = 0 .. LANES - 1, into w, by one vector Philox
+ * (issue 21: a scalar one per photon was a tenth of the kernel's time, one on all lanes at
+ * every refill 7%). */
+PPB_MC_HOT void ppb_mc_entry_words(const ppb_mc_params *p, const ppb_mc_queue *q, ulong m0, uint *w)
+{
+    vulong photon =
+        (vulong)q->base + (vulong)q->stride * ((vulong)m0 + CONVERT_VULONG(PPB_MC_IOTA) * q->step);
+    ppb_mc_vctr c = {CONVERT_VUINT(photon), CONVERT_VUINT(photon >> 32), (vuint)0, (vuint)1};
+    c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
+    VSTORE(c.v0, 0, w);
+}
+
+/* The entry points on S1 of the queue's next photons for the lanes of bits, in lane order (the
+ * k-th lane of bits takes word used + k), as a vector (other lanes 0); the words used are
+ * dropped and the next LANES made once fewer than LANES are left. */
+PPB_MC_HOT vfloat ppb_mc_entry_x(const ppb_mc_params *p, ppb_mc_queue *q, uint bits)
+{
+    int count = popcount(bits);
+    if (q->used + count >= LANES)
+        ppb_mc_entry_words(p, q, q->m + (ulong)(LANES - q->used) * q->step, q->word + LANES);
+    vfloat x = (vfloat)0.0f;
+    int k = q->used;
+    for (uint b = bits; b; b &= b - 1) {
+        float xl = p->enter_x0 + p->enter_width * ppb_mc_uniform1(q->word[k++]);
+        x = select(x, (vfloat)xl, PPB_MC_IOTA == (vuint)ppb_mc_low_lane(b));
+    }
+    q->used += count;
+    if (q->used >= LANES) {
+        q->used -= LANES;
+        for (int j = 0; j < LANES; j++)
+            q->word[j] = q->word[j + LANES];
+    }
+    return x;
+}
 
 /* Refill finished lanes only once this many have finished (or none flies): a photon takes
  * about six steps, so with 8 lanes some lane finishes on three steps in four, and a refill (the
- * tallies, exit bins, ranks and entry Philox, all on every lane) then ran almost every step;
+ * tallies, exit bins and ranks, all on every lane) then ran almost every step;
  * waiting for a quarter of the lanes idles a few lanes for a step or two instead. Which lane
  * traces a photon never changes its path. */
 #ifndef PPB_MC_REFILL
@@ -307,22 +345,16 @@ typedef struct ppb_mc_queue {
 
 /* Restarts every finished lane (bits: s->done as lane bits) with the queue's next photons, in
  * lane order (a lane's rank: the finished lanes below it), or idles it when the queue is empty.
- * A photon enters on S1 (y = 0) along w_L, at the point its entry word (Philox word 0 of the
- * counter (i mod 2^32, i / 2^32, 0, 1)) gives in the tube. Returns the restarted lanes' bits. */
+ * A photon enters on S1 (y = 0) along w_L, at the point its entry word gives in the tube
+ * (ppb_mc_entry_x). Returns the restarted lanes' bits. */
 PPB_MC_HOT uint ppb_mc_refill(const ppb_mc_params *p, ppb_mc_state *s, ppb_mc_queue *q, uint bits)
 {
     vuint below = ((vuint)1 << PPB_MC_IOTA) - 1u;
     vulong m = (vulong)q->m + CONVERT_VULONG(popcount((vuint)bits & below)) * q->step;
-    q->m += (ulong)popcount(bits) * q->step;
     vint start = s->done & CONVERT_VINT(m < (vulong)q->n);
     vulong photon = (vulong)q->base + (vulong)q->stride * m;
     vuint c0 = CONVERT_VUINT(photon), c1 = CONVERT_VUINT(photon >> 32);
-    vfloat x = (vfloat)0.0f;
-    if (p->tube) {
-        ppb_mc_vctr c = {c0, c1, (vuint)0, (vuint)1};
-        c = ppb_mc_philox(c, (uint)p->seed, (uint)(p->seed >> 32));
-        x = p->enter_x0 + p->enter_width * ppb_mc_uniform(c.v0);
-    }
+    vfloat x = p->tube ? ppb_mc_entry_x(p, q, bits) : (vfloat)0.0f;
     vfloat zero = (vfloat)0.0f;
     s->x = select(s->x, x, start), s->y = select(s->y, zero, start);
     s->wx = select(s->wx, (vfloat)p->light_x, start);
@@ -338,6 +370,7 @@ PPB_MC_HOT uint ppb_mc_refill(const ppb_mc_params *p, ppb_mc_state *s, ppb_mc_qu
     s->need_tau |= start;
     s->active = select(s->active, start, s->done);
     s->done = s->left = s->side = (vint)0;
+    q->m += (ulong)popcount(bits) * q->step;
     return ppb_mc_bits(start);
 }
 
@@ -651,6 +684,9 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     ppb_mc_state s = {0};
     s.done = (vint)-1; /* every lane finished: the first refill fills them all */
     ppb_mc_queue queue = {q0, n, per_batch, p.first + off, batches};
+    queue.used = 0;
+    if (p.tube)
+        ppb_mc_entry_words(&p, &queue, q0, queue.word);
     uint flying = ppb_mc_refill(&p, &s, &queue, (1u << LANES) - 1u);
     while (flying) {
         ppb_mc_step(&p, &s, medium);
