@@ -217,6 +217,14 @@ inline ulong ppb_mc_hsum(const vulong *v)
  * the misses left overlap, then adds. Integer sums do not depend on the order of the
  * additions. */
 #define PPB_MC_PEND 32
+/* A tally cell's line, for writing: clang's builtin on CPUs (the host sets
+ * PPB_MC_CPU_PREFETCH), as OpenCL's prefetch() is an empty function in PoCL's kernel library;
+ * OpenCL's own elsewhere. */
+#if PPB_MC_CPU_PREFETCH
+#define PPB_MC_PREFETCH(ptr) __builtin_prefetch((ptr), 1, 3)
+#else
+#define PPB_MC_PREFETCH(ptr) prefetch((ptr), 1)
+#endif
 typedef struct ppb_mc_pending {
     size_t cell[PPB_MC_PEND];
     ulong q[PPB_MC_PEND];
@@ -481,12 +489,10 @@ PPB_MC_HOT void ppb_mc_tally(const ppb_mc_params *p, const ppb_mc_edges *e, cons
     for (uint b = sbits; b; b &= b - 1) {
         int l = ppb_mc_low_lane(b);
         size_t cell = (xbits >> l) & 1 ? exact_cell[l] : (size_t)(uint)cells[l];
-        /* the cells' lines, for writing (ppb_mc_pending): clang's builtin, as OpenCL's
-         * prefetch() is a no-op in PoCL */
-        __builtin_prefetch(base + PPB_MC_TALLY_ALL * p->ncells + cell, 1, 3);
+        PPB_MC_PREFETCH(base + PPB_MC_TALLY_ALL * p->ncells + cell);
         pend->cell[pend->n] = PPB_MC_TALLY_ALL * p->ncells + cell, pend->q[pend->n++] = qs[l];
         if (ns[l] == 1)
-            __builtin_prefetch(base + PPB_MC_TALLY_ONCE * p->ncells + cell, 1, 3);
+            PPB_MC_PREFETCH(base + PPB_MC_TALLY_ONCE * p->ncells + cell);
         /* mc1's addition, kept only for a once-scattered photon (no branch to mispredict) */
         pend->cell[pend->n] = PPB_MC_TALLY_ONCE * p->ncells + cell, pend->q[pend->n] = qs[l];
         pend->n += ns[l] == 1;

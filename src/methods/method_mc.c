@@ -140,6 +140,7 @@ typedef struct mc_shape {
     int lanes;
     long long items;
     size_t local; /* work-group size when [mc] workgroup is 0 (pick_workgroup) */
+    int cpu;      /* prefetch tally lines by clang's builtin (mc.cl PPB_MC_CPU_PREFETCH) */
 } mc_shape;
 
 static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
@@ -168,6 +169,7 @@ static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
     }
     shape->items = units * (cpu ? 1024 : 2048);
     shape->local = cpu ? 1 : 64;
+    shape->cpu = cpu;
     return 0;
 }
 
@@ -430,7 +432,8 @@ int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tall
     if (device_shape(ocl, &shape, err))
         return -1;
     char opts[64];
-    snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d", shape.lanes);
+    snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d -D PPB_MC_CPU_PREFETCH=%d", shape.lanes,
+             shape.cpu);
     mc_device d = {0};
     int status = ppb_ocl_build(ocl, "mc.cl", opts, &d.prog, err);
     if (status == 0)
