@@ -322,7 +322,7 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
     if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err) ||
-        ppb_rte2d_write_refinements(ex->cfg, dir, err) || write_provenance(ex, dir, err) ||
+        ppb_rte2d_write_refinements(&ex->rte2d_study, dir, err) || write_provenance(ex, dir, err) ||
         write_config_ini(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);

@@ -19,11 +19,18 @@ int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
         ctx->cfg = &defaults;
     }
     setvbuf(out, NULL, _IOLBF, 0);
-    /* $PPBENCH_PERF_ONLY=mc runs the Monte Carlo alone (paired timing runs of two builds). */
+    /* $PPBENCH_PERF_ONLY=mc runs the Monte Carlo alone (paired timing runs of two builds),
+     * =rte2d rte2d alone. */
     const char *only = getenv("PPBENCH_PERF_ONLY");
     if (only && strcmp(only, "mc") == 0) {
         fprintf(out, "== Monte Carlo (OpenCL)\n");
         int rc = ppb_perf_mc(ctx, out, err);
+        ctx->cfg = given;
+        return rc;
+    }
+    if (only && strcmp(only, "rte2d") == 0) { /* rte2d alone, likewise */
+        fprintf(out, "== rte2d: the refinement iterated (OpenCL marches)\n");
+        int rc = ppb_perf_rte2d(ctx, out, err);
         ctx->cfg = given;
         return rc;
     }

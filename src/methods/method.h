@@ -13,6 +13,7 @@
 #include "model/result.h"
 
 struct ppb_march_cache;
+struct ppb_rte2d_study;
 
 /* What a method gets: the experiment, an OpenCL device opened on first use, caches that
  * outlive one experiment (a sweep reuses the marcher's tables across grid points), and the
@@ -30,6 +31,9 @@ typedef struct ppb_run_ctx {
     const ppb_result *prior;
     int nprior;
     const char *ref_cache; /* --ref-cache DIR: mc's tallies reused from there (mc_cache.h) */
+    /* Owned by the caller: where rte2d records its refinement study (method_rte2d.h), which
+     * `run` writes with the output set; NULL: none is run (a sweep point writes no table). */
+    struct ppb_rte2d_study *rte2d_study;
 } ppb_run_ctx;
 
 /* The device, opened on first call and shared by every method of the run. */

@@ -20,6 +20,7 @@
 #define PPB_METHOD_RTE2D_H
 
 #include "methods/method.h"
+#include "model/metrics.h"
 
 /* What a solve took (for `make perf` and tests). */
 typedef struct ppb_rte2d_stats {
@@ -37,15 +38,25 @@ typedef struct ppb_rte2d_stats {
     double t_record;   /* seconds it took (in t_total) */
 } ppb_rte2d_stats;
 
+/* The refinement study of a converged run (reference: rte2d_refinements.csv), the run's own
+ * record: its caller owns it and hands it over as ppb_run_ctx.rte2d_study (`ppbench run` does,
+ * per config, and writes it with the output set; a sweep point, which writes no table, does
+ * not, and runs no study). */
+#define PPB_RTE2D_RUNGS 10
+typedef struct ppb_rte2d_study {
+    int n;                                   /* rungs recorded; 0: none */
+    int K[PPB_RTE2D_RUNGS];                  /* refinements */
+    double rms[PPB_RTE2D_RUNGS][PPB_NCELLS]; /* rms_rel against the converged; NAN: no points */
+} ppb_rte2d_study;
+
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
-/* The same without the refinement study (tests, `make perf`), reporting what it took (stats may
- * be NULL). */
+/* The method, reporting what it took (tests, `make perf`; stats may be NULL): the refinement
+ * study runs after a converged solve where ctx->rte2d_study is set. */
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
 
-/* Writes dir/rte2d_refinements.csv (reference: Outputs) from the refinement study of the last
- * converged rte2d run of cfg (the same experiment name and output directory); nothing when there
- * was none. */
-int ppb_rte2d_write_refinements(const ppb_config *cfg, const char *dir, ppb_err *err);
+/* Writes dir/rte2d_refinements.csv (reference: Outputs) from study; nothing when study is NULL
+ * or holds no rung. */
+int ppb_rte2d_write_refinements(const ppb_rte2d_study *study, const char *dir, ppb_err *err);
 
 #endif

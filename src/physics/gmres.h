@@ -18,10 +18,23 @@
 /* y = A x; returns nonzero (with err set) to stop the solve. */
 typedef int (*ppb_matvec_fn)(void *ctx, const double *x, double *y, ppb_err *err);
 
+/* The first cycle's Arnoldi relation A V_k = V_(k+1) H_k, r_0 = b - A x_0 = beta v_1, H_k the
+ * (k + 1) x k Hessenberg matrix as the Gram-Schmidt built it (before the Givens rotations):
+ * with it a caller applies polynomials in A to r_0 without further products (rte2d's refinement
+ * study: (I - A)^j r_0 for j <= k). Kept only when the solve ends in its first cycle (a restart
+ * overwrites V); else k = 0 and V = H = NULL. */
+typedef struct ppb_gmres_basis {
+    int k;       /* Arnoldi steps */
+    double beta; /* ||r_0|| */
+    double *V;   /* [k + 1][n], orthonormal v_1 .. v_(k+1); the caller frees it */
+    double *H;   /* [k + 1][k] row-major; the caller frees it */
+} ppb_gmres_basis;
+
 typedef struct ppb_gmres_opts {
-    int restart;  /* Krylov vectors per cycle */
-    int max_iter; /* products A x at most */
-    double tol;   /* stop when ||b - A x|| <= tol ||b|| */
+    int restart;           /* Krylov vectors per cycle */
+    int max_iter;          /* products A x at most */
+    double tol;            /* stop when ||b - A x|| <= tol ||b|| */
+    ppb_gmres_basis *keep; /* NULL, or receives the first cycle's relation (above) */
 } ppb_gmres_opts;
 
 typedef struct ppb_gmres_info {
