@@ -80,8 +80,8 @@ static int draw_refinements(const char *dir, const char *name, ppb_err *err)
         fprintf(gp,
                 "set logscale xy\nset grid\nset xrange [0.8:*]\n"
                 "set key outside right top vertical title 'cell'\n"
-                "set title '%s: rte2d exit radiance after K refinements of Eq. 5 from I_pp, "
-                "RMS against the converged solve'\n"
+                "set title '%s: rte2d after K refinements of Eq. 5 from I_pp, RMS against "
+                "the converged solve'\n"
                 "set xlabel 'refinements K'\nset ylabel 'RMS (%%)'\n"
                 "set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 "
                 "lc rgb '#444444'\n"
