@@ -10,7 +10,10 @@
  *   the default ($PPBENCH_CACHE), with the same sweep.csv;
  * - --jobs 2 reports the sweep's point count, not one worker's (issue 16);
  * - a 1-D sweep of mc alone succeeds without a line plot (nothing is measured against mc), and
- *   with mp beside it draws sweep_rms.png. */
+ *   with mp beside it draws sweep_rms.png;
+ * - a sweep over the refractive index (issue 18) writes each point's `specular` column: the
+ *   Fresnel reflectance of the beam at normal incidence, ((n - 1) / (n + 1))^2 (0 and 1/36 for
+ *   n = 1 and 1.4), for every method. */
 #include "cliutil.h"
 
 #include <sys/stat.h>
@@ -207,6 +210,37 @@ static void test_reference_only_sweep(void **state)
     assert_int_equal(tu_sh("test -s %s/mp/sweep_rms.png -a -s %s/mp/sweep_rms.pdf", d, d), 0);
 }
 
+static void test_sweep_over_n(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("sweepn");
+    char cfg[1200], args[4096], path[1300];
+    snprintf(cfg, sizeof cfg, "%s/swn.ini", d);
+    tu_write_file(cfg, "[experiment]\nname = swn\nmethods = mc, ss\n[tube]\nsegments_top = 16\n"
+                       "segments_side = 6\n[bins]\ntheta = 4\nphi = 4\n[medium]\nn = 1, 1.4\n"
+                       "[mc]\nphotons = 20000\nbatches = 4\n");
+    snprintf(args, sizeof args, "sweep --quiet --no-ref-cache --out %s/out %s", d, cfg);
+    cli_expect(args, 0, "");
+    snprintf(path, sizeof path, "%s/out/sweep.csv", d);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[4096];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_non_null(strstr(line, "point,medium.n,method,"));
+    assert_non_null(strstr(line, ",ballistic,specular\n"));
+    int rows = 0;
+    while (fgets(line, sizeof line, f)) {
+        /* point,medium.n,method,...,specular */
+        double n = atof(strchr(line, ',') + 1), specular = atof(strrchr(line, ',') + 1);
+        double want = (n - 1) * (n - 1) / ((n + 1) * (n + 1));
+        if (fabs(specular - want) > 1e-9)
+            fail_msg("specular %.10g, want %.10g, in the row %s", specular, want, line);
+        rows++;
+    }
+    fclose(f);
+    assert_int_equal(rows, 6); /* 2 points x (mc, mc1, ss) */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -216,6 +250,7 @@ int main(void)
         cmocka_unit_test(test_sweep_ref_cache),
         cmocka_unit_test(test_jobs_count),
         cmocka_unit_test(test_reference_only_sweep),
+        cmocka_unit_test(test_sweep_over_n),
     };
     return cmocka_run_group_tests_name("sweep", tests, NULL, NULL);
 }

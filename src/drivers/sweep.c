@@ -71,7 +71,7 @@ static void write_header(const ppb_grid *grid, FILE *f)
     fprintf(f, ",method");
     for (int c = 0; c < PPB_NCELLS; c++)
         fprintf(f, ",rms_%s", ppb_cell_name(c));
-    fprintf(f, ",noise_R_x0,noise_T_x0,R,T,sides,absorbed,ballistic\n");
+    fprintf(f, ",noise_R_x0,noise_T_x0,R,T,sides,absorbed,ballistic,specular\n");
 }
 
 /* One row per method of a point, from the method on: the RMS per summary cell against the
@@ -100,8 +100,8 @@ static int write_rows(const ppb_experiment *ex, FILE *f, ppb_err *err)
         }
         ppb_totals t = ex->res[m].totals;
         ppb_totals_complete(&t);
-        fprintf(f, ",%.6g,%.6g,%.10g,%.10g,%.10g,%.10g,%.10g\n", x0[0].noise_rel, x0[1].noise_rel,
-                t.R, t.T, t.sides, t.absorbed, t.ballistic);
+        fprintf(f, ",%.6g,%.6g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", x0[0].noise_rel,
+                x0[1].noise_rel, t.R, t.T, t.sides, t.absorbed, t.ballistic, t.specular);
     }
     free(pts);
     return 0;
