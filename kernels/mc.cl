@@ -7,7 +7,7 @@
  * no photon can run forever), and leaves at its first boundary crossing when n = 1. At n > 1
  * (issue 18) it enters refracted with weight 1 - F(theta_L) and at every boundary hit is
  * reflected specularly with probability F(cos theta_i) or leaves refracted into air, the exit
- * binned by its air-side direction (ppb_mc_boundary). Its exit weight goes into integer
+ * binned by its air-side direction (ppb_mc_boundaries). Its exit weight goes into integer
  * fixed-point tallies (kernels/mc_params.h), so sums do not depend on the order of the atomic
  * additions.
  *
@@ -501,48 +501,52 @@ PPB_MC_HOT void ppb_mc_tally(const ppb_mc_params *p, const ppb_mc_edges *e, cons
     }
 }
 
-/* n > 1: a photon that has reached a wall (left; side: a side wall), in the scalar state of its
- * lane. With probability F(cos theta_i) (r, the step's unused fourth word) it is reflected
- * specularly and flies on (*left = 0); else it leaves along the refracted air-side direction
- * (tangential components times n, Snell), which ppb_mc_tally bins. Total internal reflection
- * has F = 1. */
-inline void ppb_mc_boundary(const ppb_mc_params *p, int side, uint r, float *wx, float *wy,
-                            float *wz, int *left)
+/* ppb_refract_cos (ppb_fresnel.h) on every lane: the same double operations in the same order,
+ * so each lane's value is the scalar one bit for bit (vector double arithmetic is IEEE, as
+ * scalar; test_mc's test_vector_fresnel_matches_scalar checks it, ppb_mc_fresnel_check). */
+PPB_MC_HOT vdouble ppb_mc_vrefract_cos(vdouble cos_i, double n_rel)
 {
-    double wn = side ? (double)*wx : (double)*wy;
-    double cos_i = fabs(wn), inv_n = 1.0 / p->n_in;
-    double cos_t = ppb_refract_cos(cos_i, inv_n);
-    if (cos_t < 0.0 || (double)ppb_mc_uniform1(r) < ppb_fresnel(cos_i, inv_n)) {
-        if (side)
-            *wx = -*wx;
-        else
-            *wy = -*wy;
-        *left = 0;
-        return;
-    }
-    double n = p->n_in, ta = n * (double)*wx, tb = n * (double)*wy;
-    double tz = n * (double)*wz, out = copysign(cos_t, wn);
-    if (side)
-        ta = out;
-    else
-        tb = out;
-    *wx = (float)ta, *wy = (float)tb, *wz = (float)tz;
+    vdouble sin2_t = (1.0 - cos_i * cos_i) / (n_rel * n_rel);
+    return select(sqrt(1.0 - sin2_t), (vdouble)-1.0, sin2_t >= 1.0);
 }
 
-/* ppb_mc_boundary for every lane in *left, lane by lane (n > 1 only). */
+/* ppb_fresnel (ppb_fresnel.h) on every lane, given the lane's ppb_refract_cos (cos_t): the same
+ * operations in the same order; 1 under total internal reflection (cos_t < 0). */
+PPB_MC_HOT vdouble ppb_mc_vfresnel(vdouble cos_i, vdouble cos_t, double n_rel)
+{
+    vdouble rs = (cos_i - n_rel * cos_t) / (cos_i + n_rel * cos_t);
+    vdouble rp = (n_rel * cos_i - cos_t) / (n_rel * cos_i + cos_t);
+    return select(0.5 * (rs * rs + rp * rp), (vdouble)1.0, cos_t < 0.0);
+}
+
+/* n > 1: every lane whose photon has reached a wall (*left; side: a side wall), all lanes at
+ * once. With probability F(cos theta_i) (r, the step's unused fourth word) it is reflected
+ * specularly and flies on (its *left cleared); else it leaves along the refracted air-side
+ * direction (tangential components times n, Snell), which ppb_mc_tally bins. Total internal
+ * reflection has F = 1. In double, as ppb_fresnel.h (issue 21: that scalar code lane by lane,
+ * through memory, was a quarter of the kernel's time at n = 1.4). */
 PPB_MC_HOT void ppb_mc_boundaries(const ppb_mc_params *p, ppb_mc_state *s, vint *left, vint side,
                                   vuint r)
 {
-    float wx[LANES], wy[LANES], wz[LANES];
-    int lf[LANES], sd[LANES];
-    uint rr[LANES];
-    VSTORE(s->wx, 0, wx), VSTORE(s->wy, 0, wy), VSTORE(s->wz, 0, wz);
-    VSTORE(*left, 0, lf), VSTORE(side, 0, sd), VSTORE(r, 0, rr);
-    for (int l = 0; l < LANES; l++)
-        if (lf[l])
-            ppb_mc_boundary(p, sd[l], rr[l], wx + l, wy + l, wz + l, lf + l);
-    s->wx = VLOAD(0, wx), s->wy = VLOAD(0, wy), s->wz = VLOAD(0, wz);
-    *left = VLOAD(0, lf);
+    vlong side_l = CONVERT_VLONG(side);
+    vdouble wx = CONVERT_VDOUBLE(s->wx), wy = CONVERT_VDOUBLE(s->wy);
+    vdouble wn = select(wy, wx, side_l);
+    vdouble cos_i = fabs(wn);
+    double inv_n = 1.0 / p->n_in, n = p->n_in;
+    vdouble cos_t = ppb_mc_vrefract_cos(cos_i, inv_n);
+    vdouble f = ppb_mc_vfresnel(cos_i, cos_t, inv_n);
+    vlong reflect = (cos_t < 0.0) | (CONVERT_VDOUBLE(ppb_mc_uniform(r)) < f);
+    vint at = *left, bounce = at & CONVERT_VINT(reflect), leave = at & ~bounce;
+    /* reflected: the normal component reversed */
+    vfloat rx = select(s->wx, -s->wx, side), ry = select(-s->wy, s->wy, side);
+    /* left: the air-side direction, the normal component the refracted cosine */
+    vdouble out = copysign(cos_t, wn);
+    vdouble ta = select(n * wx, out, side_l), tb = select(out, n * wy, side_l);
+    vdouble tz = n * CONVERT_VDOUBLE(s->wz);
+    s->wx = select(select(s->wx, rx, bounce), CONVERT_VFLOAT(ta), leave);
+    s->wy = select(select(s->wy, ry, bounce), CONVERT_VFLOAT(tb), leave);
+    s->wz = select(s->wz, CONVERT_VFLOAT(tz), leave);
+    *left = leave;
 }
 
 /* One step of every flying lane: a flight leg to the next interaction, the step plane or a
@@ -736,6 +740,38 @@ __kernel void ppb_mc_philox_check(ulong seed, __global uint *mismatches)
         for (int w = 0; w < 4; w++)
             if (r.v[w] != out[w][l])
                 atomic_inc(mismatches);
+    }
+}
+
+/* Self-check for tests/test_mc.c: ppb_mc_vrefract_cos and ppb_mc_vfresnel against the scalar
+ * ppb_refract_cos and ppb_fresnel (ppb_fresnel.h) bit for bit, at relative index n_rel, on the
+ * incidence cosines (g LANES + l + 0.5) / (global LANES) plus 0, 1 and the critical cosine
+ * sqrt(1 - n_rel^2) and its neighbours (work-item 0; at 2 lanes only 0 and the critical one);
+ * counts mismatching values into *mismatches. */
+__kernel void ppb_mc_fresnel_check(double n_rel, __global uint *mismatches)
+{
+    uint g = (uint)get_global_id(0), total = (uint)get_global_size(0) * LANES;
+    double c[LANES];
+    for (int l = 0; l < LANES; l++)
+        c[l] = ((double)(g * LANES + (uint)l) + 0.5) / (double)total;
+    if (g == 0) {
+        double crit = n_rel < 1.0 ? sqrt(1.0 - n_rel * n_rel) : 0.0;
+        c[0] = 0.0, c[1] = 1.0;
+        c[LANES - 1] = crit;
+#if LANES >= 4
+        c[2] = nextafter(crit, 0.0), c[3] = nextafter(crit, 1.0);
+#endif
+    }
+    vdouble cos_i = VLOAD(0, c);
+    vdouble cos_t = ppb_mc_vrefract_cos(cos_i, n_rel);
+    vdouble f = ppb_mc_vfresnel(cos_i, cos_t, n_rel);
+    double t[LANES], fl[LANES];
+    VSTORE(cos_t, 0, t), VSTORE(f, 0, fl);
+    for (int l = 0; l < LANES; l++) {
+        if (as_ulong(t[l]) != as_ulong(ppb_refract_cos(c[l], n_rel)))
+            atomic_inc(mismatches);
+        if (as_ulong(fl[l]) != as_ulong(ppb_fresnel(c[l], n_rel)))
+            atomic_inc(mismatches);
     }
 }
 

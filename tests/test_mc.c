@@ -1,9 +1,10 @@
 /* test_mc.c: the photon Monte Carlo reference (issue 4): chi-square tests of the kernel's HG and
- * azimuth samplers, the semi-infinite albedo and the roulette balance, the ballistic beam,
- * published slab values, single scattering against its closed form, bit-identity across
- * work-group sizes, chunkings and shards, seeds, the tube's mirror symmetry, target noise and
- * interruption. Photon counts are modest (the suite runs in well under two minutes on two
- * cores); every statistical bound is in units of the run's own standard error. */
+ * azimuth samplers, the vector Fresnel code against the scalar one, the semi-infinite albedo and
+ * the roulette balance, the ballistic beam, published slab values, single scattering against its
+ * closed form, bit-identity across work-group sizes, chunkings and shards, seeds, the tube's mirror
+ * symmetry, target noise and interruption. Photon counts are modest (the suite runs in well under
+ * two minutes on two cores); every statistical bound is in units of the run's own standard error.
+ */
 #include "testutil.h"
 
 #include "model/metrics.h"
@@ -621,6 +622,54 @@ static void test_philox_matches_random123(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
+/* The kernel's vector Fresnel reflectance and refracted cosine (ppb_mc_vfresnel,
+ * ppb_mc_vrefract_cos, which the n > 1 boundary runs on all lanes at once) equal the scalar
+ * ppb_fresnel.h code bit for bit (the same IEEE double operations in the same order; a
+ * contraction into fma in one and not the other would show here): 4096 x lanes incidence
+ * cosines spread over [0, 1], with 0, 1 and the critical cosine and its neighbours, at the
+ * relative indices of leaving n = 1.4, 1.33 and 2.5 and of entering n = 1.4, at 16, 8 and 2
+ * lanes. */
+static void test_vector_fresnel_matches_scalar(void **state)
+{
+    (void)state;
+    mc_fixture f = {0};
+    fixture_init(&f, tu_tube(), 0);
+    ppb_ocl *ocl;
+    ppb_err err;
+    if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
+        fail_msg("%s", err.msg);
+    const char *opts[3] = {"-D PPB_MC_LANES=16", "-D PPB_MC_LANES=8", "-D PPB_MC_LANES=2"};
+    const double n_rel[4] = {1.0 / 1.4, 1.0 / 1.33, 1.0 / 2.5, 1.4};
+    for (int i = 0; i < 3; i++) {
+        cl_program prog;
+        cl_kernel k;
+        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
+            ppb_ocl_kernel(prog, "ppb_mc_fresnel_check", &k, &err))
+            fail_msg("%s", err.msg);
+        for (int j = 0; j < 4; j++) {
+            cl_int rc;
+            cl_uint zero = 0, bad = 1;
+            cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                                        sizeof zero, &zero, &rc);
+            assert_int_equal(rc, CL_SUCCESS);
+            size_t global = 4096;
+            assert_int_equal(clSetKernelArg(k, 0, sizeof n_rel[j], &n_rel[j]), CL_SUCCESS);
+            assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
+            assert_int_equal(
+                clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
+                CL_SUCCESS);
+            assert_int_equal(
+                clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof bad, &bad, 0, NULL, NULL),
+                CL_SUCCESS);
+            assert_int_equal(bad, 0);
+            clReleaseMemObject(buf);
+        }
+        clReleaseKernel(k);
+        clReleaseProgram(prog);
+    }
+    ppb_ctx_close(&f.ctx);
+}
+
 /* The kernel bins an exit in float vectors and sends a lane to the scalar double code only
  * where float cannot decide (issue 21): checked against the conventions' own binning
  * (ppb_segment_of, ppb_dir_bin with atan2, in the kernel's double) on 4096 x lanes exits per
@@ -885,6 +934,7 @@ int main(void)
         cmocka_unit_test(test_hg_sampler_chi_square),
         cmocka_unit_test(test_philox_matches_random123),
         cmocka_unit_test(test_vector_bins_match_conventions),
+        cmocka_unit_test(test_vector_fresnel_matches_scalar),
         cmocka_unit_test(test_semi_infinite_albedo_and_roulette),
         cmocka_unit_test(test_ballistic),
         cmocka_unit_test(test_slab_published),
