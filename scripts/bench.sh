@@ -24,16 +24,30 @@ mapfile -t cases < configs/study.list
 # bench that only adds a method traces no photon. PPB_REF_CACHE moves it.
 cache=${PPB_REF_CACHE:-build/ref-cache}
 mkdir -p "$out"
-t0=$(date +%s)
+# The whole study's ETA weighs the cases by their cost in the previous study in $out (its
+# timings.csv: every method's seconds, mc1 being part of mc's, plus 5 s of writing and
+# figures), read before this run overwrites them: the n = 1.4 cases cost about twice the
+# others. Cases without a previous timing weigh as the mean of those with one (1 if none).
+weights=() known=0 nknown=0
+for c in "${cases[@]}"; do
+  w=$(awk -F, 'NR > 1 && $1 != "mc1" {s += $2} END {if (NR > 1) printf "%d", s + 5}' \
+      "$out/$c/timings.csv" 2> /dev/null || true)
+  weights+=("${w:-0}")
+  [ -n "$w" ] && known=$((known + w)) nknown=$((nknown + 1))
+done
+mean=$(( nknown > 0 ? known / nknown : 1 ))
+for i in "${!weights[@]}"; do [ "${weights[$i]}" -gt 0 ] || weights[$i]=$mean; done
+t0=$(date +%s) done_w=0 total_w=0
+for w in "${weights[@]}"; do total_w=$((total_w + w)); done
 for i in "${!cases[@]}"; do
   c=${cases[$i]}
-  # The whole study's ETA: the mean time of the cases done so far times the cases left.
+  # ETA: the time so far scaled by the weight left over the weight done.
   el=$(( $(date +%s) - t0 )) eta=
-  [ "$i" -gt 0 ] && eta=$(printf ', study ETA %ds more' $(( el * (${#cases[@]} - i) / i )))
+  [ "$i" -gt 0 ] && eta=$(printf ', study ETA %ds more' $(( el * (total_w - done_w) / done_w )))
   printf '[%d/%d] %s (%ds elapsed%s)\n' $((i + 1)) ${#cases[@]} "$c" $el "$eta" >&2
+  # ppbench run draws the case's figures itself (scripts/plots.sh, theta_L from provenance).
   ./ppbench run "${sets[@]}" --ref-cache "$cache" --out "$out/$c" "configs/$c.ini"
-  theta=$(awk -F' *= *' '$1 == "theta_deg" {print $2}' "configs/$c.ini")
-  bash scripts/plots.sh "$out/$c" "${theta:-0}"
+  done_w=$((done_w + weights[i]))
 done
 # The quick study's README says what it is: ppbench report copies notes.md into it (and states
 # the photon budget itself, from the cases' provenance.txt).
