@@ -580,6 +580,26 @@ static void test_slab_vs_ppslab(void **state)
     }
 }
 
+/* Runs a self-check kernel k(arg0, __global uint *count) on 4096 work-items with a zeroed
+ * counter; returns the count (the mismatches the kernel found). */
+static cl_uint count_mismatches(ppb_ocl *ocl, cl_kernel k, size_t arg0_size, const void *arg0)
+{
+    cl_int rc;
+    cl_uint zero = 0, bad = 1;
+    cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero,
+                                &zero, &rc);
+    assert_int_equal(rc, CL_SUCCESS);
+    size_t global = 4096;
+    assert_int_equal(clSetKernelArg(k, 0, arg0_size, arg0), CL_SUCCESS);
+    assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
+    assert_int_equal(clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
+                     CL_SUCCESS);
+    assert_int_equal(
+        clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof bad, &bad, 0, NULL, NULL),
+        CL_SUCCESS);
+    clReleaseMemObject(buf);
+    return bad;
+}
 /* The kernel's vector Philox is Random123's philox4x32 (the Philox4x32-10 bijection of Salmon
  * et al. 2011): compared word by word on 4096 x lanes counters, with a key of both halves
  * set, at the lane count the CPU path uses (8) and the GPU path (2). */
@@ -599,23 +619,8 @@ static void test_philox_matches_random123(void **state)
         if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
             ppb_ocl_kernel(prog, "ppb_mc_philox_check", &k, &err))
             fail_msg("%s", err.msg);
-        cl_int rc;
-        cl_uint zero = 0, bad = 1;
-        cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
-                                    sizeof zero, &zero, &rc);
-        assert_int_equal(rc, CL_SUCCESS);
         cl_ulong seed = 0x123456789abcdef0ull;
-        size_t global = 4096;
-        assert_int_equal(clSetKernelArg(k, 0, sizeof seed, &seed), CL_SUCCESS);
-        assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
-        assert_int_equal(
-            clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
-            CL_SUCCESS);
-        assert_int_equal(
-            clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof bad, &bad, 0, NULL, NULL),
-            CL_SUCCESS);
-        assert_int_equal(bad, 0);
-        clReleaseMemObject(buf);
+        assert_int_equal(count_mismatches(ocl, k, sizeof seed, &seed), 0);
         clReleaseKernel(k);
         clReleaseProgram(prog);
     }
@@ -646,24 +651,8 @@ static void test_vector_fresnel_matches_scalar(void **state)
         if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
             ppb_ocl_kernel(prog, "ppb_mc_fresnel_check", &k, &err))
             fail_msg("%s", err.msg);
-        for (int j = 0; j < 4; j++) {
-            cl_int rc;
-            cl_uint zero = 0, bad = 1;
-            cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
-                                        sizeof zero, &zero, &rc);
-            assert_int_equal(rc, CL_SUCCESS);
-            size_t global = 4096;
-            assert_int_equal(clSetKernelArg(k, 0, sizeof n_rel[j], &n_rel[j]), CL_SUCCESS);
-            assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
-            assert_int_equal(
-                clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
-                CL_SUCCESS);
-            assert_int_equal(
-                clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof bad, &bad, 0, NULL, NULL),
-                CL_SUCCESS);
-            assert_int_equal(bad, 0);
-            clReleaseMemObject(buf);
-        }
+        for (int j = 0; j < 4; j++)
+            assert_int_equal(count_mismatches(ocl, k, sizeof n_rel[j], &n_rel[j]), 0);
         clReleaseKernel(k);
         clReleaseProgram(prog);
     }
