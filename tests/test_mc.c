@@ -580,25 +580,49 @@ static void test_slab_vs_ppslab(void **state)
     }
 }
 
-/* Runs a self-check kernel k(arg0, __global uint *count) on 4096 work-items with a zeroed
- * counter; returns the count (the mismatches the kernel found). */
-static cl_uint count_mismatches(ppb_ocl *ocl, cl_kernel k, size_t arg0_size, const void *arg0)
+/* Builds mc.cl with each of the lane options and runs its self-check kernel `name`
+ * (name(arg, __global uint *count)) on 4096 work-items once per value of args (nargs values of
+ * arg_size bytes each), with a zeroed counter: every count (mismatches the kernel found) must
+ * be 0. */
+static void expect_no_mismatches(const char *name, const char *const *opts, int nopts,
+                                 const void *args, size_t arg_size, int nargs)
 {
-    cl_int rc;
-    cl_uint zero = 0, bad = 1;
-    cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof zero,
-                                &zero, &rc);
-    assert_int_equal(rc, CL_SUCCESS);
-    size_t global = 4096;
-    assert_int_equal(clSetKernelArg(k, 0, arg0_size, arg0), CL_SUCCESS);
-    assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
-    assert_int_equal(clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
-                     CL_SUCCESS);
-    assert_int_equal(
-        clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof bad, &bad, 0, NULL, NULL),
-        CL_SUCCESS);
-    clReleaseMemObject(buf);
-    return bad;
+    mc_fixture f = {0};
+    fixture_init(&f, tu_tube(), 0);
+    ppb_ocl *ocl;
+    ppb_err err;
+    if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
+        fail_msg("%s", err.msg);
+    for (int i = 0; i < nopts; i++) {
+        cl_program prog;
+        cl_kernel k;
+        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
+            ppb_ocl_kernel(prog, name, &k, &err))
+            fail_msg("%s", err.msg);
+        for (int j = 0; j < nargs; j++) {
+            cl_int rc;
+            cl_uint zero = 0, bad = 1;
+            cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                                        sizeof zero, &zero, &rc);
+            assert_int_equal(rc, CL_SUCCESS);
+            size_t global = 4096;
+            const void *arg = (const char *)args + (size_t)j * arg_size;
+            assert_int_equal(clSetKernelArg(k, 0, arg_size, arg), CL_SUCCESS);
+            assert_int_equal(clSetKernelArg(k, 1, sizeof buf, &buf), CL_SUCCESS);
+            assert_int_equal(
+                clEnqueueNDRangeKernel(ocl->queue, k, 1, NULL, &global, NULL, 0, NULL, NULL),
+                CL_SUCCESS);
+            assert_int_equal(
+                clEnqueueReadBuffer(ocl->queue, buf, CL_TRUE, 0, sizeof bad, &bad, 0, NULL, NULL),
+                CL_SUCCESS);
+            if (bad)
+                fail_msg("%s (%s, argument %d): %u mismatches", name, opts[i], j, bad);
+            clReleaseMemObject(buf);
+        }
+        clReleaseKernel(k);
+        clReleaseProgram(prog);
+    }
+    ppb_ctx_close(&f.ctx);
 }
 /* The kernel's vector Philox is Random123's philox4x32 (the Philox4x32-10 bijection of Salmon
  * et al. 2011): compared word by word on 4096 x lanes counters, with a key of both halves
@@ -606,25 +630,9 @@ static cl_uint count_mismatches(ppb_ocl *ocl, cl_kernel k, size_t arg0_size, con
 static void test_philox_matches_random123(void **state)
 {
     (void)state;
-    mc_fixture f = {0};
-    fixture_init(&f, tu_tube(), 0);
-    ppb_ocl *ocl;
-    ppb_err err;
-    if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
-        fail_msg("%s", err.msg);
-    const char *opts[2] = {"-D PPB_MC_LANES=8", "-D PPB_MC_LANES=2"};
-    for (int i = 0; i < 2; i++) {
-        cl_program prog;
-        cl_kernel k;
-        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
-            ppb_ocl_kernel(prog, "ppb_mc_philox_check", &k, &err))
-            fail_msg("%s", err.msg);
-        cl_ulong seed = 0x123456789abcdef0ull;
-        assert_int_equal(count_mismatches(ocl, k, sizeof seed, &seed), 0);
-        clReleaseKernel(k);
-        clReleaseProgram(prog);
-    }
-    ppb_ctx_close(&f.ctx);
+    const char *const opts[2] = {"-D PPB_MC_LANES=8", "-D PPB_MC_LANES=2"};
+    const cl_ulong seed = 0x123456789abcdef0ull;
+    expect_no_mismatches("ppb_mc_philox_check", opts, 2, &seed, sizeof seed, 1);
 }
 
 /* The kernel's vector Fresnel reflectance and refracted cosine (ppb_mc_vfresnel,
@@ -637,26 +645,9 @@ static void test_philox_matches_random123(void **state)
 static void test_vector_fresnel_matches_scalar(void **state)
 {
     (void)state;
-    mc_fixture f = {0};
-    fixture_init(&f, tu_tube(), 0);
-    ppb_ocl *ocl;
-    ppb_err err;
-    if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
-        fail_msg("%s", err.msg);
-    const char *opts[3] = {"-D PPB_MC_LANES=16", "-D PPB_MC_LANES=8", "-D PPB_MC_LANES=2"};
+    const char *const opts[3] = {"-D PPB_MC_LANES=16", "-D PPB_MC_LANES=8", "-D PPB_MC_LANES=2"};
     const double n_rel[4] = {1.0 / 1.4, 1.0 / 1.33, 1.0 / 2.5, 1.4};
-    for (int i = 0; i < 3; i++) {
-        cl_program prog;
-        cl_kernel k;
-        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
-            ppb_ocl_kernel(prog, "ppb_mc_fresnel_check", &k, &err))
-            fail_msg("%s", err.msg);
-        for (int j = 0; j < 4; j++)
-            assert_int_equal(count_mismatches(ocl, k, sizeof n_rel[j], &n_rel[j]), 0);
-        clReleaseKernel(k);
-        clReleaseProgram(prog);
-    }
-    ppb_ctx_close(&f.ctx);
+    expect_no_mismatches("ppb_mc_fresnel_check", opts, 3, n_rel, sizeof n_rel[0], 4);
 }
 
 /* The kernel bins an exit in float vectors and sends a lane to the scalar double code only
