@@ -219,6 +219,22 @@ static void test_ppslab_vs_adding_doubling(void **state)
     printf("# pp vs adding-doubling: worst |difference| %.2e over %d cases\n", worst, nc);
 }
 
+/* One radiance.csv row (method,surface,segment,s,theta bin,phi bin,value,se): its fields,
+ * 1 when the line is such a row of `method`, else 0 (the header, another method). */
+typedef struct rad_row {
+    char surf[8];
+    int seg, it, ip;
+    double s0, val, err;
+} rad_row;
+
+static int parse_row(const char *line, const char *method, rad_row *r)
+{
+    char m[64];
+    return sscanf(line, "%63[^,],%7[^,],%d,%lf,%d,%d,%lf,%lf", m, r->surf, &r->seg, &r->s0, &r->it,
+                  &r->ip, &r->val, &r->err) == 8 &&
+           !strcmp(m, method);
+}
+
 /* Reads method's bins of S1 and S2 from radiance.csv into v and se ([2 x 64]); returns the count.
  */
 static int read_bins(const char *path, const char *method, double *v, double *se)
@@ -226,16 +242,14 @@ static int read_bins(const char *path, const char *method, double *v, double *se
     FILE *f = fopen(path, "r");
     if (!f)
         fail_msg("%s: cannot open", path);
-    char line[512], m[64], surf[8];
-    int n = 0, seg, it, ip;
-    double s0, val, err;
+    char line[512];
+    rad_row r;
+    int n = 0;
     while (fgets(line, sizeof line, f))
-        if (sscanf(line, "%63[^,],%7[^,],%d,%lf,%d,%d,%lf,%lf", m, surf, &seg, &s0, &it, &ip, &val,
-                   &err) == 8 &&
-            !strcmp(m, method) && (!strcmp(surf, "S1") || !strcmp(surf, "S2"))) {
-            int k = (surf[1] == '2') * 64 + it * 8 + ip;
+        if (parse_row(line, method, &r) && (!strcmp(r.surf, "S1") || !strcmp(r.surf, "S2"))) {
+            int k = (r.surf[1] == '2') * 64 + r.it * 8 + r.ip;
             if (k < 128)
-                v[k] = val, se[k] = err, n++;
+                v[k] = r.val, se[k] = r.err, n++;
         }
     fclose(f);
     return n;
@@ -475,14 +489,12 @@ static int read_s1_beyond(const char *path, const char *method, double smin, dou
     FILE *f = fopen(path, "r");
     if (!f)
         fail_msg("%s: cannot open", path);
-    char line[512], m[64], surf[8];
-    int n = 0, seg, it, ip;
-    double s0, val, err;
+    char line[512];
+    rad_row r;
+    int n = 0;
     while (fgets(line, sizeof line, f))
-        if (sscanf(line, "%63[^,],%7[^,],%d,%lf,%d,%d,%lf,%lf", m, surf, &seg, &s0, &it, &ip, &val,
-                   &err) == 8 &&
-            !strcmp(m, method) && !strcmp(surf, "S1") && s0 > smin && n < cap)
-            v[n++] = val;
+        if (parse_row(line, method, &r) && !strcmp(r.surf, "S1") && r.s0 > smin && n < cap)
+            v[n++] = r.val;
     fclose(f);
     return n;
 }
