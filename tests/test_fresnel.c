@@ -396,6 +396,22 @@ static void test_ss_vs_mc1_slab(void **state)
  * each over a surface's segments; 32 + 12 segments to keep the march short). Measured at 3e6
  * photons: chi2 (g, theta) = (0, 0) 274 / 256 at the default 128 + 36 segments; the three cases
  * below as printed. */
+/* One tube case of the two tests here and below: W = 10, H = 3, 32 + 12 segments, albedo 0.95,
+ * n = 1.4, 3e6 photons, with medium_extra added to [medium]; ss against mc1 as ss_vs_mc1. */
+static void ss_tube_case(const char *name, double g, double theta, const char *medium_extra)
+{
+    char body[1024];
+    snprintf(body, sizeof body,
+             "[experiment]\nname = %s\ngeometry = tube\nmethods = mc, ss\n[tube]\n"
+             "width = 10\nheight = 3\nsegments_top = 32\nsegments_side = 12\n[medium]\n"
+             "albedo = 0.95\ng = %g\nn = 1.4\n%s[light]\ntheta_deg = %g\n[mc]\n"
+             "photons = 3e6\n",
+             name, g, medium_extra, theta);
+    double chi2;
+    double p = ss_vs_mc1(name, body, 4, &chi2);
+    assert_true(p > 1e-3);
+}
+
 static void test_ss_vs_mc1_tube(void **state)
 {
     (void)state;
@@ -403,17 +419,9 @@ static void test_ss_vs_mc1_tube(void **state)
         double g, theta;
     } cases[3] = {{0.0, 0.0}, {0.0, 45.0}, {0.5, 0.0}};
     for (int i = 0; i < 3; i++) {
-        char name[64], body[1024];
+        char name[64];
         snprintf(name, sizeof name, "fresnel_ss_tube%d", i);
-        snprintf(body, sizeof body,
-                 "[experiment]\nname = %s\ngeometry = tube\nmethods = mc, ss\n[tube]\n"
-                 "width = 10\nheight = 3\nsegments_top = 32\nsegments_side = 12\n[medium]\n"
-                 "albedo = 0.95\ng = %g\nn = 1.4\n[light]\ntheta_deg = %g\n[mc]\n"
-                 "photons = 3e6\n",
-                 name, cases[i].g, cases[i].theta);
-        double chi2;
-        double p = ss_vs_mc1(name, body, 4, &chi2);
-        assert_true(p > 1e-3);
+        ss_tube_case(name, cases[i].g, cases[i].theta, "");
     }
 }
 
@@ -466,20 +474,12 @@ static void test_pp_vs_ppslab(void **state)
 static void test_ss_vs_mc1_steps(void **state)
 {
     (void)state;
-    const char *steps[2] = {"step = density\nsigma_t_right = 0.5\n",
-                            "step = albedo\nalbedo_right = 0.475\n"};
+    const char *steps[2] = {"step = density\nsigma_t_right = 0.5\nstep_x = 0\n",
+                            "step = albedo\nalbedo_right = 0.475\nstep_x = 0\n"};
     for (int i = 0; i < 2; i++) {
-        char name[64], body[1024];
+        char name[64];
         snprintf(name, sizeof name, "fresnel_ss_step%d", i);
-        snprintf(body, sizeof body,
-                 "[experiment]\nname = %s\ngeometry = tube\nmethods = mc, ss\n[tube]\n"
-                 "width = 10\nheight = 3\nsegments_top = 32\nsegments_side = 12\n[medium]\n"
-                 "albedo = 0.95\ng = 0\nn = 1.4\n%sstep_x = 0\n[light]\ntheta_deg = 45\n[mc]\n"
-                 "photons = 3e6\n",
-                 name, steps[i]);
-        double chi2;
-        double p = ss_vs_mc1(name, body, 4, &chi2);
-        assert_true(p > 1e-3);
+        ss_tube_case(name, 0.0, 45.0, steps[i]);
     }
 }
 
