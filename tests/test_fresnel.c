@@ -235,9 +235,10 @@ static int parse_row(const char *line, const char *method, rad_row *r)
            !strcmp(m, method);
 }
 
-/* Reads method's bins of S1 and S2 from radiance.csv into v and se ([2 x 64]); returns the count.
- */
-static int read_bins(const char *path, const char *method, double *v, double *se)
+/* Calls take(r, ctx) on every radiance.csv row of method in file order; returns their count
+ * of take's nonzero answers. */
+static int scan_rows(const char *path, const char *method, int (*take)(const rad_row *, void *),
+                     void *ctx)
 {
     FILE *f = fopen(path, "r");
     if (!f)
@@ -246,13 +247,32 @@ static int read_bins(const char *path, const char *method, double *v, double *se
     rad_row r;
     int n = 0;
     while (fgets(line, sizeof line, f))
-        if (parse_row(line, method, &r) && (!strcmp(r.surf, "S1") || !strcmp(r.surf, "S2"))) {
-            int k = (r.surf[1] == '2') * 64 + r.it * 8 + r.ip;
-            if (k < 128)
-                v[k] = r.val, se[k] = r.err, n++;
-        }
+        if (parse_row(line, method, &r))
+            n += take(&r, ctx) != 0;
     fclose(f);
     return n;
+}
+
+typedef struct bins_ctx {
+    double *v, *se;
+} bins_ctx;
+
+static int take_bin(const rad_row *r, void *ctx)
+{
+    bins_ctx *c = ctx;
+    int k = (r->surf[1] == '2') * 64 + r->it * 8 + r->ip;
+    if ((strcmp(r->surf, "S1") && strcmp(r->surf, "S2")) || k >= 128)
+        return 0;
+    c->v[k] = r->val, c->se[k] = r->err;
+    return 1;
+}
+
+/* Reads method's bins of S1 and S2 from radiance.csv into v and se ([2 x 64]); returns the count.
+ */
+static int read_bins(const char *path, const char *method, double *v, double *se)
+{
+    bins_ctx c = {v, se};
+    return scan_rows(path, method, take_bin, &c);
 }
 
 /* ppslab bin by bin against the Monte Carlo in slab mode at n = 1.4, oblique light (30 deg, so
@@ -483,20 +503,25 @@ static void test_ss_vs_mc1_steps(void **state)
     }
 }
 
+typedef struct beyond_ctx {
+    double smin, *v;
+    int n, cap;
+} beyond_ctx;
+
+static int take_beyond(const rad_row *r, void *ctx)
+{
+    beyond_ctx *c = ctx;
+    if (strcmp(r->surf, "S1") || !(r->s0 > c->smin) || c->n >= c->cap)
+        return 0;
+    c->v[c->n++] = r->val;
+    return 1;
+}
+
 /* pp's S1 rows with segment centre s > smin: values in file order into v (cap entries). */
 static int read_s1_beyond(const char *path, const char *method, double smin, double *v, int cap)
 {
-    FILE *f = fopen(path, "r");
-    if (!f)
-        fail_msg("%s: cannot open", path);
-    char line[512];
-    rad_row r;
-    int n = 0;
-    while (fgets(line, sizeof line, f))
-        if (parse_row(line, method, &r) && !strcmp(r.surf, "S1") && r.s0 > smin && n < cap)
-            v[n++] = r.val;
-    fclose(f);
-    return n;
+    beyond_ctx c = {smin, v, 0, cap};
+    return scan_rows(path, method, take_beyond, &c);
 }
 
 /* pp at n > 1 with a step reads, at every point, its own column's Fresnel slab solution at its
