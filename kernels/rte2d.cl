@@ -1,14 +1,14 @@
-/* rte2d.cl: the marches of `rte2d` (reference: Methods; paper Sec. 3.1, Eq. 5).
+/* rte2d.cl: the sweeps and the exit march of `rte2d` (reference: Methods; paper Sec. 3.1, Eq. 5).
  *
- * One refinement of Eq. 5, I_n = K I_(n-1) + I_0, is a march from every grid node in every
- * direction cell through the piecewise-constant medium (ppb_rte_sweep); the exit radiance is the
- * same march from every segment point in every direction sample of every bin (ppb_rte_exit), as
- * `pp` averages its bins (reference: Bins). Both integrate, along q = p - l w,
+ * One refinement of Eq. 5, I_n = K I_(n-1) + I_0, is a sweep of every direction cell's tracks
+ * through the flat-source regions (ppb_rte_moc, below: conservative by construction). The exit
+ * radiance is a march from every segment point in every direction sample of every bin
+ * (ppb_rte_exit), as `pp` averages its bins (reference: Bins), along q = p - l w:
  *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
- * where J is the grid's scattered-light source per unit scattering coefficient (bilinear in the
- * nodes, rte2d_params.h) and C E the direct beam's first scattering, exact: E = lit exp(-D) with
- * D linear along each piece (C = the cell average of p(w.w_L) in the sweep, p(w.w_L) itself at
- * the exit, as `ss`).
+ * where J is the converged scattered-light source per unit scattering coefficient (bilinear in
+ * the nodes, each node its dual region's average, rte2d_params.h) and C E the direct beam's
+ * first scattering, exact: E = lit exp(-D) with D linear along each piece, C = p(w.w_L) (as
+ * `ss`).
  *
  * The ray is cut into pieces where sigma_t, alpha or D's slope change or the light is cut off
  * (the step plane x = step_x, the light lines x' = step_x and x' = -W/2), as march.cl cuts them.
@@ -54,14 +54,13 @@ inline double rte_beam_images(const ppb_rte_params *P, const double *cb, double 
 }
 
 /* n > 1: the radiance entering at the wall the ray from (px, py) along (mx, my) reaches after
- * length lfar and optical depth d, reflected: e^{-d} F I(mirror, q), I the field rad of the
- * direction mirrored in that face at the wall point q (bilinear), F the cell-averaged
- * reflectance (bnd[4 + face]) in the sweep, exact for the direction (wx, wy) at the exit. This
- * is the boundary condition I_in = F I_out(mirror) of a smooth dielectric face (reference:
- * Medium), so the walls' reflections are part of the operator GMRES inverts. */
+ * length lfar and optical depth d, reflected: e^{-d} F I(mirror, q), I the converged field rad of
+ * the cell holding the direction mirrored in that face at the wall point q (bilinear), F the
+ * exact reflectance of the sample direction (wx, wy): the boundary condition I_in = F I_out(mirror)
+ * of a smooth dielectric face (reference: Medium). */
 inline double rte_wall(const ppb_rte_params *P, __global const double *rad,
-                       __global const double *bnd, int exact, double px, double py, double mx,
-                       double my, double wx, double wy, double lfar, double d)
+                       __global const double *bnd, double px, double py, double mx, double my,
+                       double wx, double wy, double lfar, double d)
 {
     double ly = my > 0.0 ? -py / my : (my < 0.0 ? (-P->height - py) / my : INFINITY);
     double lx = INFINITY;
@@ -69,7 +68,7 @@ inline double rte_wall(const ppb_rte_params *P, __global const double *rad,
         lx = mx > 0.0 ? (0.5 * P->width - px) / mx
                       : (mx < 0.0 ? (-0.5 * P->width - px) / mx : INFINITY);
     int face = lx < ly ? (mx > 0.0 ? PPB_S4 : PPB_S3) : (my > 0.0 ? PPB_S1 : PPB_S2);
-    double F = exact ? ppb_fresnel(fabs(face >= PPB_S3 ? wx : wy), 1.0 / P->n) : bnd[4 + face];
+    double F = ppb_fresnel(fabs(face >= PPB_S3 ? wx : wy), 1.0 / P->n);
     int slot = (int)bnd[face];
     double qx = px + lfar * mx, qy = py + lfar * my;
     return exp(-d) * F * ppb_rte_lookup(P, rad + (long)slot * ppb_rte_nnodes(P), qx, qy);
@@ -79,8 +78,8 @@ inline double rte_wall(const ppb_rte_params *P, __global const double *rad,
  * (-wx, -wy) in the plane per unit length): grid source from plane (if P->diffuse) plus the beam
  * term with coefficient C (if P->beam). */
 inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane, const double *cb,
-                           __global const double *rad, __global const double *bnd, int exact,
-                           double px, double py, double wx, double wy)
+                           __global const double *rad, __global const double *bnd, double px,
+                           double py, double wx, double wy)
 {
     double C = cb[0];
     double mx = -wx, my = -wy;
@@ -98,7 +97,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
     int wall = P->refl && !(lfar > P->d_cap / sig_min);
     lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
     if (lfar <= 0.0)
-        return wall ? rte_wall(P, rad, bnd, exact, px, py, mx, my, wx, wy, 0.0, 0.0) : 0.0;
+        return wall ? rte_wall(P, rad, bnd, px, py, mx, my, wx, wy, 0.0, 0.0) : 0.0;
 
     double brk[7];
     int nb = 0;
@@ -201,7 +200,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         d += sigma_t * len;
     }
     if (wall && d < P->d_cap)
-        L += rte_wall(P, rad, bnd, exact, px, py, mx, my, wx, wy, lfar, d);
+        L += rte_wall(P, rad, bnd, px, py, mx, my, wx, wy, lfar, d);
     return L;
 }
 
@@ -210,35 +209,15 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
  * chose: it takes the mean of the two sides, as the node's bilinear hat straddles both. (Taking
  * the right side alone moved R_x0, at the step, by 0.1-0.2 % in albedo_step and shadow_step.) */
 inline double rte_ray(const ppb_rte_params *P, __global const double *plane, const double *cb,
-                      __global const double *rad, __global const double *bnd, int exact, double px,
-                      double py, double wx, double wy)
+                      __global const double *rad, __global const double *bnd, double px, double py,
+                      double wx, double wy)
 {
     if (P->tube && P->step_kind != PPB_STEP_NONE && px == P->step_x && fabs(wx) < 1e-12) {
         double e = 1e-9 * P->width;
-        return 0.5 * (rte_ray_side(P, plane, cb, rad, bnd, exact, px - e, py, wx, wy) +
-                      rte_ray_side(P, plane, cb, rad, bnd, exact, px + e, py, wx, wy));
+        return 0.5 * (rte_ray_side(P, plane, cb, rad, bnd, px - e, py, wx, wy) +
+                      rte_ray_side(P, plane, cb, rad, bnd, px + e, py, wx, wy));
     }
-    return rte_ray_side(P, plane, cb, rad, bnd, exact, px, py, wx, wy);
-}
-
-/* One work-item per (direction cell, node): the cell's radiance at the node. */
-__kernel void ppb_rte_sweep(const ppb_rte_params P, __global const double *dirs,
-                            __global const double *src, __global double *out,
-                            __global const double *rad, __global const double *bnd)
-{
-    int nn = ppb_rte_nnodes(&P);
-    int gid = (int)get_global_id(0);
-    int cell = gid / nn, node = gid % nn;
-    if (cell >= P.ncell)
-        return;
-    int i = node % P.nx, j = node / P.nx;
-    double px = ppb_rte_node_x(&P, i), py = ppb_rte_node_y(&P, j);
-    __global const double *dc = dirs + 4 * cell;
-    __global const double *bc = bnd + PPB_RTE_BND * (P.n > 1.0 ? cell : 0);
-    double cb[4] = {dc[3], 0.0, 0.0, 0.0};
-    if (P.n > 1.0)
-        cb[1] = bc[8], cb[2] = bc[9], cb[3] = bc[10];
-    out[gid] = rte_ray(&P, src + (long)cell * nn, cb, rad, bc, 0, px, py, dc[0], dc[1]);
+    return rte_ray_side(P, plane, cb, rad, bnd, px, py, wx, wy);
 }
 
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
@@ -276,14 +255,228 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                                     ppb_hg_phase(P.g, v[0] * st + v[1] * ct),
                                     ppb_hg_phase(P.g, -v[0] * st - v[1] * ct),
                                     ppb_hg_phase(P.g, -v[0] * st + v[1] * ct)};
-                    sum += wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, 1, px, py,
+                    sum += wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py,
                                         v[0], v[1]);
                     continue;
                 }
                 double cb[4] = {ppb_hg_phase(P.g, wx * P.sin_theta_l - wy * P.cos_theta_l), 0.0,
                                 0.0, 0.0};
-                sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, 0, px, py, wx, wy);
+                sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, wx, wy);
             }
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
+}
+
+/* ---- The conservative sweep: a flat-source method of characteristics (reference: Methods) ----
+ *
+ * The unknown of the solve is the average radiance of every transported direction cell over every
+ * flat-source region (FSR, the grid nodes' dual cells, rte2d_params.h). A direction's parallel
+ * tracks, spacing delta perpendicular to its planar direction u = (w_x, w_y) / s, cross the FSRs;
+ * along a track segment of planar length l in an FSR of sigma_t with flat emission Q, the 3-D path
+ * is L = l / s and the radiance leaves as
+ *     psi_out = psi_in e^{-tau} + (Q / sigma_t)(1 - e^{-tau}),   tau = sigma_t L,
+ * the exact solution for a flat source. Integrated over the segment, the transport equation reads
+ * sigma_t psi_bar L = Q L + psi_in - psi_out; times the track's planar flux s delta and summed over
+ * the segments in the FSR (area A), the FSR's balance is
+ *     sigma_t psi_FSR A = Q A + s delta sum (psi_in - psi_out),
+ * and psi_FSR is taken from it (the balance form): every FSR then conserves exactly for the
+ * tracks laid, so the solve's R + T + sides + absorbed + ballistic = 1 holds to the solver's
+ * tolerance whatever the grid (the tracks' quadrature moves the answer, not the balance). What a
+ * track carries out through a boundary edge, s delta psi_out, is that edge's outgoing power per sr
+ * and unit z; what enters (n > 1: the walls' reflection, host side) is shared among the tracks
+ * entering through the edge so that their s delta psi_in sum to it exactly. */
+
+typedef struct moc_grid {
+    int nfx, ny;
+    __global const double *fx, *fy;
+} moc_grid;
+
+/* The interval [e_k, e_(k+1)] of the n + 1 ascending (asc) or descending edges holding v,
+ * clamped to [0, n - 1]. */
+inline int moc_find(__global const double *e, int n, double v, int asc)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (asc ? v >= e[mid] : v <= e[mid])
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* One track: the line p0 + t u (planar), v_k its perpendicular offset. mode 0 counts it at its
+ * entry edge (scr += 1); mode 1 transports psi_in = scr[entry edge] through the FSRs, adding each
+ * segment's s delta (psi_in - psi_out) to tal and the exit's s delta psi to bout. */
+inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, double uy, double s,
+                      double delta, double vk, __global const double *sig, __global const double *Q,
+                      __global double *tal, __global double *bout, __global double *scr, int mode)
+{
+    double hw = 0.5 * P->width, p0x = -uy * vk, p0y = ux * vk;
+    double txa = -INFINITY, txb = INFINITY, tya = -INFINITY, tyb = INFINITY;
+    if (ux != 0.0) {
+        double a = (-hw - p0x) / ux, b = (hw - p0x) / ux;
+        txa = fmin(a, b);
+        txb = fmax(a, b);
+    } else if (p0x <= -hw || p0x >= hw)
+        return;
+    if (uy != 0.0) {
+        double a = -p0y / uy, b = (-P->height - p0y) / uy;
+        tya = fmin(a, b);
+        tyb = fmax(a, b);
+    } else if (p0y >= 0.0 || p0y <= -P->height)
+        return;
+    double tin = fmax(txa, tya), tout = fmin(txb, tyb);
+    if (!(tout > tin))
+        return;
+    int nb_s3 = 2 * g->nfx, i, j, edge;
+    double xin = p0x + tin * ux, yin = p0y + tin * uy;
+    if (txa > tya) { /* through S3 (moving +x) or S4 */
+        i = ux > 0.0 ? 0 : g->nfx - 1;
+        j = moc_find(g->fy, g->ny, yin, 0);
+        edge = nb_s3 + (ux > 0.0 ? 0 : g->ny) + j;
+    } else { /* through S1 (moving down) or S2 */
+        j = uy < 0.0 ? 0 : g->ny - 1;
+        i = moc_find(g->fx, g->nfx, xin, 1);
+        edge = (uy < 0.0 ? 0 : g->nfx) + i;
+    }
+    if (mode == 0) {
+        scr[edge] += 1.0;
+        return;
+    }
+    double w = s * delta, psi = scr[edge], t = tin;
+    int di = ux > 0.0 ? 1 : -1, dj = uy < 0.0 ? 1 : -1; /* j counts down the rows */
+    for (;;) {
+        double tnx = ux != 0.0 ? (g->fx[i + (ux > 0.0)] - p0x) / ux : INFINITY;
+        double tny = uy != 0.0 ? (g->fy[j + (uy < 0.0)] - p0y) / uy : INFINITY;
+        double tn = fmin(fmin(tnx, tny), tout), l = tn - t;
+        if (l > 0.0) {
+            int f = j * g->nfx + i;
+            double st = sig[i], q = Q[f], tau = st * l / s, po;
+            if (tau < 1e-8)
+                po = psi + (q - st * psi) * (l / s);
+            else {
+                double e = exp(-tau);
+                po = psi * e + (q / st) * (1.0 - e);
+            }
+            tal[f] += w * (psi - po);
+            psi = po;
+            t = tn;
+        }
+        /* Advance; a tie (a corner) crosses both lines. */
+        int ax = tnx <= tny, ay = tny <= tnx;
+        int ni = ax ? i + di : i, nj = ay ? j + dj : j;
+        int outx = ni < 0 || ni >= g->nfx, outy = nj < 0 || nj >= g->ny;
+        if (tn >= tout || outx || outy) {
+            /* The face left through: the line crossed out of the grid (x at a corner), or where
+             * the track ends when rounding ended it a hair before its last crossing. */
+            int xface = (outx || outy) ? outx : txb < tyb;
+            int out = xface ? nb_s3 + (ux > 0.0 ? g->ny : 0) + j : (uy < 0.0 ? g->nfx : 0) + i;
+            bout[out] += w * psi;
+            return;
+        }
+        i = ni;
+        j = nj;
+    }
+}
+
+/* n > 1: the power entering each edge, shared among the tracks entering there (scr holds their
+ * count on entry, psi_in on return). An edge no track enters (a direction grazing the face)
+ * hands its power to the face's next edge that has one (the last such edge takes the face's
+ * tail), so none is lost. */
+inline void moc_inflow(__global const double *bin, __global double *scr, int e0, int ne, double w)
+{
+    int last = -1;
+    double tail = 0.0;
+    for (int e = e0 + ne - 1; e >= e0 && last < 0; e--) {
+        if (scr[e] > 0.0)
+            last = e;
+        else
+            tail += bin[e];
+    }
+    double pend = 0.0;
+    for (int e = e0; e <= last; e++) {
+        pend += bin[e];
+        if (scr[e] > 0.0) {
+            scr[e] = (pend + (e == last ? tail : 0.0)) / (w * scr[e]);
+            pend = 0.0;
+        }
+    }
+}
+
+/* The slab (rte2d_params.h: one column of unit width): one track per direction along y, planar
+ * flux |w_y| per unit area. */
+inline void moc_slab(const ppb_rte_params *P, const moc_grid *g, double wy,
+                     __global const double *sig, __global const double *Q,
+                     __global const double *bin, __global double *tal, __global double *bout)
+{
+    double w = fabs(wy), st = sig[0];
+    if (w < 1e-12)
+        return; /* z-invariant in x too: psi = Q / sigma_t, the balance form's answer */
+    int down = wy < 0.0, j = down ? 0 : g->ny - 1, dj = down ? 1 : -1;
+    double psi = P->refl ? bin[down ? 0 : 1] / w : 0.0;
+    for (; j >= 0 && j < g->ny; j += dj) {
+        double L = (g->fy[j] - g->fy[j + 1]) / w, tau = st * L, q = Q[j], po;
+        if (tau < 1e-8)
+            po = psi + (q - st * psi) * L;
+        else {
+            double e = exp(-tau);
+            po = psi * e + (q / st) * (1.0 - e);
+        }
+        tal[j] += w * (psi - po);
+        psi = po;
+    }
+    bout[down ? 1 : 0] += w * psi;
+}
+
+/* One work-item per transported direction cell: all its tracks, in order, so the sums are the
+ * same whatever the device or work-group size. */
+__kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
+                          __global const double *edges, __global const double *sig,
+                          __global const double *Q, __global const double *bin,
+                          __global double *out, __global double *bout, __global double *scr,
+                          const int nfx, const double2 dmin)
+{
+    int c = (int)get_global_id(0);
+    if (c >= P.ncell)
+        return;
+    moc_grid g = {nfx, P.ny, edges, edges + nfx + 1};
+    int nf = nfx * P.ny, nb = ppb_moc_nb(nfx, P.ny);
+    __global const double *q = Q + (long)c * nf, *bi = bin + (long)c * nb;
+    __global double *tal = out + (long)c * nf, *bo = bout + (long)c * nb, *sc = scr + (long)c * nb;
+    for (int f = 0; f < nf; f++)
+        tal[f] = 0.0;
+    for (int e = 0; e < nb; e++)
+        bo[e] = sc[e] = 0.0;
+    double wx = dirs[4 * c], wy = dirs[4 * c + 1], s = sqrt(wx * wx + wy * wy);
+    if (!P.tube)
+        moc_slab(&P, &g, wy, sig, q, bi, tal, bo);
+    else if (s > 1e-12) {
+        double ux = wx / s, uy = wy / s, hw = 0.5 * P.width;
+        /* The tracks' offsets v = p . (-u_y, u_x) over the cross-section's corners. */
+        double v1 = -uy * -hw, v2 = -uy * hw, v3 = v1 - ux * P.height, v4 = v2 - ux * P.height;
+        double vmin = fmin(fmin(v1, v2), fmin(v3, v4)), vmax = fmax(fmax(v1, v2), fmax(v3, v4));
+        double proj = dmin.x * fabs(uy) + dmin.y * fabs(ux);
+        double delta = fmin(P.hstep, proj / PPB_MOC_TRACKS_PER_CELL);
+        int ntr = max(1, (int)ceil((vmax - vmin) / delta));
+        delta = (vmax - vmin) / ntr;
+        if (P.refl) {
+            for (int k = 0; k < ntr; k++)
+                moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, tal, bo, sc,
+                          0);
+            moc_inflow(bi, sc, 0, nfx, s * delta);
+            moc_inflow(bi, sc, nfx, nfx, s * delta);
+            moc_inflow(bi, sc, 2 * nfx, P.ny, s * delta);
+            moc_inflow(bi, sc, 2 * nfx + P.ny, P.ny, s * delta);
+        }
+        for (int k = 0; k < ntr; k++)
+            moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, tal, bo, sc, 1);
+    }
+    /* The balance form: sigma_t psi A = Q A + the tracks' net inflow. */
+    for (int f = 0; f < nf; f++) {
+        int i = f % nfx, j = f / nfx;
+        double A = (g.fx[i + 1] - g.fx[i]) * (g.fy[j] - g.fy[j + 1]);
+        tal[f] = (q[f] * A + tal[f]) / (sig[i] * A);
+    }
 }

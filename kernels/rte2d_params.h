@@ -14,8 +14,9 @@
  * hyf, 2 hyf, .., 2^(nyl-1) hyf (depth dlay = hyf (2^nyl - 1)), the middle nym rows of hy
  * (nyl = 0: uniform; ppb_rte_node_y): the scattered light of a direction rises from 0 at a face
  * within about |mu| mfp, so the source has a boundary layer as thin as the most grazing cell's
- * |mu| that linear interpolation underestimates (issue 19: halving hy everywhere took the
- * balance from -4.7e-3 to -2.0e-3, halving hx alone only to -4.2e-3). In x the nodes are uniform on
+ * |mu| (issue 19, measured on the nodal scheme rte2d had before its flat-source regions: the
+ * layers mattered, x much less). The flat-source regions of the sweep are the nodes' dual cells
+ * (rte2d_grid.h), so the layers refine them too. In x the nodes are uniform on
  * [-W/2, step_x] (nl cells) and on [step_x, W/2] (nr cells), sharing the node at step_x, so the
  * step is a grid line (the source per unit scattering coefficient, J = sum_j P_ij I_j, is
  * continuous across it but kinked; sigma_s, which jumps, is applied at the exact position).
@@ -37,22 +38,48 @@
 #define PPB_RTE_HOT static inline
 #endif
 
-/* Kernel arguments of both kernels, by index. */
+/* Arguments of the exit march ppb_rte_exit (rte2d.cl), by index. */
 enum {
     PPB_RTE_ARG_PARAMS = 0, /* ppb_rte_params by value */
-    PPB_RTE_ARG_DIRS = 1,   /* sweep: [ncell][4] = centre (x, y, z), beam coefficient q_i */
-    PPB_RTE_ARG_SRC = 2,    /* source planes J [nplanes][nnodes] (sweep: per cell; exit: per
-                               exit direction sample) */
-    PPB_RTE_ARG_OUT = 3,    /* sweep: I [ncell][nnodes]; exit: radiance [rows][nbins] */
-    PPB_RTE_ARG_RAD = 4,    /* n > 1: the field I [ncell][nnodes] the walls reflect */
-    PPB_RTE_ARG_BND = 5,    /* n > 1, sweep: [ncell][PPB_RTE_BND] = slot of the cell's mirror
-                               at S1..S4, its cell-averaged F there, the beam coefficients of
-                               (+sin, up), (-sin, down), (-sin, up) (dirs has (+sin, down));
-                               exit: [ndir][4] = slot of the sample's mirror at S1..S4 */
+    PPB_RTE_ARG_DIRS = 1,   /* unused (the sweep's cells) */
+    PPB_RTE_ARG_SRC = 2,    /* source planes J [ndir][nnodes], one per exit direction sample */
+    PPB_RTE_ARG_OUT = 3,    /* radiance [rows][nbins] */
+    PPB_RTE_ARG_RAD = 4,    /* n > 1: the converged field I [ncell][nnodes] the walls reflect */
+    PPB_RTE_ARG_BND = 5,    /* n > 1: [ndir][4] = slot of the sample's mirror at S1..S4 */
     PPB_RTE_NARGS = 6
 };
 
-/* Doubles per transported cell in the sweep's PPB_RTE_ARG_BND buffer. */
+/* Arguments of the conservative sweep ppb_rte_moc (rte2d.cl), by index. The flat-source regions
+ * (FSRs) are the grid nodes' dual cells (rte2d_grid.h): nfx columns (edges fx, ascending from
+ * -W/2 to W/2; slab: one column) by ny rows (edges fy, descending from 0 to -H). A direction's
+ * boundary edges: S1 [0, nfx), S2 [nfx, 2 nfx), S3 [2 nfx, 2 nfx + ny), S4 [.., 2 nfx + 2 ny). */
+enum {
+    PPB_MOC_ARG_PARAMS = 0, /* ppb_rte_params by value */
+    PPB_MOC_ARG_DIRS = 1,   /* [ncell][4]: centre (x, y, z), unused */
+    PPB_MOC_ARG_EDGES = 2,  /* fx [nfx + 1] then fy [ny + 1] */
+    PPB_MOC_ARG_SIG = 3,    /* sigma_t of each FSR column [nfx] */
+    PPB_MOC_ARG_SRC = 4,    /* flat emission density Q [ncell][nfsr], per sr */
+    PPB_MOC_ARG_BIN = 5,    /* power entering through each boundary edge [ncell][nb] */
+    PPB_MOC_ARG_OUT = 6,    /* the FSRs' average radiance [ncell][nfsr] */
+    PPB_MOC_ARG_BOUT = 7,   /* power leaving through each boundary edge [ncell][nb] */
+    PPB_MOC_ARG_SCR = 8,    /* scratch [ncell][nb] */
+    PPB_MOC_ARG_NFX = 9,    /* int: FSR columns */
+    PPB_MOC_ARG_DMIN = 10,  /* double2: the least FSR width and height (track spacing) */
+    PPB_MOC_NARGS = 11
+};
+
+/* Tracks a direction lays across its thinnest FSR (its projected width, perpendicular). */
+#define PPB_MOC_TRACKS_PER_CELL 2
+
+/* Boundary edges per direction. */
+PPB_FN int ppb_moc_nb(int nfx, int ny)
+{
+    return 2 * nfx + 2 * ny;
+}
+
+/* Doubles per transported cell of the grid's walls (rte2d_grid.h, G->bnd): the slot of the
+ * cell's mirror at S1..S4, its cell-averaged F there, the beam coefficients of (+sin, up),
+ * (-sin, down), (-sin, up). */
 #define PPB_RTE_BND 11
 
 /* Parameters of one launch. All doubles first, then an even number of ints (host asserts). */

@@ -37,28 +37,36 @@ typedef struct rte_solver {
     ppb_ocl *ocl;
     ppb_rte_grid G;
     cl_program prog;
-    cl_kernel sweep, exitk;
-    cl_mem dirs, src, out;
-    cl_mem radb, bnd; /* n > 1: the field the walls reflect, the cells' walls (else NULL) */
-    size_t nvec;      /* nc x nnodes */
-    double *J;        /* [nc][nnodes] scratch */
+    cl_kernel moc, exitk;
+    /* The sweep's buffers (rte2d_params.h, PPB_MOC_ARG_*) and the exit march's. */
+    cl_mem dirs, edges, sig, q, bin, psi, bout, scr;
+    cl_mem src, out, radb, bnd; /* exit: sources, radiance, n > 1: node field and walls */
+    size_t nvec;                /* the unknown: nc (nf + nb) (rte2d_grid.h) */
+    double *Q, *Qb, *J, *B;     /* [nc][nf] emission, beam emission, scatter; [nc][nb] inflow */
+    double *rn;                 /* [nc][nnodes]: a field at the nodes, for the exit march */
+    double collided, absorbed_beam;
     int sweeps;
     double t_sweeps;
 } rte_solver;
 
 static void solver_free(rte_solver *s)
 {
-    cl_mem bufs[] = {s->dirs, s->src, s->out, s->radb, s->bnd};
-    for (size_t i = 0; i < 5; i++)
+    cl_mem bufs[] = {s->dirs, s->edges, s->sig, s->q,   s->bin,  s->psi,
+                     s->bout, s->scr,   s->src, s->out, s->radb, s->bnd};
+    for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             clReleaseMemObject(bufs[i]);
-    if (s->sweep)
-        clReleaseKernel(s->sweep);
+    if (s->moc)
+        clReleaseKernel(s->moc);
     if (s->exitk)
         clReleaseKernel(s->exitk);
     if (s->prog)
         clReleaseProgram(s->prog);
+    free(s->Q);
+    free(s->Qb);
     free(s->J);
+    free(s->B);
+    free(s->rn);
     ppb_rte_grid_free(&s->G);
     memset(s, 0, sizeof *s);
 }
@@ -77,56 +85,110 @@ static cl_mem buffer(ppb_ocl *ocl, cl_mem_flags flags, size_t n, const double *h
     return m;
 }
 
+static int set_arg(cl_kernel k, cl_uint i, size_t size, const void *v, ppb_err *err)
+{
+    return ppb_cl_check(clSetKernelArg(k, i, size, v), "clSetKernelArg(rte2d)", err);
+}
+
 static int set_args(cl_kernel k, const ppb_rte_params *P, cl_mem dirs, cl_mem src, cl_mem out,
                     cl_mem rad, cl_mem bnd, ppb_err *err)
 {
-    /* n = 1: the kernels read neither; any buffer keeps the arguments set. */
+    /* n = 1: the kernel reads neither; any buffer keeps the arguments set. */
     rad = rad ? rad : dirs;
     bnd = bnd ? bnd : dirs;
-    if (ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_RAD, sizeof(cl_mem), &rad),
-                     "clSetKernelArg(rte2d)", err) ||
-        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_BND, sizeof(cl_mem), &bnd),
-                     "clSetKernelArg(rte2d)", err))
-        return -1;
-    if (ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_PARAMS, sizeof *P, P), "clSetKernelArg(rte2d)",
-                     err) ||
-        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_DIRS, sizeof(cl_mem), &dirs),
-                     "clSetKernelArg(rte2d)", err) ||
-        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_SRC, sizeof(cl_mem), &src),
-                     "clSetKernelArg(rte2d)", err) ||
-        ppb_cl_check(clSetKernelArg(k, PPB_RTE_ARG_OUT, sizeof(cl_mem), &out),
-                     "clSetKernelArg(rte2d)", err))
-        return -1;
-    return 0;
+    return set_arg(k, PPB_RTE_ARG_RAD, sizeof(cl_mem), &rad, err) ||
+           set_arg(k, PPB_RTE_ARG_BND, sizeof(cl_mem), &bnd, err) ||
+           set_arg(k, PPB_RTE_ARG_PARAMS, sizeof *P, P, err) ||
+           set_arg(k, PPB_RTE_ARG_DIRS, sizeof(cl_mem), &dirs, err) ||
+           set_arg(k, PPB_RTE_ARG_SRC, sizeof(cl_mem), &src, err) ||
+           set_arg(k, PPB_RTE_ARG_OUT, sizeof(cl_mem), &out, err);
 }
 
-/* out = T (sigma_s J + beam) (+ B x at n > 1: the walls' reflection of the field x that J was
- * scattered from): one march from every node in every transported cell. J NULL: the beam's
- * first scattering alone; beam 0: the grid source alone. */
-static int sweep(rte_solver *s, const double *J, int beam, const double *x, double *out,
-                 ppb_err *err)
+/* The walls at n > 1: what enters cell c through edge e of a face is, summed over the cells b
+ * that carry light out there, F_b times b's outgoing power there times the share refl[f][b][c]
+ * of b's mirror image that c stands for (rte2d_grid.h), F_b b's cell-averaged reflectance at
+ * that face: so what is reflected (here) and what is transmitted (ppb_rte_boundary_flux) add up
+ * to what reached the wall. */
+static void reflect_inflow(const ppb_rte_grid *G, const double *x, double *B)
+{
+    size_t stride = (size_t)G->nf + G->nb;
+    int nc = G->nc;
+    memset(B, 0, sizeof(double) * nc * G->nb);
+    for (int face = 0; face < (G->P.tube ? 4 : 2); face++) {
+        int e0 = face < 2 ? face * G->nfx : 2 * G->nfx + (face - 2) * G->P.ny;
+        int ne = face < 2 ? G->nfx : G->P.ny;
+        for (int b = 0; b < nc; b++) {
+            const double *row = G->refl + ((size_t)face * nc + b) * nc;
+            const double *out = x + b * stride + G->nf;
+            double F = G->bnd[PPB_RTE_BND * b + 4 + face];
+            for (int c = 0; c < nc; c++)
+                if (row[c] != 0.0) {
+                    double *in = B + (size_t)c * G->nb;
+                    /* Per sr of c: the cells stand for mult of them each. */
+                    double w = F * row[c] * G->mult[b] / G->mult[c];
+                    for (int e = e0; e < e0 + ne; e++)
+                        in[e] += w * out[e];
+                }
+        }
+    }
+}
+
+/* y = T (sigma_s J(x) + beam) with the walls' reflection of x (n > 1): one conservative sweep
+ * (rte2d.cl, ppb_rte_moc) of every transported cell. x NULL: the beam's first scattering alone;
+ * beam 0: the scattered light of x alone. */
+static int sweep(rte_solver *s, const double *x, int beam, double *y, ppb_err *err)
 {
     if (ppb_interrupted())
         return ppb_fail(err, "rte2d: interrupted");
     double t0 = ppb_now();
-    ppb_rte_params P = s->G.P;
-    P.beam = beam;
-    P.diffuse = J != NULL;
+    const ppb_rte_grid *G = &s->G;
+    ppb_rte_params P = G->P;
     P.refl = P.refl && x != NULL;
-    cl_command_queue q = s->ocl->queue;
-    size_t bytes = s->nvec * sizeof(double), global = s->nvec;
-    if (J && ppb_cl_check(clEnqueueWriteBuffer(q, s->src, CL_TRUE, 0, bytes, J, 0, NULL, NULL),
-                          "clEnqueueWriteBuffer(rte2d source)", err))
+    size_t nq = (size_t)G->nc * G->nf, nb = (size_t)G->nc * G->nb;
+    if (x)
+        ppb_rte_scatter(G, x, s->J);
+    for (size_t i = 0; i < nq; i++) {
+        double al_st = G->falb[(i % G->nf) % G->nfx] * G->fsig[(i % G->nf) % G->nfx];
+        s->Q[i] = (x ? al_st * s->J[i] : 0.0) + (beam ? s->Qb[i] : 0.0);
+    }
+    if (P.refl)
+        reflect_inflow(G, x, s->B);
+    else
+        memset(s->B, 0, sizeof(double) * nb);
+    cl_command_queue qu = s->ocl->queue;
+    size_t global = (size_t)G->nc;
+    int nfx = G->nfx;
+    cl_double2 dmin = {{G->dmin[0], G->dmin[1]}};
+    cl_mem args[] = {s->dirs, s->edges, s->sig, s->q, s->bin, s->psi, s->bout, s->scr};
+    int rc = ppb_cl_check(clEnqueueWriteBuffer(qu, s->q, CL_TRUE, 0, nq * sizeof(double), s->Q, 0,
+                                               NULL, NULL),
+                          "clEnqueueWriteBuffer(rte2d source)", err) ||
+             ppb_cl_check(clEnqueueWriteBuffer(qu, s->bin, CL_TRUE, 0, nb * sizeof(double), s->B, 0,
+                                               NULL, NULL),
+                          "clEnqueueWriteBuffer(rte2d inflow)", err) ||
+             set_arg(s->moc, PPB_MOC_ARG_PARAMS, sizeof P, &P, err) ||
+             set_arg(s->moc, PPB_MOC_ARG_NFX, sizeof nfx, &nfx, err) ||
+             set_arg(s->moc, PPB_MOC_ARG_DMIN, sizeof dmin, &dmin, err);
+    for (cl_uint i = 0; !rc && i < 8; i++)
+        rc = set_arg(s->moc, PPB_MOC_ARG_DIRS + i, sizeof(cl_mem), &args[i], err);
+    if (rc ||
+        ppb_cl_check(clEnqueueNDRangeKernel(qu, s->moc, 1, NULL, &global, NULL, 0, NULL, NULL),
+                     "clEnqueueNDRangeKernel(rte2d sweep)", err))
         return -1;
-    if (P.refl &&
-        ppb_cl_check(clEnqueueWriteBuffer(q, s->radb, CL_TRUE, 0, bytes, x, 0, NULL, NULL),
-                     "clEnqueueWriteBuffer(rte2d field)", err))
-        return -1;
-    if (set_args(s->sweep, &P, s->dirs, s->src, s->out, s->radb, s->bnd, err) ||
-        ppb_cl_check(clEnqueueNDRangeKernel(q, s->sweep, 1, NULL, &global, NULL, 0, NULL, NULL),
-                     "clEnqueueNDRangeKernel(rte2d sweep)", err) ||
-        ppb_cl_check(clEnqueueReadBuffer(q, s->out, CL_TRUE, 0, bytes, out, 0, NULL, NULL),
-                     "clEnqueueReadBuffer(rte2d sweep)", err))
+    /* y = [psi | bout] per cell (rte2d_grid.h). */
+    size_t stride = (size_t)G->nf + G->nb;
+    for (int a = 0; a < G->nc; a++) {
+        size_t off = a * stride * sizeof(double);
+        if (ppb_cl_check(clEnqueueReadBuffer(qu, s->psi, CL_FALSE, (size_t)a * G->nf * 8,
+                                             (size_t)G->nf * 8, (char *)y + off, 0, NULL, NULL),
+                         "clEnqueueReadBuffer(rte2d sweep)", err) ||
+            ppb_cl_check(clEnqueueReadBuffer(qu, s->bout, CL_FALSE, (size_t)a * G->nb * 8,
+                                             (size_t)G->nb * 8, (char *)y + off + G->nf * 8, 0,
+                                             NULL, NULL),
+                         "clEnqueueReadBuffer(rte2d sweep)", err))
+            return -1;
+    }
+    if (ppb_cl_check(clFinish(qu), "clFinish(rte2d sweep)", err))
         return -1;
     s->sweeps++;
     s->t_sweeps += ppb_now() - t0;
@@ -137,8 +199,7 @@ static int sweep(rte_solver *s, const double *J, int beam, const double *x, doub
 static int matvec(void *ctx, const double *x, double *y, ppb_err *err)
 {
     rte_solver *s = ctx;
-    ppb_rte_scatter(&s->G, x, s->J);
-    if (sweep(s, s->J, 0, x, y, err))
+    if (sweep(s, x, 0, y, err))
         return -1;
     for (size_t i = 0; i < s->nvec; i++)
         y[i] = x[i] - y[i];
@@ -151,31 +212,50 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_
     memset(s, 0, sizeof *s);
     s->ocl = ocl;
     const ppb_rte2d_settings *r = &cfg->rte2d;
-    if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, &s->G, err))
+    ppb_rte_grid *G = &s->G;
+    if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, G, err))
         return -1;
-    s->nvec = (size_t)s->G.nc * s->G.nnodes;
-    size_t planes = src_planes > (size_t)s->G.nc ? src_planes : (size_t)s->G.nc;
-    size_t outn = out_cells > s->nvec ? out_cells : s->nvec;
-    s->J = malloc(sizeof(double) * s->nvec);
-    if (!s->J)
+    s->nvec = ppb_rte_nvec(G);
+    size_t nq = (size_t)G->nc * G->nf, nb = (size_t)G->nc * G->nb;
+    size_t nodes = (size_t)G->nc * G->nnodes;
+    size_t planes = src_planes > (size_t)G->nc ? src_planes : (size_t)G->nc;
+    s->Q = malloc(sizeof(double) * nq);
+    s->Qb = malloc(sizeof(double) * nq);
+    s->J = malloc(sizeof(double) * nq);
+    s->B = malloc(sizeof(double) * nb);
+    s->rn = malloc(sizeof(double) * nodes);
+    if (!s->Q || !s->Qb || !s->J || !s->B || !s->rn)
         return ppb_fail(err, "rte2d: out of memory");
-    if (ppb_ocl_build(ocl, "rte2d.cl", "", &s->prog, err) ||
-        ppb_ocl_kernel(s->prog, "ppb_rte_sweep", &s->sweep, err) ||
+    if (ppb_rte_beam_sources(G, s->Qb, &s->collided, &s->absorbed_beam, err) ||
+        ppb_ocl_build(ocl, "rte2d.cl", "", &s->prog, err) ||
+        ppb_ocl_kernel(s->prog, "ppb_rte_moc", &s->moc, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_exit", &s->exitk, err))
         return -1;
-    s->dirs = buffer(ocl, CL_MEM_READ_ONLY, 4 * (size_t)s->G.nc, s->G.dir4, "rte2d cells", err);
-    if (s->dirs)
-        s->src = buffer(ocl, CL_MEM_READ_ONLY, planes * s->G.nnodes, NULL, "rte2d source", err);
-    if (s->src)
-        s->out = buffer(ocl, CL_MEM_WRITE_ONLY, outn, NULL, "rte2d output", err);
-    if (s->out && s->G.bnd) {
-        s->radb = buffer(ocl, CL_MEM_READ_ONLY, s->nvec, NULL, "rte2d field", err);
-        if (s->radb)
-            s->bnd = buffer(ocl, CL_MEM_READ_ONLY, PPB_RTE_BND * (size_t)s->G.nc, s->G.bnd,
-                            "rte2d walls", err);
-        return s->bnd ? 0 : -1;
-    }
-    return s->out ? 0 : -1;
+    cl_mem_flags ro = CL_MEM_READ_ONLY, rw = CL_MEM_READ_WRITE;
+    struct {
+        cl_mem *m;
+        cl_mem_flags fl;
+        size_t n;
+        const double *host;
+        const char *what;
+    } want[] = {
+        {&s->dirs, ro, 4 * (size_t)G->nc, G->dir4, "rte2d cells"},
+        {&s->edges, ro, (size_t)G->nfx + 1 + G->P.ny + 1, G->fedge, "rte2d edges"},
+        {&s->sig, ro, (size_t)G->nfx, G->fsig, "rte2d sigma_t"},
+        {&s->q, ro, nq, NULL, "rte2d emission"},
+        {&s->bin, ro, nb, NULL, "rte2d inflow"},
+        {&s->psi, rw, nq, NULL, "rte2d regions"},
+        {&s->bout, rw, nb, NULL, "rte2d outflow"},
+        {&s->scr, rw, nb, NULL, "rte2d scratch"},
+        {&s->src, ro, planes * G->nnodes, NULL, "rte2d exit source"},
+        {&s->out, CL_MEM_WRITE_ONLY, out_cells, NULL, "rte2d exit output"},
+        {&s->radb, ro, G->bnd ? nodes : 0, NULL, "rte2d field"},
+        {&s->bnd, ro, G->bnd ? PPB_RTE_BND * (size_t)G->nc : 0, G->bnd, "rte2d walls"},
+    };
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+        if (!(*want[i].m = buffer(ocl, want[i].fl, want[i].n, want[i].host, want[i].what, err)))
+            return -1;
+    return 0;
 }
 
 /* The exit directions' cell integrals of a sampling, once per solve (every exit march of that
@@ -220,10 +300,13 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
 
 /* The exit march of sampling ex: the grid source for every exit direction sample, then every
  * (row, bin); radiance [lo->ncells] receives the bins. */
-static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, const double *rad,
+static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, const double *x,
                       const ppb_layout *lo, double *radiance, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
+    /* The source at the nodes: each its dual cell's average (rte2d_grid.h). */
+    ppb_rte_to_nodes(&s->G, x, s->rn);
+    const double *rad = s->rn;
     int nbins = lo->nbins, ndir = ex->ndir, nn = s->G.nnodes, nc = s->G.nc;
     double *Jx = malloc(sizeof(double) * (size_t)ndir * nn);
     int rc = Jx ? 0 : ppb_fail(err, "rte2d: out of memory (exit source)");
@@ -239,7 +322,8 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
     cl_mem bx = NULL;
     if (!rc && ex->bx) {
         rc = ppb_cl_check(clEnqueueWriteBuffer(s->ocl->queue, s->radb, CL_TRUE, 0,
-                                               sizeof(double) * s->nvec, rad, 0, NULL, NULL),
+                                               sizeof(double) * s->G.nc * s->G.nnodes, rad, 0, NULL,
+                                               NULL),
                           "clEnqueueWriteBuffer(rte2d field)", err);
         if (!rc && !(bx = buffer(s->ocl, CL_MEM_READ_ONLY, 4 * (size_t)ndir, ex->bx,
                                  "rte2d exit walls", err)))
@@ -330,8 +414,7 @@ typedef struct rte_plain {
 /* r <- T S r (+ the walls' B r at n > 1): one sweep. */
 static int plain_ts(rte_solver *s, double *r, ppb_err *err)
 {
-    ppb_rte_scatter(&s->G, r, s->J);
-    return sweep(s, s->J, 0, r, r, err);
+    return sweep(s, r, 0, r, err);
 }
 
 static int plain_init(rte_plain *pl, rte_solver *s, const ppb_gmres_basis *kb, ppb_err *err)
@@ -504,9 +587,11 @@ static int solve_field(rte_solver *s, const ppb_config *cfg, double *rad, double
 {
     int K = cfg->rte2d.refinements;
     /* I_1: the exact first scattering marched to every node; I_pp: the start. */
-    int rc = sweep(s, NULL, 1, NULL, b, err);
+    int rc = sweep(s, NULL, 1, b, err);
     if (!rc)
-        rc = ppb_rte_initial_pp(&s->G, &cfg->scene, rad, err);
+        rc = ppb_rte_initial_pp(&s->G, &cfg->scene, s->rn, err);
+    if (!rc)
+        ppb_rte_from_nodes(&s->G, s->rn, rad);
     if (!rc && ipp)
         memcpy(ipp, rad, sizeof(double) * s->nvec);
     if (!rc && K == 0) {
@@ -520,8 +605,7 @@ static int solve_field(rte_solver *s, const ppb_config *cfg, double *rad, double
                     info.iters, info.resid);
     }
     for (int k = 1; !rc && k < K; k++) {
-        ppb_rte_scatter(&s->G, rad, s->J);
-        rc = sweep(s, s->J, 0, rad, rad, err);
+        rc = sweep(s, rad, 0, rad, err);
         for (size_t i = 0; !rc && i < s->nvec; i++)
             rad[i] += b[i];
     }
@@ -535,14 +619,9 @@ static int finish_result(rte_solver *s, const ppb_config *cfg, const double *rad
 {
     const ppb_scene *sc = &cfg->scene;
     const ppb_layout *lo = &out->layout;
-    double *phi = malloc(sizeof(double) * s->G.nnodes);
-    if (!phi)
-        return ppb_fail(err, "rte2d: out of memory");
-    ppb_rte_fluence(&s->G, rad, phi);
     double in = ppb_scene_power_in(sc);
-    st->absorbed_beam = ppb_rte_absorbed_beam(sc) / in;
-    st->absorbed_scattered = ppb_rte_absorbed_scattered(&s->G, phi) / in;
-    free(phi);
+    st->absorbed_beam = s->absorbed_beam / in;
+    st->absorbed_scattered = ppb_rte_absorbed_scattered(&s->G, rad) / in;
     if (ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
     memset(out->se, 0, lo->ncells * sizeof *out->se);

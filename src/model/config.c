@@ -131,7 +131,7 @@ static const key_def keys[] = {
     {"rte2d", "directions", K_INT, F(rte2d.directions), 2, 2000, "128", NULL,
      "rte2d: direction cells per hemisphere"},
     {"rte2d", "step", K_REAL, F(rte2d.step), 1e-3, 1, "0.05", NULL,
-     "rte2d: march step in the cross-section's plane, mfp"},
+     "rte2d: largest track spacing of the sweep and march step of the exit, in the plane, mfp"},
     {"rte2d", "tolerance", K_REAL, F(rte2d.tol), 1e-12, 0.1, "1e-7", NULL,
      "rte2d: relative residual at which the solve stops"},
     {"rte2d", "refinements", K_INT, F(rte2d.refinements), 0, 10000, "0", NULL,

@@ -11,6 +11,7 @@
 #include "physics/maps.h"
 #include "physics/phase.h"
 #include "physics/ppsolver.h"
+#include "physics/rte2d_beam.h"
 
 /* x-node layout: a split at step_x when a step lies strictly inside the tube. */
 static void grid_x(const ppb_scene *sc, double spacing, int *nl, int *nr, double *hxl, double *hxr)
@@ -35,10 +36,11 @@ static void grid_x(const ppb_scene *sc, double spacing, int *nl, int *nr, double
 
 /* y rows (rte2d_params.h): under S1 and over S2 a boundary layer of RTE_LAYER_LEVELS rows,
  * spacing / 16 doubling to spacing / 2 (depth 15/16 spacing), the middle at about spacing;
- * uniform when the layers would not leave a middle of at least one spacing. Measured on
- * uniform_g0_normal at spacing 0.1 (issue 19): the energy balance -4.7e-3 uniform, -3.3e-3 with
- * the layers (7 rows more: 38 instead of 31); in the slab -4.2e-3 and -2.8e-3; six levels gain
- * nothing more (-2.75e-3). */
+ * uniform when the layers would not leave a middle of at least one spacing. Chosen on the nodal
+ * scheme rte2d had before its flat-source regions (issue 19: at spacing 0.1 the layers took its
+ * conservation error from -4.7e-3 to -3.3e-3, six levels gained nothing more); the regions are
+ * the nodes' dual cells, so the layers refine them as well, where a grazing cell's radiance
+ * rises from 0 within |mu| mfp. */
 #define RTE_LAYER_LEVELS 4
 static void grid_y(const ppb_scene *sc, double spacing, ppb_rte_params *P)
 {
@@ -58,18 +60,6 @@ static void grid_y(const ppb_scene *sc, double spacing, ppb_rte_params *P)
         P->hy = P->hyf = H / P->nym;
     }
     P->ny = 2 * P->nyl + P->nym + 1;
-}
-
-/* Spacing between rows j and j + 1. */
-static double row_dy(const ppb_rte_params *P, int j)
-{
-    return ppb_rte_node_y(P, j) - ppb_rte_node_y(P, j + 1);
-}
-
-/* Trapezoid weight of row j. */
-static double row_wy(const ppb_rte_params *P, int j)
-{
-    return 0.5 * ((j > 0 ? row_dy(P, j - 1) : 0.0) + (j < P->ny - 1 ? row_dy(P, j) : 0.0));
 }
 
 /* The walls at n > 1 (rte2d_grid.h): G->bnd. Fl is the row of p(w . w_L) cell integrals. */
@@ -120,6 +110,226 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
             b[8 + k] = Fu[(size_t)k * m + i] / G->dirs.solid;
     }
     free(Fu);
+    return 0;
+}
+
+/* Does a direction w enter the cross-section through face f (move inward there)? */
+static int enters(int face, const double *w)
+{
+    return face == PPB_S1   ? w[1] < 0.0
+           : face == PPB_S2 ? w[1] > 0.0
+           : face == PPB_S3 ? w[0] > 0.0
+                            : w[0] < 0.0;
+}
+
+/* The walls' reflection map (rte2d_grid.h, G->refl): cell b's Gauss nodes mirrored in face f,
+ * each into the cell holding it, weighted by its solid angle and |w . n|; a node whose cell's
+ * centre does not enter through f (a cell straddling the face's plane: its centre carries its
+ * radiance out, not in) gives its share to the cells that do, by renormalising. No share left:
+ * the entering cell nearest the mirrored centre takes it all. Each row sums to 1, so what is
+ * reflected is exactly what reaches the wall times F. */
+static int grid_reflection(ppb_rte_grid *G, ppb_err *err)
+{
+    const int q = 8;
+    int nc = G->nc;
+    G->refl = calloc((size_t)4 * nc * nc, sizeof(double));
+    if (!G->refl)
+        return ppb_fail(err, "rte2d: out of memory (walls)");
+    for (int face = 0; face < 4; face++)
+        for (int b = 0; b < nc; b++) {
+            double *row = G->refl + ((size_t)face * nc + b) * nc, tot = 0.0;
+            const double *nd = pp_dirs_nodes(&G->dirs, G->rep[b], q, err);
+            if (!nd)
+                return -1;
+            for (int k = 0; k < q * q; k++) {
+                double m[3] = {nd[4 * k], nd[4 * k + 1], nd[4 * k + 2]};
+                m[face < 2 ? 1 : 0] = -m[face < 2 ? 1 : 0];
+                int c = G->slot[pp_dirs_cell_of(&G->dirs, m)];
+                double wt = nd[4 * k + 3] * fabs(m[face < 2 ? 1 : 0]);
+                if (enters(face, G->dir4 + 4 * c) && wt > 0.0) {
+                    row[c] += wt;
+                    tot += wt;
+                }
+            }
+            if (tot > 0.0) {
+                for (int c = 0; c < nc; c++)
+                    row[c] /= tot;
+                continue;
+            }
+            const double *w = G->dir4 + 4 * b;
+            double m[3] = {w[0], w[1], w[2]}, best = -2.0;
+            m[face < 2 ? 1 : 0] = -m[face < 2 ? 1 : 0];
+            int bc = -1;
+            for (int c = 0; c < nc; c++) {
+                const double *v = G->dir4 + 4 * c;
+                double dot = v[0] * m[0] + v[1] * m[1] + v[2] * m[2];
+                if (enters(face, v) && dot > best)
+                    best = dot, bc = c;
+            }
+            if (bc >= 0)
+                row[bc] = 1.0;
+        }
+    return 0;
+}
+
+/* The FSRs (rte2d_grid.h): dual-cell edges at the midpoints between nodes, the faces, and
+ * step_x where a node column lies on it. */
+static int grid_fsr(ppb_rte_grid *G, const ppb_scene *sc, ppb_err *err)
+{
+    const ppb_rte_params *P = &G->P;
+    int split = P->tube && P->nx > P->nl + 1; /* node nl sits on step_x */
+    G->nfx = P->tube ? P->nx + split : 1;
+    G->nf = G->nfx * P->ny;
+    G->nb = ppb_moc_nb(G->nfx, P->ny);
+    G->fedge = malloc(sizeof(double) * (G->nfx + 1 + P->ny + 1));
+    G->fsig = malloc(sizeof(double) * G->nfx);
+    G->falb = malloc(sizeof(double) * G->nfx);
+    G->fcol = malloc(sizeof(int) * G->nfx);
+    G->farea = malloc(sizeof(double) * G->nf);
+    if (!G->fedge || !G->fsig || !G->falb || !G->fcol || !G->farea)
+        return ppb_fail(err, "rte2d: out of memory (regions)");
+    double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
+    if (!P->tube) {
+        fx[0] = -0.5;
+        fx[1] = 0.5;
+        G->fcol[0] = 0;
+    } else {
+        int k = 0;
+        fx[k] = -0.5 * P->width;
+        for (int i = 0; i < P->nx; i++) {
+            if (split && i == P->nl) { /* the step column, in two */
+                G->fcol[k] = i;
+                fx[++k] = P->step_x;
+            }
+            G->fcol[k] = i;
+            fx[++k] = i + 1 < P->nx ? 0.5 * (ppb_rte_node_x(P, i) + ppb_rte_node_x(P, i + 1))
+                                    : 0.5 * P->width;
+        }
+    }
+    fy[0] = 0.0;
+    for (int j = 1; j < P->ny; j++)
+        fy[j] = 0.5 * (ppb_rte_node_y(P, j - 1) + ppb_rte_node_y(P, j));
+    fy[P->ny] = -P->height;
+    G->dmin[0] = G->dmin[1] = INFINITY;
+    for (int k = 0; k < G->nfx; k++) {
+        double xm = 0.5 * (fx[k] + fx[k + 1]);
+        G->fsig[k] = P->tube
+                         ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
+                         : P->sigma_t;
+        G->falb[k] = P->tube
+                         ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
+                         : P->albedo;
+        G->dmin[0] = fmin(G->dmin[0], fx[k + 1] - fx[k]);
+    }
+    for (int j = 0; j < P->ny; j++) {
+        G->dmin[1] = fmin(G->dmin[1], fy[j] - fy[j + 1]);
+        for (int k = 0; k < G->nfx; k++)
+            G->farea[j * G->nfx + k] = (fx[k + 1] - fx[k]) * (fy[j] - fy[j + 1]);
+    }
+    (void)sc;
+    return 0;
+}
+
+size_t ppb_rte_nvec(const ppb_rte_grid *G)
+{
+    return (size_t)G->nc * (G->nf + G->nb);
+}
+
+void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad)
+{
+    const ppb_rte_params *P = &G->P;
+    size_t stride = (size_t)G->nf + G->nb;
+    for (int a = 0; a < G->nc; a++)
+        for (int j = 0; j < P->ny; j++) {
+            const double *psi = x + a * stride + (size_t)j * G->nfx;
+            const double *area = G->farea + (size_t)j * G->nfx;
+            double *row = rad + (size_t)a * G->nnodes + (size_t)j * P->nx;
+            /* Node column i gathers FSR columns k .. m - 1 (two where i sits on the step). */
+            for (int k = 0, m; k < G->nfx; k = m) {
+                double sum = 0.0, A = 0.0;
+                for (m = k; m < G->nfx && G->fcol[m] == G->fcol[k]; m++) {
+                    sum += area[m] * psi[m];
+                    A += area[m];
+                }
+                row[G->fcol[k]] = sum / A;
+            }
+        }
+}
+
+/* Length of boundary edge e and the outward normal's component along w (|w . n| where w leaves,
+ * 0 where it enters). */
+static double edge_out(const ppb_rte_grid *G, int e, const double *w)
+{
+    const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
+    int nfx = G->nfx, ny = G->P.ny;
+    if (e < nfx)
+        return w[1] > 0.0 ? w[1] * (fx[e + 1] - fx[e]) : 0.0;
+    if (e < 2 * nfx)
+        return w[1] < 0.0 ? -w[1] * (fx[e - nfx + 1] - fx[e - nfx]) : 0.0;
+    if (!G->P.tube)
+        return 0.0;
+    int j = (e - 2 * nfx) % ny;
+    double len = fy[j] - fy[j + 1];
+    if (e < 2 * nfx + ny)
+        return w[0] < 0.0 ? -w[0] * len : 0.0;
+    return w[0] > 0.0 ? w[0] * len : 0.0;
+}
+
+/* The FSR a boundary edge borders. */
+static int edge_fsr(const ppb_rte_grid *G, int e)
+{
+    int nfx = G->nfx, ny = G->P.ny;
+    if (e < nfx)
+        return e;
+    if (e < 2 * nfx)
+        return (ny - 1) * nfx + (e - nfx);
+    int j = (e - 2 * nfx) % ny;
+    return j * nfx + (e < 2 * nfx + ny ? 0 : nfx - 1);
+}
+
+void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x)
+{
+    const ppb_rte_params *P = &G->P;
+    size_t stride = (size_t)G->nf + G->nb;
+    for (int a = 0; a < G->nc; a++) {
+        const double *r = rad + (size_t)a * G->nnodes;
+        double *psi = x + a * stride, *bout = psi + G->nf;
+        for (int j = 0; j < P->ny; j++)
+            for (int k = 0; k < G->nfx; k++)
+                psi[j * G->nfx + k] = r[j * P->nx + G->fcol[k]];
+        for (int e = 0; e < G->nb; e++)
+            bout[e] = edge_out(G, e, G->dir4 + 4 * a) * psi[edge_fsr(G, e)];
+    }
+}
+
+int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *collided, double *absorbed,
+                         ppb_err *err)
+{
+    const ppb_rte_params *P = &G->P;
+    const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
+    double *E = malloc(sizeof(double) * 4 * G->nf);
+    if (!E)
+        return ppb_fail(err, "rte2d: out of memory (beam sources)");
+    *collided = *absorbed = 0.0;
+    for (int j = 0; j < P->ny; j++)
+        for (int k = 0; k < G->nfx; k++) {
+            int f = j * G->nfx + k;
+            ppb_rte_beam_rect(P, fx[k], fx[k + 1], fy[j + 1], fy[j], E + 4 * f);
+            double sum = E[4 * f] + E[4 * f + 1] + E[4 * f + 2] + E[4 * f + 3];
+            *collided += sum;
+            *absorbed += (1.0 - G->falb[k]) * sum;
+        }
+    for (int a = 0; a < G->nc; a++) {
+        const double *bc = G->bnd ? G->bnd + PPB_RTE_BND * a : NULL;
+        double cb[4] = {G->dir4[4 * a + 3], bc ? bc[8] : 0.0, bc ? bc[9] : 0.0, bc ? bc[10] : 0.0};
+        for (int f = 0; f < G->nf; f++) {
+            const double *e = E + 4 * f;
+            double al = G->falb[f % G->nfx];
+            Qb[(size_t)a * G->nf + f] =
+                al * (cb[0] * e[0] + cb[1] * e[1] + cb[2] * e[2] + cb[3] * e[3]) / G->farea[f];
+        }
+    }
+    free(E);
     return 0;
 }
 
@@ -197,9 +407,8 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     G->slot = malloc(sizeof(int) * m);
     G->rep = malloc(sizeof(int) * m);
     G->mult = calloc((size_t)m, sizeof(double));
-    G->wnode = malloc(sizeof(double) * G->nnodes);
     double *Pfull = malloc(sizeof(double) * m * m), *F = malloc(sizeof(double) * m);
-    if (!G->slot || !G->rep || !G->mult || !G->wnode || !Pfull || !F) {
+    if (!G->slot || !G->rep || !G->mult || !Pfull || !F) {
         free(Pfull);
         free(F);
         ppb_rte_grid_free(G);
@@ -233,22 +442,13 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
             for (int j = 0; j < m; j++)
                 G->Pf[(size_t)a * G->nc + G->slot[j]] += Pfull[(size_t)i * m + j];
         }
-        /* Trapezoid weights of the bilinear interpolant. */
-        for (int j = 0; j < P->ny; j++) {
-            double wy = row_wy(P, j);
-            for (int i = 0; i < P->nx; i++) {
-                double wx = 1.0;
-                if (tube) {
-                    double left = i > 0 ? (i <= P->nl ? P->hxl : P->hxr) : 0.0;
-                    double right = i < P->nx - 1 ? (i < P->nl ? P->hxl : P->hxr) : 0.0;
-                    wx = 0.5 * (left + right);
-                }
-                G->wnode[j * P->nx + i] = wx * wy;
-            }
-        }
     }
     if (!rc && sc->n > 1.0)
         rc = grid_walls(G, sc, F, err);
+    if (!rc)
+        rc = grid_fsr(G, sc, err);
+    if (!rc && sc->n > 1.0)
+        rc = grid_reflection(G, err);
     free(Pfull);
     free(F);
     if (rc)
@@ -264,15 +464,20 @@ void ppb_rte_grid_free(ppb_rte_grid *G)
     free(G->mult);
     free(G->dir4);
     free(G->Pf);
-    free(G->wnode);
     free(G->bnd);
+    free(G->fedge);
+    free(G->refl);
+    free(G->fsig);
+    free(G->falb);
+    free(G->fcol);
+    free(G->farea);
     memset(G, 0, sizeof *G);
 }
 
-void ppb_rte_scatter(const ppb_rte_grid *G, const double *rad, double *J)
+void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J)
 {
-    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, G->nc, G->nnodes, G->nc, 1.0, G->Pf,
-                G->nc, rad, G->nnodes, 0.0, J, G->nnodes);
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, G->nc, G->nf, G->nc, 1.0, G->Pf, G->nc,
+                x, G->nf + G->nb, 0.0, J, G->nf);
 }
 
 int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, double *F,
@@ -341,67 +546,40 @@ int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, 
     return 0;
 }
 
-void ppb_rte_fluence(const ppb_rte_grid *G, const double *rad, double *phi)
+void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *x, double flux[4])
 {
-    for (int n = 0; n < G->nnodes; n++)
-        phi[n] = 0.0;
-    for (int a = 0; a < G->nc; a++) {
-        const double *row = rad + (size_t)a * G->nnodes;
-        double w = G->mult[a] * G->dirs.solid;
-        for (int n = 0; n < G->nnodes; n++)
-            phi[n] += w * row[n];
-    }
-}
-
-void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *rad, double flux[4])
-{
-    const ppb_rte_params *P = &G->P;
-    int nn = G->nnodes;
+    int nfx = G->nfx, ny = G->P.ny;
+    size_t stride = (size_t)G->nf + G->nb;
     for (int k = 0; k < 4; k++)
         flux[k] = 0.0;
     for (int a = 0; a < G->nc; a++) {
-        const double *row = rad + (size_t)a * nn;
-        double w = G->mult[a] * G->dirs.solid, ky = G->dirs.k[G->rep[a]], kx = G->dir4[4 * a];
-        /* n > 1: what leaves is 1 - F of what reaches the face (rte2d_grid.h). */
-        double ty = G->bnd ? 1.0 - G->bnd[PPB_RTE_BND * a + 4 + PPB_S1] : 1.0;
-        double tx = G->bnd ? 1.0 - G->bnd[PPB_RTE_BND * a + 4 + PPB_S3] : 1.0;
-        for (int i = 0; i < P->nx; i++) {
-            double wx = P->nx == 1 ? 1.0 : G->wnode[i] / row_wy(P, 0);
-            if (ky > 0.0)
-                flux[PPB_S1] += ty * (w * ky * wx * row[i]);
-            else
-                flux[PPB_S2] -= ty * (w * ky * wx * row[(P->ny - 1) * P->nx + i]);
-        }
-        if (P->nx == 1)
-            continue;
-        for (int j = 0; j < P->ny; j++) {
-            double wy = row_wy(P, j);
-            if (kx < 0.0)
-                flux[PPB_S3] -= tx * (w * kx * wy * row[j * P->nx]);
-            else if (kx > 0.0)
-                flux[PPB_S4] += tx * (w * kx * wy * row[j * P->nx + P->nx - 1]);
+        const double *bout = x + a * stride + G->nf;
+        const double *bc = G->bnd ? G->bnd + PPB_RTE_BND * a : NULL;
+        double w = G->mult[a] * G->dirs.solid;
+        for (int face = 0; face < 4; face++) {
+            int e0 = face < 2 ? face * nfx : 2 * nfx + (face - 2) * ny, ne = face < 2 ? nfx : ny;
+            double sum = 0.0;
+            for (int e = e0; e < e0 + ne; e++)
+                sum += bout[e];
+            /* n > 1: F of it is reflected back in (the solve's walls), 1 - F leaves. */
+            flux[face] += w * (bc ? 1.0 - bc[4 + face] : 1.0) * sum;
         }
     }
 }
 
-double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *phi)
+double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *x)
 {
-    const ppb_rte_params *P = &G->P;
+    size_t stride = (size_t)G->nf + G->nb;
     double sum = 0.0;
-    if (P->nx == 1) {
-        for (int j = 0; j + 1 < P->ny; j++)
-            sum += row_dy(P, j) * 0.5 * (phi[j] + phi[j + 1]);
-        return (1.0 - P->albedo) * P->sigma_t * sum;
-    }
-    for (int j = 0; j + 1 < P->ny; j++)
-        for (int i = 0; i + 1 < P->nx; i++) {
-            double xm = 0.5 * (ppb_rte_node_x(P, i) + ppb_rte_node_x(P, i + 1));
-            double st = ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right);
-            double al = ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right);
-            double area = (i < P->nl ? P->hxl : P->hxr) * row_dy(P, j);
-            const double *c = phi + j * P->nx + i;
-            sum += (1.0 - al) * st * area * 0.25 * (c[0] + c[1] + c[P->nx] + c[P->nx + 1]);
+    for (int a = 0; a < G->nc; a++) {
+        const double *psi = x + a * stride;
+        double s = 0.0;
+        for (int f = 0; f < G->nf; f++) {
+            int k = f % G->nfx;
+            s += (1.0 - G->falb[k]) * G->fsig[k] * G->farea[f] * psi[f];
         }
+        sum += G->mult[a] * G->dirs.solid * s;
+    }
     return sum;
 }
 

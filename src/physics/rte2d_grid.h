@@ -14,9 +14,12 @@
  * one cell of each mirror pair is transported (about N + sqrt(N) of the 2N cells) and the
  * phase matrix is folded over the pairs.
  *
- * Unknown: rad[c][node], the scattered radiance (cell average) of transported cell c at every
- * node. The grid source per unit scattering coefficient is J[c][node] = sum_b Pf[c][b] rad[b][node]
- * (Pf the folded phase matrix); the march multiplies by sigma_s at the exact position. */
+ * Space: the nodes of rte2d_params.h and their dual cells, the flat-source regions (FSRs) of
+ * the conservative sweep (rte2d.cl, ppb_rte_moc); the solve's unknown is each transported cell's
+ * average radiance over each FSR and the power it carries out through each boundary edge
+ * (ppb_rte_nvec). The grid source per unit scattering coefficient is J[c][f] = sum_b Pf[c][b]
+ * psi[b][f] (Pf the folded phase matrix), the FSR's emission alpha sigma_t J plus the beam's
+ * (ppb_rte_beam_sources); the exit march reads J at the nodes (ppb_rte_to_nodes). */
 #ifndef PPB_RTE2D_GRID_H
 #define PPB_RTE2D_GRID_H
 
@@ -28,16 +31,43 @@
 typedef struct ppb_rte_grid {
     ppb_rte_params P; /* the grid and medium fields (launch fields left to the caller) */
     int nnodes;
-    pp_dirs dirs;  /* the solver's partition: antipodal for g < 0, as ppsolver.c builds it */
-    int nc;        /* transported cells */
-    int *rep;      /* [nc]: the cell of dirs each transported cell is */
-    int *slot;     /* [2N]: transported index of every cell (its mirror's where not itself) */
-    double *mult;  /* [nc]: 1 or 2, cells the transported one stands for */
-    double *dir4;  /* [nc][4]: centre (x, y, z) and the cell average of p(w.w_L) */
-    double *Pf;    /* [nc][nc] row-major: folded phase matrix */
-    double *wnode; /* [nnodes]: trapezoid area weights (per unit z; slab: per unit area) */
-    double *bnd;   /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
+    pp_dirs dirs; /* the solver's partition: antipodal for g < 0, as ppsolver.c builds it */
+    int nc;       /* transported cells */
+    int *rep;     /* [nc]: the cell of dirs each transported cell is */
+    int *slot;    /* [2N]: transported index of every cell (its mirror's where not itself) */
+    double *mult; /* [nc]: 1 or 2, cells the transported one stands for */
+    double *dir4; /* [nc][4]: centre (x, y, z) and the cell average of p(w.w_L) */
+    double *Pf;   /* [nc][nc] row-major: folded phase matrix */
+    double *bnd;  /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
+    /* The flat-source regions (FSRs) of the conservative sweep: the nodes' dual cells, the
+     * column of the node on the step split in two at step_x (so sigma_t and alpha are constant
+     * in each); slab: one column of unit width. */
+    int nfx, nf, nb; /* FSR columns, FSRs (nfx x ny, f = j nfx + k), boundary edges per cell */
+    double *fedge;   /* fx [nfx + 1] ascending, then fy [ny + 1] from 0 down to -H */
+    double *fsig;    /* [nfx] sigma_t of each column */
+    double *falb;    /* [nfx] albedo of each column */
+    int *fcol;       /* [nfx] the node column of each FSR column */
+    double *farea;   /* [nf] areas (per unit z; slab: per unit area) */
+    double dmin[2];  /* the least FSR width and height */
+    /* n > 1: refl[f][b][c], the share of what cell b carries out through face f that the wall
+     * reflects into cell c (rows sum to 1; the mirror image of b's directions, over the cells
+     * whose centres enter through f); NULL at n = 1. */
+    double *refl;
 } ppb_rte_grid;
+
+/* The solve's unknown, per transported cell a: psi[a][f], the FSRs' average radiance, then
+ * bout[a][e], the power (per sr, per unit z) leaving through each boundary edge
+ * (rte2d_params.h's edge order), nc (nf + nb) values in all: the walls' reflection at n > 1 is
+ * a linear map of bout, so the solve inverts it with the scattering. */
+size_t ppb_rte_nvec(const ppb_rte_grid *G);
+
+/* The node field rad[nc][nnodes] of the solve's unknown x: each node the area-weighted mean of
+ * its FSRs (its dual cell's average), for the exit march's bilinear source. */
+void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad);
+
+/* The unknown of a node field (I_pp): every FSR its node's value, every edge the power that
+ * value carries out through it (|w . n| times the edge's length, where w leaves). */
+void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x);
 
 /* At n > 1 (reference: Medium) the partition has a collar edge at the critical cosine, as
  * ppsolver.c's, the light fields of P are the refracted beam's, and bnd holds each transported
@@ -55,8 +85,9 @@ void ppb_rte_grid_free(ppb_rte_grid *G);
 /* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building. */
 double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart);
 
-/* J = Pf rad, both [nc][nnodes]. */
-void ppb_rte_scatter(const ppb_rte_grid *G, const double *rad, double *J);
+/* J = Pf psi, the scattered light's source per unit sigma_s in every FSR: [nc][nf] from the
+ * unknown x. */
+void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J);
 
 /* Folded cell integrals of the exit directions: F[d][c] = sum over the cells c stands for of
  * integral_{Omega_j} p(w_d . w') dw', for the ndir unit vectors w (rows of 3). */
@@ -67,20 +98,22 @@ int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, do
  * tau = D cos(theta_L) clamped to the slab (reference: Methods, pp), 0 where unlit. */
 int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, ppb_err *err);
 
-/* Scattered fluence at every node, phi[node] = sum over all 2N cells |Omega| I. */
-void ppb_rte_fluence(const ppb_rte_grid *G, const double *rad, double *phi);
+/* Scattered power leaving through each surface (PPB_S1..S4; per unit z, slab: per unit area)
+ * of the unknown x: its outgoing edge powers times |Omega| (n > 1: times 1 - F of the cell at
+ * that face, F being reflected back in): the same tracks the FSRs' balance is made of, so
+ * R + T + sides + absorbed + ballistic = 1 to the solver's tolerance. */
+void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *x, double flux[4]);
 
-/* Scattered power leaving through each surface (PPB_S1..S4; per unit z, slab: per unit area):
- * the outgoing cells' flux |Omega| (w.n) I (n > 1: times 1 - F of the cell) at the boundary nodes
- * (w.n = the cell's exact mean cosine k_i on S1 and S2, its centre's on S3 and S4), trapezoid along
- * the surface. The totals come from it as ppslab's come from its cell field: the same discrete
- * field the absorption is taken from, so R + T + sides + absorbed + ballistic = 1 measures the
- * scheme's conservation, not the bins' quadrature. */
-void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *rad, double flux[4]);
+/* Power absorbed from the scattered light of x: sum over FSRs and cells of
+ * (1 - alpha) sigma_t A |Omega| psi. */
+double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *x);
 
-/* Power absorbed from the scattered light, integral of sigma_a(x) phi over the cross-section
- * (bilinear phi: the trapezoid weights; every grid cell lies on one side of the step). */
-double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *phi);
+/* The beam's first scattering as the FSRs' flat emission density, exact (rte2d_beam.h):
+ * Qb[a][f] = alpha sum_k cb_a[k] (integral over f of sigma_t E_k) / A_f, cb_a the cell's phase
+ * coefficients of the beam's directions; *collided = the beam's collisions over the cross-section
+ * and *absorbed their (1 - alpha) part (per unit z, slab: per unit area). */
+int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *collided, double *absorbed,
+                         ppb_err *err);
 
 /* Power absorbed from the unscattered beam, exact: along every entry point's path the
  * piecewise-constant (1 - alpha)(e^{-tau_a} - e^{-tau_b}), over the lit entry points by
