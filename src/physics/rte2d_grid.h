@@ -36,7 +36,8 @@ typedef struct ppb_rte_grid {
     int *rep;     /* [nc]: the cell of dirs each transported cell is */
     int *slot;    /* [2N]: transported index of every cell (its mirror's where not itself) */
     double *mult; /* [nc]: 1 or 2, cells the transported one stands for */
-    double *dir4; /* [nc][4]: centre (x, y, z) and the cell average of p(w.w_L) */
+    double *dir4; /* [nc][4]: transport direction (the centre; in the tube x scaled so the
+                     cells integrate w_x^2 exactly) and the cell average of p(w.w_L) */
     double *Pf;   /* [nc][nc] row-major: folded phase matrix */
     double *bnd;  /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
     /* The flat-source regions (FSRs) of the conservative sweep: the nodes' dual cells, the
