@@ -199,6 +199,8 @@ static void test_sigint_pp_setup(void **state)
  * (a solve of 1 s, then some 25 s of bin evaluations on an idle machine): exit 130 within
  * seconds. Before: the loop ran to its end. The signal goes once the loop's progress lines
  * appear, or after 20 s (the code before printed none; by then its solve was over). */
+/* The run must outlast the first progress line (5 s off a terminal): at samples_dir = 8 an idle
+ * CI machine finished ppslab in 4.7 s, before any; 24 makes the bins 9 times the work. */
 static void test_sigint_ppslab(void **state)
 {
     (void)state;
@@ -206,7 +208,7 @@ static void test_sigint_ppslab(void **state)
     char cfg[1200], args[3000];
     snprintf(cfg, sizeof cfg, "%s",
              cli_config("sig-slab", "[experiment]\nname = s\ngeometry = slab\nmethods = ppslab\n"
-                                    "[bins]\nsamples_dir = 8\n[pp]\ndirections = 1000\n"));
+                                    "[bins]\nsamples_dir = 24\n[pp]\ndirections = 1000\n"));
     snprintf(args, sizeof args, "run --out '%s/out' '%s'", dir, cfg);
     child c;
     start(&c, dir, args);
