@@ -306,6 +306,17 @@ inline int moc_find(__global const double *e, int n, double v, int asc)
     return lo;
 }
 
+/* The radiance leaving a segment of 3-D length L and optical length tau = sigma_t L that psi
+ * entered, with flat emission q: exact for the flat source, its first order where e^{-tau}
+ * would lose the difference. */
+inline double moc_segment(double psi, double q, double st, double tau, double L)
+{
+    if (tau < 1e-8)
+        return psi + (q - st * psi) * L;
+    double e = exp(-tau);
+    return psi * e + (q / st) * (1.0 - e);
+}
+
 /* One track: the line p0 + t u (planar), v_k its perpendicular offset. mode 0 counts it at its
  * entry edge (scr += 1); mode 1 transports psi_in = scr[entry edge] through the FSRs, adding each
  * segment's s delta (psi_in - psi_out) to tal and the exit's s delta psi to bout. */
@@ -330,16 +341,16 @@ inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, dou
     double tin = fmax(txa, tya), tout = fmin(txb, tyb);
     if (!(tout > tin))
         return;
-    int nb_s3 = 2 * g->nfx, i, j, edge;
+    int i, j, edge;
     double xin = p0x + tin * ux, yin = p0y + tin * uy;
     if (txa > tya) { /* through S3 (moving +x) or S4 */
         i = ux > 0.0 ? 0 : g->nfx - 1;
         j = moc_find(g->fy, g->ny, yin, 0);
-        edge = nb_s3 + (ux > 0.0 ? 0 : g->ny) + j;
+        edge = ppb_moc_edge0(g->nfx, g->ny, ux > 0.0 ? PPB_S3 : PPB_S4) + j;
     } else { /* through S1 (moving down) or S2 */
         j = uy < 0.0 ? 0 : g->ny - 1;
         i = moc_find(g->fx, g->nfx, xin, 1);
-        edge = (uy < 0.0 ? 0 : g->nfx) + i;
+        edge = ppb_moc_edge0(g->nfx, g->ny, uy < 0.0 ? PPB_S1 : PPB_S2) + i;
     }
     if (mode == 0) {
         scr[edge] += 1.0;
@@ -353,13 +364,7 @@ inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, dou
         double tn = fmin(fmin(tnx, tny), tout), l = tn - t;
         if (l > 0.0) {
             int f = j * g->nfx + i;
-            double st = sig[i], q = Q[f], tau = st * l / s, po;
-            if (tau < 1e-8)
-                po = psi + (q - st * psi) * (l / s);
-            else {
-                double e = exp(-tau);
-                po = psi * e + (q / st) * (1.0 - e);
-            }
+            double st = sig[i], po = moc_segment(psi, Q[f], st, st * l / s, l / s);
             tal[f] += w * (psi - po);
             psi = po;
             t = tn;
@@ -372,7 +377,8 @@ inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, dou
             /* The face left through: the line crossed out of the grid (x at a corner), or where
              * the track ends when rounding ended it a hair before its last crossing. */
             int xface = (outx || outy) ? outx : txb < tyb;
-            int out = xface ? nb_s3 + (ux > 0.0 ? g->ny : 0) + j : (uy < 0.0 ? g->nfx : 0) + i;
+            int out = xface ? ppb_moc_edge0(g->nfx, g->ny, ux > 0.0 ? PPB_S4 : PPB_S3) + j
+                            : ppb_moc_edge0(g->nfx, g->ny, uy < 0.0 ? PPB_S2 : PPB_S1) + i;
             bout[out] += w * psi;
             return;
         }
@@ -415,19 +421,15 @@ inline void moc_slab(const ppb_rte_params *P, const moc_grid *g, double wy,
     if (w < 1e-12)
         return; /* z-invariant in x too: psi = Q / sigma_t, the balance form's answer */
     int down = wy < 0.0, j = down ? 0 : g->ny - 1, dj = down ? 1 : -1;
-    double psi = P->refl ? bin[down ? 0 : 1] / w : 0.0;
+    int in = ppb_moc_edge0(g->nfx, g->ny, down ? PPB_S1 : PPB_S2);
+    int out = ppb_moc_edge0(g->nfx, g->ny, down ? PPB_S2 : PPB_S1);
+    double psi = P->refl ? bin[in] / w : 0.0;
     for (; j >= 0 && j < g->ny; j += dj) {
-        double L = (g->fy[j] - g->fy[j + 1]) / w, tau = st * L, q = Q[j], po;
-        if (tau < 1e-8)
-            po = psi + (q - st * psi) * L;
-        else {
-            double e = exp(-tau);
-            po = psi * e + (q / st) * (1.0 - e);
-        }
+        double L = (g->fy[j] - g->fy[j + 1]) / w, po = moc_segment(psi, Q[j], st, st * L, L);
         tal[j] += w * (psi - po);
         psi = po;
     }
-    bout[down ? 1 : 0] += w * psi;
+    bout[out] += w * psi;
 }
 
 /* One work-item per transported direction cell: all its tracks, in order, so the sums are the
@@ -435,8 +437,8 @@ inline void moc_slab(const ppb_rte_params *P, const moc_grid *g, double wy,
 __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
                           __global const double *edges, __global const double *sig,
                           __global const double *Q, __global const double *bin,
-                          __global double *out, __global double *bout, __global double *scr,
-                          const int nfx, const double2 dmin)
+                          __global double *out, __global double *scr, const int nfx,
+                          const double2 dmin)
 {
     int c = (int)get_global_id(0);
     if (c >= P.ncell)
@@ -444,7 +446,8 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
     moc_grid g = {nfx, P.ny, edges, edges + nfx + 1};
     int nf = nfx * P.ny, nb = ppb_moc_nb(nfx, P.ny);
     __global const double *q = Q + (long)c * nf, *bi = bin + (long)c * nb;
-    __global double *tal = out + (long)c * nf, *bo = bout + (long)c * nb, *sc = scr + (long)c * nb;
+    /* The cell's slice of the unknown: its FSRs' radiance, then its edges' outgoing power. */
+    __global double *tal = out + (long)c * (nf + nb), *bo = tal + nf, *sc = scr + (long)c * nb;
     for (int f = 0; f < nf; f++)
         tal[f] = 0.0;
     for (int e = 0; e < nb; e++)
@@ -465,10 +468,9 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
             for (int k = 0; k < ntr; k++)
                 moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, tal, bo, sc,
                           0);
-            moc_inflow(bi, sc, 0, nfx, s * delta);
-            moc_inflow(bi, sc, nfx, nfx, s * delta);
-            moc_inflow(bi, sc, 2 * nfx, P.ny, s * delta);
-            moc_inflow(bi, sc, 2 * nfx + P.ny, P.ny, s * delta);
+            for (int face = PPB_S1; face <= PPB_S4; face++)
+                moc_inflow(bi, sc, ppb_moc_edge0(nfx, P.ny, face), ppb_moc_nedge(nfx, P.ny, face),
+                           s * delta);
         }
         for (int k = 0; k < ntr; k++)
             moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, tal, bo, sc, 1);

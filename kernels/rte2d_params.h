@@ -60,12 +60,13 @@ enum {
     PPB_MOC_ARG_SIG = 3,    /* sigma_t of each FSR column [nfx] */
     PPB_MOC_ARG_SRC = 4,    /* flat emission density Q [ncell][nfsr], per sr */
     PPB_MOC_ARG_BIN = 5,    /* power entering through each boundary edge [ncell][nb] */
-    PPB_MOC_ARG_OUT = 6,    /* the FSRs' average radiance [ncell][nfsr] */
-    PPB_MOC_ARG_BOUT = 7,   /* power leaving through each boundary edge [ncell][nb] */
-    PPB_MOC_ARG_SCR = 8,    /* scratch [ncell][nb] */
-    PPB_MOC_ARG_NFX = 9,    /* int: FSR columns */
-    PPB_MOC_ARG_DMIN = 10,  /* double2: the least FSR width and height (track spacing) */
-    PPB_MOC_NARGS = 11
+    PPB_MOC_ARG_OUT = 6,    /* [ncell][nfsr + nb]: the FSRs' average radiance, then the power
+                               leaving through each boundary edge (the solve's unknown,
+                               rte2d_grid.h) */
+    PPB_MOC_ARG_SCR = 7,    /* scratch [ncell][nb] */
+    PPB_MOC_ARG_NFX = 8,    /* int: FSR columns */
+    PPB_MOC_ARG_DMIN = 9,   /* double2: the least FSR width and height (track spacing) */
+    PPB_MOC_NARGS = 10
 };
 
 /* Tracks a direction lays across its thinnest FSR (its projected width, perpendicular). */
@@ -75,6 +76,17 @@ enum {
 PPB_FN int ppb_moc_nb(int nfx, int ny)
 {
     return 2 * nfx + 2 * ny;
+}
+
+/* The first boundary edge of face PPB_S1..S4 and the face's edge count (the order above). */
+PPB_FN int ppb_moc_edge0(int nfx, int ny, int face)
+{
+    return face < 2 ? face * nfx : 2 * nfx + (face - 2) * ny;
+}
+
+PPB_FN int ppb_moc_nedge(int nfx, int ny, int face)
+{
+    return face < 2 ? nfx : ny;
 }
 
 /* Doubles per transported cell of the grid's walls (rte2d_grid.h, G->bnd): the slot of the

@@ -39,20 +39,20 @@ typedef struct rte_solver {
     cl_program prog;
     cl_kernel moc, exitk;
     /* The sweep's buffers (rte2d_params.h, PPB_MOC_ARG_*) and the exit march's. */
-    cl_mem dirs, edges, sig, q, bin, psi, bout, scr;
+    cl_mem dirs, edges, sig, q, bin, xo, scr; /* xo: the sweep's result, the unknown's layout */
     cl_mem src, out, radb, bnd; /* exit: sources, radiance, n > 1: node field and walls */
     size_t nvec;                /* the unknown: nc (nf + nb) (rte2d_grid.h) */
     double *Q, *Qb, *J, *B;     /* [nc][nf] emission, beam emission, scatter; [nc][nb] inflow */
     double *rn;                 /* [nc][nnodes]: a field at the nodes, for the exit march */
-    double collided, absorbed_beam;
+    double absorbed_beam;       /* the beam's collisions times 1 - alpha (ppb_rte_beam_sources) */
     int sweeps;
     double t_sweeps;
 } rte_solver;
 
 static void solver_free(rte_solver *s)
 {
-    cl_mem bufs[] = {s->dirs, s->edges, s->sig, s->q,   s->bin,  s->psi,
-                     s->bout, s->scr,   s->src, s->out, s->radb, s->bnd};
+    cl_mem bufs[] = {s->dirs, s->edges, s->sig, s->q,    s->bin, s->xo,
+                     s->scr,  s->src,   s->out, s->radb, s->bnd};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             clReleaseMemObject(bufs[i]);
@@ -115,8 +115,7 @@ static void reflect_inflow(const ppb_rte_grid *G, const double *x, double *B)
     int nc = G->nc;
     memset(B, 0, sizeof(double) * nc * G->nb);
     for (int face = 0; face < (G->P.tube ? 4 : 2); face++) {
-        int e0 = face < 2 ? face * G->nfx : 2 * G->nfx + (face - 2) * G->P.ny;
-        int ne = face < 2 ? G->nfx : G->P.ny;
+        int e0 = ppb_moc_edge0(G->nfx, G->P.ny, face), ne = ppb_moc_nedge(G->nfx, G->P.ny, face);
         for (int b = 0; b < nc; b++) {
             const double *row = G->refl + ((size_t)face * nc + b) * nc;
             const double *out = x + b * stride + G->nf;
@@ -159,7 +158,7 @@ static int sweep(rte_solver *s, const double *x, int beam, double *y, ppb_err *e
     size_t global = (size_t)G->nc;
     int nfx = G->nfx;
     cl_double2 dmin = {{G->dmin[0], G->dmin[1]}};
-    cl_mem args[] = {s->dirs, s->edges, s->sig, s->q, s->bin, s->psi, s->bout, s->scr};
+    cl_mem args[] = {s->dirs, s->edges, s->sig, s->q, s->bin, s->xo, s->scr};
     int rc = ppb_cl_check(clEnqueueWriteBuffer(qu, s->q, CL_TRUE, 0, nq * sizeof(double), s->Q, 0,
                                                NULL, NULL),
                           "clEnqueueWriteBuffer(rte2d source)", err) ||
@@ -169,26 +168,16 @@ static int sweep(rte_solver *s, const double *x, int beam, double *y, ppb_err *e
              set_arg(s->moc, PPB_MOC_ARG_PARAMS, sizeof P, &P, err) ||
              set_arg(s->moc, PPB_MOC_ARG_NFX, sizeof nfx, &nfx, err) ||
              set_arg(s->moc, PPB_MOC_ARG_DMIN, sizeof dmin, &dmin, err);
-    for (cl_uint i = 0; !rc && i < 8; i++)
+    for (cl_uint i = 0; !rc && i < sizeof args / sizeof args[0]; i++)
         rc = set_arg(s->moc, PPB_MOC_ARG_DIRS + i, sizeof(cl_mem), &args[i], err);
     if (rc ||
         ppb_cl_check(clEnqueueNDRangeKernel(qu, s->moc, 1, NULL, &global, NULL, 0, NULL, NULL),
                      "clEnqueueNDRangeKernel(rte2d sweep)", err))
         return -1;
-    /* y = [psi | bout] per cell (rte2d_grid.h). */
-    size_t stride = (size_t)G->nf + G->nb;
-    for (int a = 0; a < G->nc; a++) {
-        size_t off = a * stride * sizeof(double);
-        if (ppb_cl_check(clEnqueueReadBuffer(qu, s->psi, CL_FALSE, (size_t)a * G->nf * 8,
-                                             (size_t)G->nf * 8, (char *)y + off, 0, NULL, NULL),
-                         "clEnqueueReadBuffer(rte2d sweep)", err) ||
-            ppb_cl_check(clEnqueueReadBuffer(qu, s->bout, CL_FALSE, (size_t)a * G->nb * 8,
-                                             (size_t)G->nb * 8, (char *)y + off + G->nf * 8, 0,
-                                             NULL, NULL),
-                         "clEnqueueReadBuffer(rte2d sweep)", err))
-            return -1;
-    }
-    if (ppb_cl_check(clFinish(qu), "clFinish(rte2d sweep)", err))
+    /* y in the unknown's layout (rte2d_grid.h), as the kernel wrote it. */
+    if (ppb_cl_check(
+            clEnqueueReadBuffer(qu, s->xo, CL_TRUE, 0, s->nvec * sizeof(double), y, 0, NULL, NULL),
+            "clEnqueueReadBuffer(rte2d sweep)", err))
         return -1;
     s->sweeps++;
     s->t_sweeps += ppb_now() - t0;
@@ -226,7 +215,7 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_
     s->rn = malloc(sizeof(double) * nodes);
     if (!s->Q || !s->Qb || !s->J || !s->B || !s->rn)
         return ppb_fail(err, "rte2d: out of memory");
-    if (ppb_rte_beam_sources(G, s->Qb, &s->collided, &s->absorbed_beam, err) ||
+    if (ppb_rte_beam_sources(G, s->Qb, &s->absorbed_beam, err) ||
         ppb_ocl_build(ocl, "rte2d.cl", "", &s->prog, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_moc", &s->moc, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_exit", &s->exitk, err))
@@ -244,8 +233,7 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_
         {&s->sig, ro, (size_t)G->nfx, G->fsig, "rte2d sigma_t"},
         {&s->q, ro, nq, NULL, "rte2d emission"},
         {&s->bin, ro, nb, NULL, "rte2d inflow"},
-        {&s->psi, rw, nq, NULL, "rte2d regions"},
-        {&s->bout, rw, nb, NULL, "rte2d outflow"},
+        {&s->xo, rw, s->nvec, NULL, "rte2d regions and outflow"},
         {&s->scr, rw, nb, NULL, "rte2d scratch"},
         {&s->src, ro, planes * G->nnodes, NULL, "rte2d exit source"},
         {&s->out, CL_MEM_WRITE_ONLY, out_cells, NULL, "rte2d exit output"},
@@ -586,7 +574,7 @@ static int solve_field(rte_solver *s, const ppb_config *cfg, double *rad, double
                        ppb_gmres_basis *kb, ppb_rte2d_stats *st, ppb_err *err)
 {
     int K = cfg->rte2d.refinements;
-    /* I_1: the exact first scattering marched to every node; I_pp: the start. */
+    /* I_1: the beam's first scattering swept through every region; I_pp: the start. */
     int rc = sweep(s, NULL, 1, b, err);
     if (!rc)
         rc = ppb_rte_initial_pp(&s->G, &cfg->scene, s->rn, err);

@@ -131,13 +131,16 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
     return 0;
 }
 
+/* w . n, n the outward normal of face PPB_S1..S4. */
+static double out_cos(int face, const double *w)
+{
+    return face == PPB_S1 ? w[1] : face == PPB_S2 ? -w[1] : face == PPB_S3 ? -w[0] : w[0];
+}
+
 /* Does a direction w enter the cross-section through face f (move inward there)? */
 static int enters(int face, const double *w)
 {
-    return face == PPB_S1   ? w[1] < 0.0
-           : face == PPB_S2 ? w[1] > 0.0
-           : face == PPB_S3 ? w[0] > 0.0
-                            : w[0] < 0.0;
+    return out_cos(face, w) < 0.0;
 }
 
 /* The walls' reflection map (rte2d_grid.h, G->refl): cell b's Gauss nodes mirrored in face f,
@@ -192,7 +195,7 @@ static int grid_reflection(ppb_rte_grid *G, ppb_err *err)
 
 /* The FSRs (rte2d_grid.h): dual-cell edges at the midpoints between nodes, the faces, and
  * step_x where a node column lies on it. */
-static int grid_fsr(ppb_rte_grid *G, const ppb_scene *sc, ppb_err *err)
+static int grid_fsr(ppb_rte_grid *G, ppb_err *err)
 {
     const ppb_rte_params *P = &G->P;
     int split = P->tube && P->nx > P->nl + 1; /* node nl sits on step_x */
@@ -244,7 +247,6 @@ static int grid_fsr(ppb_rte_grid *G, const ppb_scene *sc, ppb_err *err)
         for (int k = 0; k < G->nfx; k++)
             G->farea[j * G->nfx + k] = (fx[k + 1] - fx[k]) * (fy[j] - fy[j + 1]);
     }
-    (void)sc;
     return 0;
 }
 
@@ -321,35 +323,16 @@ void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad)
     }
 }
 
-/* Length of boundary edge e and the outward normal's component along w (|w . n| where w leaves,
- * 0 where it enters). */
-static double edge_out(const ppb_rte_grid *G, int e, const double *w)
+/* Edge k of face PPB_S1..S4 (rte2d_params.h's order): the FSR it borders and its length. */
+static int face_edge(const ppb_rte_grid *G, int face, int k, double *len)
 {
     const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
     int nfx = G->nfx, ny = G->P.ny;
-    if (e < nfx)
-        return w[1] > 0.0 ? w[1] * (fx[e + 1] - fx[e]) : 0.0;
-    if (e < 2 * nfx)
-        return w[1] < 0.0 ? -w[1] * (fx[e - nfx + 1] - fx[e - nfx]) : 0.0;
-    if (!G->P.tube)
-        return 0.0;
-    int j = (e - 2 * nfx) % ny;
-    double len = fy[j] - fy[j + 1];
-    if (e < 2 * nfx + ny)
-        return w[0] < 0.0 ? -w[0] * len : 0.0;
-    return w[0] > 0.0 ? w[0] * len : 0.0;
-}
-
-/* The FSR a boundary edge borders. */
-static int edge_fsr(const ppb_rte_grid *G, int e)
-{
-    int nfx = G->nfx, ny = G->P.ny;
-    if (e < nfx)
-        return e;
-    if (e < 2 * nfx)
-        return (ny - 1) * nfx + (e - nfx);
-    int j = (e - 2 * nfx) % ny;
-    return j * nfx + (e < 2 * nfx + ny ? 0 : nfx - 1);
+    *len = face < 2 ? fx[k + 1] - fx[k] : fy[k] - fy[k + 1];
+    return face == PPB_S1   ? k
+           : face == PPB_S2 ? (ny - 1) * nfx + k
+           : face == PPB_S3 ? k * nfx
+                            : k * nfx + nfx - 1;
 }
 
 void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x)
@@ -363,25 +346,31 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x)
             for (int k = 0; k < G->nfx; k++)
                 psi[j * G->nfx + k] = r[j * P->nx + G->fcol[k]];
         for (int e = 0; e < G->nb; e++)
-            bout[e] = edge_out(G, e, G->dir4 + 4 * a) * psi[edge_fsr(G, e)];
+            bout[e] = 0.0;
+        for (int face = 0; face < (P->tube ? 4 : 2); face++) {
+            int e0 = ppb_moc_edge0(G->nfx, P->ny, face), ne = ppb_moc_nedge(G->nfx, P->ny, face);
+            double wn = out_cos(face, G->dir4 + 4 * a), len;
+            for (int k = 0; wn > 0.0 && k < ne; k++) {
+                int f = face_edge(G, face, k, &len);
+                bout[e0 + k] = wn * len * psi[f];
+            }
+        }
     }
 }
 
-int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *collided, double *absorbed,
-                         ppb_err *err)
+int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, ppb_err *err)
 {
     const ppb_rte_params *P = &G->P;
     const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
     double *E = malloc(sizeof(double) * 4 * G->nf);
     if (!E)
         return ppb_fail(err, "rte2d: out of memory (beam sources)");
-    *collided = *absorbed = 0.0;
+    *absorbed = 0.0;
     for (int j = 0; j < P->ny; j++)
         for (int k = 0; k < G->nfx; k++) {
             int f = j * G->nfx + k;
             ppb_rte_beam_rect(P, fx[k], fx[k + 1], fy[j + 1], fy[j], E + 4 * f);
             double sum = E[4 * f] + E[4 * f + 1] + E[4 * f + 2] + E[4 * f + 3];
-            *collided += sum;
             *absorbed += (1.0 - G->falb[k]) * sum;
         }
     for (int a = 0; a < G->nc; a++) {
@@ -513,7 +502,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     if (!rc && sc->n > 1.0)
         rc = grid_walls(G, sc, F, err);
     if (!rc)
-        rc = grid_fsr(G, sc, err);
+        rc = grid_fsr(G, err);
     if (!rc && sc->n > 1.0)
         rc = grid_reflection(G, err);
     free(Pfull);
@@ -624,7 +613,7 @@ void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *x, double flux[4
         const double *bc = G->bnd ? G->bnd + PPB_RTE_BND * a : NULL;
         double w = G->mult[a] * G->dirs.solid;
         for (int face = 0; face < 4; face++) {
-            int e0 = face < 2 ? face * nfx : 2 * nfx + (face - 2) * ny, ne = face < 2 ? nfx : ny;
+            int e0 = ppb_moc_edge0(nfx, ny, face), ne = ppb_moc_nedge(nfx, ny, face);
             double sum = 0.0;
             for (int e = e0; e < e0 + ne; e++)
                 sum += bout[e];
