@@ -11,12 +11,12 @@ SAN     ?=
 CFLAGS  += -std=c11 $(OPT) $(WARN) $(SAN) -fno-strict-aliasing
 # Includes name their layer (#include "physics/maps.h", "kernels/ppb_conventions.h").
 CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc -I. \
-            -DPPB_KERNEL_DIR='"$(CURDIR)/kernels"' -DPPB_SCRIPT_DIR='"$(CURDIR)/scripts"'
+            -Ikernels -DPPB_SOURCE_DIR='"$(CURDIR)"' -DPPB_SCRIPT_DIR='"$(CURDIR)/scripts"'
 LDFLAGS += $(SAN)
 
-# src/<layer>/<module>.c; the layers and their order are in README.md (Layout) and checked by
+# src/<layer>/<module>.c, and src/methods/<slice>/<module>.c for each method; the layers and their order are in README.md (Layout) and checked by
 # scripts/check_layers.sh.
-SRC   := $(filter-out src/drivers/main.c,$(wildcard src/*/*.c))
+SRC   := $(filter-out src/drivers/main.c,$(wildcard src/*/*.c src/methods/*/*.c))
 OBJ   := $(SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
@@ -117,11 +117,13 @@ test: test-cluster
 test-cluster: $(BIN)
 	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= BUILD_DIR=$(CURDIR)/$(BUILD) timeout 900 bash tests/cluster.sh
 
+FORMATTED = $(wildcard src/*/*.[ch] src/methods/*/*.[ch] src/methods/*/*.cl tests/*.[ch] \
+              kernels/*.cl kernels/*.h)
 format:
-	clang-format -i src/*/*.c src/*/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
+	clang-format -i $(FORMATTED)
 
 format-check:
-	clang-format --dry-run --Werror src/*/*.c src/*/*.h tests/*.c tests/*.h kernels/*.cl kernels/*.h
+	clang-format --dry-run --Werror $(FORMATTED)
 
 clean:
 	rm -rf build build-asan ppbench

@@ -641,27 +641,30 @@ static void test_default_cache(void **state)
 }
 
 /* A changed kernel is another reference: the key holds the hash of mc.cl's source text and of
- * every header it includes. A copy of kernels/ in another directory (PPBENCH_KERNELS) serves
- * the cached tallies (the text is the same, its place does not count); a comment added to
- * mc.cl, or to a header it includes (ppb_sampling.h), makes the run trace again. */
+ * every header it includes. A copy of the kernel sources in another tree (PPBENCH_SOURCE)
+ * serves the cached tallies (the text is the same, its place does not count); a comment added
+ * to mc.cl, or to a header it includes (ppb_sampling.h), makes the run trace again. */
 static void test_cache_kernel_change(void **state)
 {
     (void)state;
     char dir[1024], env[4096], out[1100], cache[1100];
     snprintf(dir, sizeof dir, "%s", tu_scratch("ext_kcache"));
     snprintf(cache, sizeof cache, "%s/cache", dir);
-    assert_int_equal(tu_sh("rm -rf %s/k && cp -r %s %s/k", dir, PPB_KERNEL_DIR, dir), 0);
+    assert_int_equal(tu_sh("rm -rf %s/k && mkdir -p %s/k && cd %s && cp --parents kernels/*.h "
+                           "src/methods/*/*.cl src/methods/*/*.h %s/k",
+                           dir, dir, PPB_SOURCE_DIR, dir),
+                     0);
     snprintf(env, sizeof env, "PPBENCH_CACHE=%s", cache);
     snprintf(out, sizeof out, "%s/a", dir);
     assert_true(traced(env, "--quiet", out));
-    snprintf(env, sizeof env, "PPBENCH_CACHE=%s PPBENCH_KERNELS=%s/k", cache, dir);
+    snprintf(env, sizeof env, "PPBENCH_CACHE=%s PPBENCH_SOURCE=%s/k", cache, dir);
     snprintf(out, sizeof out, "%s/b", dir);
     assert_false(traced(env, "--quiet", out));
-    const char *edits[] = {"mc.cl", "ppb_sampling.h"};
+    const char *edits[] = {"src/methods/mc/mc.cl", "kernels/ppb_sampling.h"};
     for (int i = 0; i < 2; i++) {
-        /* mc.cl restored from kernels/ each time: the second edit is the header's alone. */
+        /* mc.cl restored from the tree each time: the second edit is the header's alone. */
         assert_int_equal(tu_sh("cp %s/%s %s/k/%s && printf '\\n/* changed */\\n' >> %s/k/%s",
-                               PPB_KERNEL_DIR, edits[0], dir, edits[0], dir, edits[i]),
+                               PPB_SOURCE_DIR, edits[0], dir, edits[0], dir, edits[i]),
                          0);
         snprintf(out, sizeof out, "%s/c%d", dir, i);
         if (!traced(env, "--quiet", out))

@@ -10,10 +10,12 @@ static void broken_kernel(const char *file, const char *methods)
 {
     const char *dir = tu_scratch("broken-kernels");
     char cmd[3000], env[1200], args[3000];
-    snprintf(cmd, sizeof cmd, "cp %s/*.cl %s/*.h '%s' && echo 'this is not OpenCL C' >> '%s/%s'",
-             PPB_KERNEL_DIR, PPB_KERNEL_DIR, dir, dir, file);
+    snprintf(cmd, sizeof cmd,
+             "cd %s && cp --parents kernels/*.h src/methods/*/*.cl src/methods/*/*.h '%s' && "
+             "echo 'this is not OpenCL C' >> '%s/%s'",
+             PPB_SOURCE_DIR, dir, dir, file);
     assert_int_equal(system(cmd), 0);
-    snprintf(env, sizeof env, "PPBENCH_KERNELS='%s'", dir);
+    snprintf(env, sizeof env, "PPBENCH_SOURCE='%s'", dir);
     const char *p = cli_config("broken-cfg", "[mc]\nphotons = 1e4\n");
     snprintf(args, sizeof args, "run --quiet --set experiment.methods=%s --out '%s/out' '%s'",
              methods, dir, p);
@@ -24,13 +26,13 @@ static void broken_kernel(const char *file, const char *methods)
 static void test_kernel_build_failure_march(void **state)
 {
     (void)state;
-    broken_kernel("march.cl", "ss");
+    broken_kernel("src/methods/pp/march.cl", "ss");
 }
 
 static void test_kernel_build_failure_mc(void **state)
 {
     (void)state;
-    broken_kernel("mc.cl", "mc");
+    broken_kernel("src/methods/mc/mc.cl", "mc");
 }
 
 int main(void)

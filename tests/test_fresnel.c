@@ -10,8 +10,8 @@
 #include <math.h>
 
 #include "kernels/ppb_fresnel.h"
-#include "methods/mc_tally.h"
-#include "methods/method_mc.h"
+#include "methods/mc/mc_tally.h"
+#include "methods/mc/method_mc.h"
 #include "methods/registry.h"
 #include "model/config.h"
 #include "physics/ppsolver.h"

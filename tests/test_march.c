@@ -7,8 +7,8 @@
 
 #include <math.h>
 
-#include "methods/march.h"
-#include "methods/method_pp.h"
+#include "methods/pp/march.h"
+#include "methods/pp/method_pp.h"
 #include "physics/ppsolver.h"
 
 static ppb_ocl g_ocl;

@@ -12,10 +12,10 @@
 #include <math.h>
 #include <signal.h>
 
-#include "kernels/mc_params.h"
-#include "methods/mc_tally.h"
-#include "methods/method_mc.h"
-#include "methods/method_ppslab.h"
+#include "methods/mc/mc_params.h"
+#include "methods/mc/mc_tally.h"
+#include "methods/mc/method_mc.h"
+#include "methods/ppslab/method_ppslab.h"
 #include "base/progress.h"
 
 /* One run context per test, on the default device ($PPBENCH_DEVICE or 0). */
@@ -551,7 +551,7 @@ static void test_slab_vs_ppslab(void **state)
         mc_fixture f = {0};
         ppb_err err;
         char path[1024];
-        snprintf(path, sizeof path, "%s/../configs/slab_g0.ini", PPB_KERNEL_DIR);
+        snprintf(path, sizeof path, "%s/configs/slab_g0.ini", PPB_SOURCE_DIR);
         if (ppb_config_load(&f.cfg, path, &err) ||
             ppb_config_set(&f.cfg, "medium", "g", gs[i], &err))
             fail_msg("%s", err.msg);
@@ -596,7 +596,7 @@ static void expect_no_mismatches(const char *name, const char *const *opts, int 
     for (int i = 0; i < nopts; i++) {
         cl_program prog;
         cl_kernel k;
-        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
+        if (ppb_ocl_build(ocl, PPB_MC_KERNEL, opts[i], &prog, &err) ||
             ppb_ocl_kernel(prog, name, &k, &err))
             fail_msg("%s", err.msg);
         for (int j = 0; j < nargs; j++) {
@@ -673,7 +673,7 @@ static void test_vector_bins_match_conventions(void **state)
     for (int i = 0; i < 2; i++) {
         cl_program prog;
         cl_kernel k;
-        if (ppb_ocl_build(ocl, "mc.cl", opts[i], &prog, &err) ||
+        if (ppb_ocl_build(ocl, PPB_MC_KERNEL, opts[i], &prog, &err) ||
             ppb_ocl_kernel(prog, "ppb_mc_bins_check", &k, &err))
             fail_msg("%s", err.msg);
         for (int j = 0; j < 4; j++) {
@@ -821,11 +821,11 @@ static void test_hg_sampler_chi_square(void **state)
     ppb_err err;
     if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
         fail_msg("%s", err.msg);
-    const char *dir = getenv("PPBENCH_KERNELS") && *getenv("PPBENCH_KERNELS")
-                          ? getenv("PPBENCH_KERNELS")
-                          : PPB_KERNEL_DIR;
+    const char *dir = getenv("PPBENCH_SOURCE") && *getenv("PPBENCH_SOURCE")
+                          ? getenv("PPBENCH_SOURCE")
+                          : PPB_SOURCE_DIR;
     char opts[2200];
-    snprintf(opts, sizeof opts, "-I %s -I /usr/include", dir); /* as ppb_ocl_build */
+    snprintf(opts, sizeof opts, "-I %s/kernels -I /usr/include", dir); /* as ppb_ocl_build */
     cl_int rc;
     cl_program prog = clCreateProgramWithSource(ocl->context, 1, &sampler_src, NULL, &rc);
     assert_int_equal(rc, CL_SUCCESS);

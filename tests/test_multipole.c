@@ -13,8 +13,8 @@
 
 #include "model/config.h"
 #include "kernels/ppb_fresnel.h"
-#include "methods/method_mp.h"
-#include "physics/multipole.h"
+#include "methods/mp/method_mp.h"
+#include "methods/mp/multipole.h"
 #include "physics/ppsolver.h"
 
 /* 2 pi int_0^inf r f(r) dr by 8-point-per-panel midpoint-free Gauss-Legendre on geometric

@@ -46,7 +46,7 @@ static void test_build_log(void **state)
     FILE *f = fopen(path, "w");
     fputs("__kernel void k(__global int *a) { a[0] = undefined_symbol; }\n", f);
     fclose(f);
-    setenv("PPBENCH_KERNELS", dir, 1);
+    setenv("PPBENCH_SOURCE", dir, 1);
     ppb_err err = {{0}};
     ppb_ocl ocl;
     assert_int_equal(ppb_ocl_open(&ocl, NULL, &err), 0);
@@ -56,7 +56,7 @@ static void test_build_log(void **state)
     assert_non_null(strstr(err.msg, "undefined_symbol")); /* the compiler's log is included */
     assert_int_equal(ppb_ocl_build(&ocl, "missing.cl", NULL, &prog, &err), -1);
     assert_non_null(strstr(err.msg, "missing.cl: cannot open kernel source"));
-    unsetenv("PPBENCH_KERNELS");
+    unsetenv("PPBENCH_SOURCE");
     ppb_ocl_close(&ocl);
 }
 
@@ -77,7 +77,7 @@ static void test_kernel_matches_host(void **state)
     ppb_ocl ocl;
     assert_int_equal(ppb_ocl_open(&ocl, NULL, &err), 0);
     cl_program prog;
-    if (ppb_ocl_build(&ocl, "selftest.cl", NULL, &prog, &err))
+    if (ppb_ocl_build(&ocl, "kernels/selftest.cl", NULL, &prog, &err))
         fail_msg("%s", err.msg);
     cl_kernel k;
     assert_int_equal(ppb_ocl_kernel(prog, "bins_of", &k, &err), 0);

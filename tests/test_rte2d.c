@@ -20,9 +20,9 @@
 
 #include <lapacke.h>
 
-#include "methods/method_mc.h"
-#include "methods/method_ppslab.h"
-#include "methods/method_rte2d.h"
+#include "methods/mc/method_mc.h"
+#include "methods/ppslab/method_ppslab.h"
+#include "methods/rte2d/method_rte2d.h"
 #include "model/config.h"
 #include "model/metrics.h"
 #include "physics/gmres.h"

@@ -15,8 +15,8 @@
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
 #include "model/config.h"
-#include "physics/rte2d_beam.h"
-#include "physics/rte2d_grid.h"
+#include "methods/rte2d/rte2d_beam.h"
+#include "methods/rte2d/rte2d_grid.h"
 
 static ppb_scene base_scene(ppb_geometry geom)
 {

@@ -19,7 +19,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "methods/mc_tally.h"
+#include "methods/mc/mc_tally.h"
 
 /* Soft checks: each failure is printed and counted, and the test fails at its end, so one run
  * shows every check that fails (on the code before the fixes: all of them). */

@@ -11,7 +11,7 @@
 #include "io/csv.h"
 #include "io/images.h"
 #include "io/plots.h"
-#include "methods/method_rte2d.h"
+#include "methods/rte2d/method_rte2d.h"
 #include "methods/registry.h"
 #include "methods/work_estimate.h"
 #include "base/progress.h"

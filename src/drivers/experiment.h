@@ -11,7 +11,7 @@
 
 #include "model/config.h"
 #include "methods/method.h"
-#include "methods/method_rte2d.h"
+#include "methods/rte2d/method_rte2d.h"
 #include "model/result.h"
 #include "drivers/provenance.h"
 

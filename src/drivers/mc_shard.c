@@ -6,7 +6,7 @@
 
 #include "base/atomic_file.h"
 #include "drivers/experiment.h"
-#include "methods/method_mc.h"
+#include "methods/mc/method_mc.h"
 
 /* Photons of part i of n: a contiguous range, the remainder spread over the first parts. */
 static void part_range(long long total, int i, int n, long long *first, long long *count)

@@ -1,7 +1,7 @@
 /* perf_march.c: the ray marcher's benchmark (perf_march.h). */
 #include "drivers/perf_march.h"
 
-#include "methods/march.h"
+#include "methods/pp/march.h"
 #include "base/progress.h"
 
 /* Times one whole case (every row of the layout in one launch) after a warm-up run of the same

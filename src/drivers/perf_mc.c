@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "base/csv_read.h"
-#include "methods/method_mc.h"
+#include "methods/mc/method_mc.h"
 #include "model/metrics.h"
 
 /* Photons per timed case: enough for a few seconds on a 2-core CPU (the launches then dominate

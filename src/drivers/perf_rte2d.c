@@ -1,7 +1,7 @@
 /* perf_rte2d.c: the rte2d benchmark (perf_rte2d.h). */
 #include "drivers/perf_rte2d.h"
 
-#include "methods/method_rte2d.h"
+#include "methods/rte2d/method_rte2d.h"
 
 int ppb_perf_rte2d(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
 {

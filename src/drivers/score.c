@@ -11,7 +11,7 @@
 #include "base/csv_read.h"
 #include "drivers/experiment.h"
 #include "io/csv.h"
-#include "methods/method_external.h"
+#include "methods/external/method_external.h"
 #include "methods/registry.h"
 #include "model/config.h"
 

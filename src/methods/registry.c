@@ -3,13 +3,13 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "methods/method_mc.h"
-#include "methods/method_external.h"
-#include "methods/method_mp.h"
-#include "methods/method_pp.h"
-#include "methods/method_ppslab.h"
-#include "methods/method_rte2d.h"
-#include "methods/method_ss.h"
+#include "methods/mc/method_mc.h"
+#include "methods/external/method_external.h"
+#include "methods/mp/method_mp.h"
+#include "methods/pp/method_pp.h"
+#include "methods/ppslab/method_ppslab.h"
+#include "methods/rte2d/method_rte2d.h"
+#include "methods/pp/method_ss.h"
 
 /* The registry: the order here is the order of outputs. */
 static const ppb_method methods[] = {

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "kernels/mc_params.h"
+#include "methods/mc/mc_params.h"
 #include "methods/registry.h"
 #include "model/scene.h"
 

@@ -7,8 +7,8 @@
 
 #include "base/hash.h"
 
-#ifndef PPB_KERNEL_DIR
-#define PPB_KERNEL_DIR "kernels"
+#ifndef PPB_SOURCE_DIR
+#define PPB_SOURCE_DIR "."
 #endif
 #define MAX_PLATFORMS 16
 #define MAX_DEVICES   64
@@ -287,17 +287,31 @@ void ppb_ocl_close(ppb_ocl *ocl)
     ocl->context = NULL;
 }
 
-static const char *kernel_dir(void)
+/* The tree kernel files are named in: the repository (kernels/ holds the headers every kernel
+ * shares, src/methods/<slice>/ each method's own kernels); $PPBENCH_SOURCE overrides it. */
+static const char *source_root(void)
 {
-    const char *d = getenv("PPBENCH_KERNELS");
-    return (d && *d) ? d : PPB_KERNEL_DIR;
+    const char *d = getenv("PPBENCH_SOURCE");
+    return (d && *d) ? d : PPB_SOURCE_DIR;
+}
+
+/* The build's include path, in the compiler's order: the kernel's own folder (its slice),
+ * then the shared kernels/ headers, then Random123 under /usr/include. */
+enum { NINC = 3 };
+static void include_dirs(const char *path, char dirs[NINC][1024])
+{
+    const char *slash = strrchr(path, '/');
+    snprintf(dirs[0], sizeof dirs[0], "%.*s", slash ? (int)(slash - path) : 1,
+             slash ? path : ".");
+    snprintf(dirs[1], sizeof dirs[1], "%s/kernels", source_root());
+    snprintf(dirs[2], sizeof dirs[2], "/usr/include");
 }
 
 static char *read_file(const char *path, ppb_err *err)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
-        ppb_fail(err, "%s: cannot open kernel source (set PPBENCH_KERNELS to the kernels/ dir)",
+        ppb_fail(err, "%s: cannot open kernel source (set PPBENCH_SOURCE to the ppbench source tree)",
                  path);
         return NULL;
     }
@@ -321,6 +335,7 @@ static char *read_file(const char *path, ppb_err *err)
  * does; both forms then in the build's -I dirs (ppb_ocl_build). */
 typedef struct src_walk {
     ppb_hasher *h;
+    const char *root; /* the kernel file the walk started from: its include path */
     char seen[64][1024];
     int nseen;
 } src_walk;
@@ -353,14 +368,17 @@ static int hash_source(src_walk *w, const char *path, int depth, ppb_err *err)
             continue;
         char name[512], cand[1024];
         snprintf(name, sizeof name, "%.*s", (int)(end - p - 1), p + 1);
+        /* "x" beside its includer first, as the compiler does; both forms then on the
+         * build's include path. */
+        char inc[NINC][1024], here[1024];
+        include_dirs(w->root, inc);
         const char *slash = strrchr(path, '/');
-        const char *dirs[3] = {NULL, kernel_dir(), "/usr/include"};
-        char here[1024];
+        const char *dirs[NINC + 1] = {NULL, inc[0], inc[1], inc[2]};
         if (close == '"' && slash) {
             snprintf(here, sizeof here, "%.*s", (int)(slash - path), path);
             dirs[0] = here;
         }
-        for (int d = 0; d < 3; d++) {
+        for (int d = 0; d < NINC + 1; d++) {
             if (!dirs[d])
                 continue;
             snprintf(cand, sizeof cand, "%s/%s", dirs[d], name);
@@ -384,7 +402,8 @@ int ppb_ocl_source_hash(const char *file, uint64_t *hash, ppb_err *err)
         return ppb_fail(err, "out of memory hashing kernel %s", file);
     }
     char path[2048];
-    snprintf(path, sizeof path, "%s/%s", kernel_dir(), file);
+    snprintf(path, sizeof path, "%s/%s", source_root(), file);
+    w->root = path;
     int rc = hash_source(w, path, 0, err);
     uint64_t h = ppb_hash64_end(w->h);
     free(w);
@@ -421,8 +440,7 @@ int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program 
             *prog = ocl->built[i].prog;
             return 0;
         }
-    const char *dir = kernel_dir();
-    snprintf(path, sizeof path, "%s/%s", dir, file);
+    snprintf(path, sizeof path, "%s/%s", source_root(), file);
     char *src = read_file(path, err);
     if (!src)
         return -1;
@@ -436,7 +454,9 @@ int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program 
     }
     /* Random123's headers sit under /usr/include; -cl-fp32-correctly-rounded-divide-sqrt is
      * left out on purpose: kernels that need exact results use double. */
-    snprintf(opts, sizeof opts, "-I %s -I /usr/include %s", dir, extra ? extra : "");
+    char inc[NINC][1024];
+    include_dirs(path, inc);
+    snprintf(opts, sizeof opts, "-I %s -I %s -I %s %s", inc[0], inc[1], inc[2], extra ? extra : "");
     rc = clBuildProgram(*prog, 1, &ocl->device, opts, NULL, NULL);
     if (rc != CL_SUCCESS) {
         cl_program failed = *prog;

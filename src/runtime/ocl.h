@@ -1,6 +1,6 @@
 /* ocl.h: the OpenCL runtime: platform and device discovery and choice, program builds from
- * kernels/ with the shared headers and Random123 on the include path, and error names.
- *
+ * the source tree (a slice's kernel with its own folder and the shared kernels/ headers and
+ * Random123 on the include path), and error names.
  * A ppb_ocl owns its context, queue and device; ppb_ocl_close releases them. Device choice:
  * an index into the flattened list that `ppbench devices` prints, or a case-insensitive
  * substring of "platform / device" names; NULL or "" falls back to $PPBENCH_DEVICE, then 0. */
@@ -46,14 +46,15 @@ int ppb_ocl_select(const char *selector, ppb_err *err);
 int ppb_ocl_open(ppb_ocl *ocl, const char *selector, ppb_err *err);
 void ppb_ocl_close(ppb_ocl *ocl);
 
-/* Builds kernels/<file> (directory from $PPBENCH_KERNELS, else the build-time path) with
- * options "-I <kernels> -I <Random123> <extra>". On failure err holds the build log. A program
+/* Builds <root>/<file>, the root being the source tree ($PPBENCH_SOURCE, else the build-time
+ * path) and file a kernel such as "src/methods/mc/mc.cl", with options "-I <file's folder>
+ * -I <root>/kernels -I <Random123> <extra>". On failure err holds the build log. A program
  * built before on this ocl with the same file and extra is returned again (retained: the caller
  * releases it as a fresh one); ppb_ocl_close releases them. */
 int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog,
                   ppb_err *err);
 
-/* A hash of the source text a build of kernels/<file> compiles: the file and, transitively,
+/* A hash of the source text a build of <root>/<file> compiles: the file and, transitively,
  * every header it includes that the build's include path finds (the shared kernels/ headers,
  * Random123), so a cache of a kernel's results (methods/mc_cache.h) can tell a changed kernel.
  * Fails as ppb_ocl_build does when a file cannot be read. */

@@ -1,6 +1,6 @@
 /* multipole.c: Donner & Jensen 2005 multipole (Jensen et al. 2001 dipole as its one-pair case);
  * see multipole.h for the geometry and the conventions. */
-#include "physics/multipole.h"
+#include "methods/mp/multipole.h"
 
 #include <math.h>
 

@@ -7,7 +7,7 @@
  * the exponent's affine coefficients from the term's point formula at three points inside each
  * piece (so the point formula stays the one definition), and integrating exp(affine) over each
  * convex piece in closed form (poly_exp: chord lengths along the gradient). */
-#include "physics/rte2d_beam.h"
+#include "methods/rte2d/rte2d_beam.h"
 
 #include <math.h>
 

@@ -1,5 +1,5 @@
 /* method_rte2d.c: `rte2d` (method_rte2d.h): OpenCL marches, host scattering and GMRES. */
-#include "methods/method_rte2d.h"
+#include "methods/rte2d/method_rte2d.h"
 
 #include <cblas.h>
 #include <math.h>
@@ -13,11 +13,11 @@
 #include "base/progress.h"
 #include "kernels/march_params.h"
 #include "kernels/ppb_fresnel.h"
-#include "methods/march.h"
+#include "methods/pp/march.h"
 #include "methods/result_check.h"
 #include "model/metrics.h"
 #include "physics/gmres.h"
-#include "physics/rte2d_grid.h"
+#include "methods/rte2d/rte2d_grid.h"
 
 _Static_assert(sizeof(ppb_rte_params) == 22 * sizeof(double) + 24 * sizeof(int),
                "ppb_rte_params: doubles first, an even number of ints, no padding");
@@ -216,7 +216,7 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, size_
     if (!s->Q || !s->Qb || !s->J || !s->B || !s->rn)
         return ppb_fail(err, "rte2d: out of memory");
     if (ppb_rte_beam_sources(G, s->Qb, &s->absorbed_beam, err) ||
-        ppb_ocl_build(ocl, "rte2d.cl", "", &s->prog, err) ||
+        ppb_ocl_build(ocl, "src/methods/rte2d/rte2d.cl", "", &s->prog, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_moc", &s->moc, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_exit", &s->exitk, err))
         return -1;

@@ -1,5 +1,5 @@
 /* march.c: host side of the ray marcher (march.h). */
-#include "methods/march.h"
+#include "methods/pp/march.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -152,7 +152,7 @@ int ppb_marcher_init(ppb_marcher *mr, ppb_ocl *ocl, const ppb_scene *sc, const p
     mr->rows = (int)(lo.ncells / (size_t)lo.nbins);
     mr->params = march_params(sc, maps, tab, opts);
     march_params_arrays(&mr->params, &lo, tab);
-    if (ppb_ocl_build(ocl, "march.cl", "", &mr->prog, err) ||
+    if (ppb_ocl_build(ocl, PPB_MARCH_KERNEL, "", &mr->prog, err) ||
         ppb_ocl_kernel(mr->prog, "ppb_march_kernel", &mr->kernel, err) ||
         march_buffers(mr, maps, tab, lo.ncells, err) || march_bind_buffers(mr, err)) {
         ppb_marcher_free(mr);

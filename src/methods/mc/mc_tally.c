@@ -1,4 +1,4 @@
-#include "methods/mc_tally.h"
+#include "methods/mc/mc_tally.h"
 
 #include <errno.h>
 #include <math.h>

@@ -16,7 +16,7 @@
 #ifndef PPB_MC_CACHE_H
 #define PPB_MC_CACHE_H
 
-#include "methods/mc_tally.h"
+#include "methods/mc/mc_tally.h"
 #include "methods/method.h"
 
 #define PPB_MC_CACHE_VERSION 1

@@ -1,4 +1,4 @@
-#include "methods/mc_cache.h"
+#include "methods/mc/mc_cache.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -37,7 +37,7 @@ static int cache_path(ppb_run_ctx *ctx, char *buf, size_t cap, ppb_err *err)
                        0,
                        0};
     memcpy(&key[6], &cfg->mc.target_noise, sizeof key[6]);
-    if (ppb_ocl_source_hash("mc.cl", &key[7], err) || device_hash(ctx, &key[8], err))
+    if (ppb_ocl_source_hash(PPB_MC_KERNEL, &key[7], err) || device_hash(ctx, &key[8], err))
         return -1;
     snprintf(buf, cap, "%s/mc-%016llx.bin", ctx->ref_cache,
              (unsigned long long)ppb_hash64(key, sizeof key));

@@ -1,5 +1,5 @@
 #define _XOPEN_SOURCE 700 /* nftw */
-#include "methods/method_external.h"
+#include "methods/external/method_external.h"
 
 #include <errno.h>
 #include <ftw.h>

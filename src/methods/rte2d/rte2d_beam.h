@@ -15,7 +15,7 @@
 #ifndef PPB_RTE2D_BEAM_H
 #define PPB_RTE2D_BEAM_H
 
-#include "kernels/rte2d_params.h"
+#include "methods/rte2d/rte2d_params.h"
 
 /* The beam's direction classes, (sin, cos) of the beam inside and the sign of each. */
 enum {

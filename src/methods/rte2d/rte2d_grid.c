@@ -1,5 +1,5 @@
 /* rte2d_grid.c: grid, folded cells, scattering, I_pp and absorption of `rte2d` (rte2d_grid.h). */
-#include "physics/rte2d_grid.h"
+#include "methods/rte2d/rte2d_grid.h"
 
 #include <cblas.h>
 #include <math.h>
@@ -11,7 +11,7 @@
 #include "physics/maps.h"
 #include "physics/phase.h"
 #include "physics/ppsolver.h"
-#include "physics/rte2d_beam.h"
+#include "methods/rte2d/rte2d_beam.h"
 
 /* x-node layout: a split at step_x when a step lies strictly inside the tube. */
 static void grid_x(const ppb_scene *sc, double spacing, int *nl, int *nr, double *hxl, double *hxr)

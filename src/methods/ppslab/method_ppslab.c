@@ -1,6 +1,6 @@
 /* method_ppslab.c: the plane-parallel solution evaluated at the slab's faces (reference:
  * Methods; paper Sec. 2.2 through src/physics/ppsolver.h). */
-#include "methods/method_ppslab.h"
+#include "methods/ppslab/method_ppslab.h"
 
 #include <math.h>
 

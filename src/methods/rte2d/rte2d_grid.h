@@ -24,7 +24,7 @@
 #define PPB_RTE2D_GRID_H
 
 #include "base/err.h"
-#include "kernels/rte2d_params.h"
+#include "methods/rte2d/rte2d_params.h"
 #include "model/scene.h"
 #include "physics/directions.h"
 

@@ -51,4 +51,7 @@ void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *r
  * S march reads its table only at piece ends, the R march at every step). */
 #define PPB_MARCH_TAU_PER_MFP 64
 
+/* The marcher kernel, in the source tree (runtime/ocl.h). */
+#define PPB_MARCH_KERNEL "src/methods/pp/march.cl"
+
 #endif

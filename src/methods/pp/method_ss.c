@@ -1,7 +1,7 @@
 /* method_ss.c: single scattering by ray marching (method_ss.h). */
-#include "methods/method_ss.h"
+#include "methods/pp/method_ss.h"
 
-#include "methods/method_pp.h"
+#include "methods/pp/method_pp.h"
 
 int ppb_method_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {

@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "kernels/mc_params.h"
+#include "methods/mc/mc_params.h"
 #include "base/err.h"
 #include "model/result.h"
 #include "model/scene.h"
@@ -80,5 +80,8 @@ typedef struct ppb_mc_totals_stats {
  * scratch allocation failed). */
 void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int once,
                            ppb_mc_totals_stats *st);
+
+/* The Monte Carlo kernel, in the source tree (runtime/ocl.h). */
+#define PPB_MC_KERNEL "src/methods/mc/mc.cl"
 
 #endif

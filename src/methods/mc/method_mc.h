@@ -7,7 +7,7 @@
 #ifndef PPB_METHOD_MC_H
 #define PPB_METHOD_MC_H
 
-#include "methods/mc_tally.h"
+#include "methods/mc/mc_tally.h"
 #include "methods/method.h"
 
 /* The method: traces cfg->mc.photons photons starting at cfg->mc.first and fills out[0] (mc)

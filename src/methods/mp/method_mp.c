@@ -28,7 +28,7 @@
  *   fluxes of the multipole with A and the placed sources.
  * - Ballistic: the unscattered refracted beam followed through its internal reflections (F at
  *   each face, TIR entirely) until it has left; slab mode in closed form. */
-#include "methods/method_mp.h"
+#include "methods/mp/method_mp.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -36,10 +36,10 @@
 
 #include "base/progress.h"
 #include "kernels/ppb_fresnel.h"
-#include "methods/method_ss.h"
+#include "methods/pp/method_ss.h"
 #include "methods/result_check.h"
 #include "physics/maps.h"
-#include "physics/multipole.h"
+#include "methods/mp/multipole.h"
 
 /* The boundary terms at n > 1 (file comment); fresnel = 0 at n = 1, where none applies. */
 #define MP_MAX_THETA 64

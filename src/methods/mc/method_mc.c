@@ -1,4 +1,4 @@
-#include "methods/method_mc.h"
+#include "methods/mc/method_mc.h"
 
 #include <stdio.h>
 #include <math.h>
@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "kernels/ppb_fresnel.h"
-#include "methods/mc_cache.h"
+#include "methods/mc/mc_cache.h"
 #include "model/metrics.h"
 #include "base/memory.h"
 #include "base/progress.h"
@@ -435,7 +435,7 @@ int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tall
     snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d -D PPB_MC_CPU_PREFETCH=%d", shape.lanes,
              shape.cpu);
     mc_device d = {0};
-    int status = ppb_ocl_build(ocl, "mc.cl", opts, &d.prog, err);
+    int status = ppb_ocl_build(ocl, PPB_MC_KERNEL, opts, &d.prog, err);
     if (status == 0)
         status = ppb_ocl_kernel(d.prog, "ppb_mc_trace_kernel", &d.kernel, err);
     if (status == 0)

@@ -1,12 +1,12 @@
 /* method_pp.c: the paper's method, plane-parallel ray marching (method_pp.h): the pipeline of
  * the paper's Fig. 3, from the light maps through the slab tables to the march. */
-#include "methods/method_pp.h"
+#include "methods/pp/method_pp.h"
 
 #include <stdio.h>
 #include <string.h>
 
 #include "base/memory.h"
-#include "methods/march.h"
+#include "methods/pp/march.h"
 #include "methods/result_check.h"
 
 /* Issue 15: what the pipeline will hold at its peak, estimated before it allocates, against
