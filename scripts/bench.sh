@@ -25,12 +25,12 @@ mapfile -t cases < configs/study.list
 cache=${PPB_REF_CACHE:-build/ref-cache}
 mkdir -p "$out"
 # The whole study's ETA weighs the cases by their cost in the previous study in $out (its
-# timings.csv: every method's seconds, mc1 being part of mc's, plus 5 s of writing and
-# figures), read before this run overwrites them: the n = 1.4 cases cost about twice the
-# others. Cases without a previous timing weigh as the mean of those with one (1 if none).
+# timings.csv: every result's seconds, a companion result counting its method's again (a
+# weight, not a time), plus 5 s of writing and figures), read before this run overwrites them:
+# the n = 1.4 cases cost about twice the others. Cases without a previous timing weigh as the mean of those with one (1 if none).
 weights=() known=0 nknown=0
 for c in "${cases[@]}"; do
-  w=$(awk -F, 'NR > 1 && $1 != "mc1" {s += $2} END {if (NR > 1) printf "%d", s + 5}' \
+  w=$(awk -F, 'NR > 1 {s += $2} END {if (NR > 1) printf "%d", s + 5}' \
       "$out/$c/timings.csv" 2> /dev/null || true)
   weights+=("${w:-0}")
   [ -n "$w" ] && known=$((known + w)) nknown=$((nknown + 1))

@@ -663,8 +663,9 @@ static void test_march_cache(void **state)
     ppb_march_cache_free(NULL); /* like free() */
 }
 
-/* The method's entry with ctx->march_cache: results byte-identical to a run without the cache,
- * on the build and on the hit. */
+/* The tables pp keeps in its run state (method.h: ppb_ctx_state): a second run on the same
+ * context hits them, and both are byte-identical to a run on a fresh context, which builds its
+ * own. */
 static void test_march_method_cache(void **state)
 {
     (void)state;
@@ -676,25 +677,28 @@ static void test_march_method_cache(void **state)
     cfg.scene.segments_top = 16;
     cfg.scene.segments_side = 6;
     cfg.pp.directions = 24;
-    ppb_run_ctx ctx = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx fresh = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx ctx = fresh;
     ppb_layout lo = ppb_scene_layout(&cfg.scene);
     ppb_result r[3];
     for (int i = 0; i < 3; i++) {
         if (ppb_result_init(&r[i], "pp", &lo, &err))
             fail_msg("%s", err.msg);
-        ctx.march_cache = i == 0 ? NULL : (i == 1 ? ppb_march_cache_new() : ctx.march_cache);
-        if (ppb_method_pp(&ctx, &r[i], &err))
+        if (ppb_method_pp(i == 0 ? &fresh : &ctx, &r[i], &err))
             fail_msg("%s", err.msg);
     }
     long hits, builds;
-    ppb_march_cache_stats(ctx.march_cache, &hits, &builds);
+    const ppb_march_cache *kept = ppb_ctx_state(&ctx, "pp.march_tables");
+    assert_non_null(kept);
+    ppb_march_cache_stats(kept, &hits, &builds);
     assert_int_equal(builds, 1);
     assert_int_equal(hits, 1);
     for (int i = 1; i < 3; i++)
         assert_memory_equal(r[i].radiance, r[0].radiance, lo.ncells * sizeof *r[0].radiance);
     for (int i = 0; i < 3; i++)
         ppb_result_free(&r[i]);
-    ppb_march_cache_free(ctx.march_cache);
+    ppb_ctx_drop_state(&fresh); /* the device is borrowed: only the states are released */
+    ppb_ctx_drop_state(&ctx);
 }
 
 int main(void)

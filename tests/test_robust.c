@@ -330,7 +330,6 @@ static void test_result_memory_checked(void **state)
 int main(void)
 {
     g_ctx.quiet = 1;
-    g_ctx.march_cache = ppb_march_cache_new();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_robust_tube),
         cmocka_unit_test(test_robust_slab),
@@ -338,9 +337,10 @@ int main(void)
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     long hits = 0, builds = 0;
-    ppb_march_cache_stats(g_ctx.march_cache, &hits, &builds);
+    const ppb_march_cache *kept = ppb_ctx_state(&g_ctx, "pp.march_tables");
+    if (kept)
+        ppb_march_cache_stats(kept, &hits, &builds);
     printf("[ robust   ] march tables: %ld built, %ld reused\n", builds, hits);
-    ppb_march_cache_free(g_ctx.march_cache);
     ppb_ctx_close(&g_ctx);
     return rc;
 }

@@ -604,12 +604,13 @@ static void test_refinement_study(void **state)
     ppb_result conv, bare;
     if (ppb_result_init(&conv, "rte2d", &lo, &err))
         fail_msg("%s", err.msg);
-    ppb_rte2d_study study;
     ppb_rte2d_stats st, st_bare;
-    ppb_run_ctx ctx = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1, .rte2d_study = &study};
-    if (ppb_rte2d_run(&ctx, &conv, &st, &err) || ppb_rte2d_write_refinements(&study, dir, &err))
+    ppb_run_ctx ctx = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1, .extras = 1};
+    if (ppb_rte2d_run(&ctx, &conv, &st, &err) || ppb_result_write_extra(&conv, dir, &err))
         fail_msg("%s", err.msg);
-    assert_int_equal(st.record_rungs, study.n);
+    const ppb_rte2d_study *study = conv.extra.data; /* the result carries its study */
+    assert_non_null(study);
+    assert_int_equal(st.record_rungs, study->n);
     assert_true(st.record_rungs > 0);
     /* The last rung lies past GMRES's basis (marched on from it): the recomputed last rung
      * checks that path too. */

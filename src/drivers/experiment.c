@@ -11,7 +11,6 @@
 #include "io/csv.h"
 #include "io/images.h"
 #include "io/plots.h"
-#include "methods/rte2d/method_rte2d.h"
 #include "methods/registry.h"
 #include "methods/work_estimate.h"
 #include "base/progress.h"
@@ -42,6 +41,7 @@ static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, p
     ppb_err why = {{0}};
     ctx->prior = ex->res; /* what ran before it, for a method that combines others */
     ctx->nprior = ex->n - nout;
+    ctx->self = m;
     if (m->run(ctx, out, &why)) {
         /* Issue 15: this method's failure is its own; the others run on. */
         for (int i = 0; i < nout; i++)
@@ -321,9 +321,12 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     out_path(dir, "angular.csv", path, sizeof path);
     if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
-    if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err) ||
-        ppb_rte2d_write_refinements(&ex->rte2d_study, dir, err) || write_provenance(ex, dir, err) ||
-        write_config_ini(ex, dir, err))
+    if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err))
+        return -1;
+    for (int i = 0; i < ex->n; i++) /* a method's own outputs (rte2d_refinements.csv) */
+        if (ppb_result_write_extra(&ex->res[i], dir, err))
+            return -1;
+    if (write_provenance(ex, dir, err) || write_config_ini(ex, dir, err))
         return -1;
     const ppb_result *ref = ppb_experiment_reference(ex);
     const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};

@@ -11,7 +11,6 @@
 
 #include "model/config.h"
 #include "methods/method.h"
-#include "methods/rte2d/method_rte2d.h"
 #include "model/result.h"
 #include "drivers/provenance.h"
 
@@ -33,9 +32,6 @@ typedef struct ppb_experiment {
     /* Deterministic methods interrupted midway (issue 14): none of their rows are written. */
     int nincomplete;
     char incomplete[PPB_MAX_METHODS][32];
-    /* rte2d's refinement study, written as rte2d_refinements.csv: recorded where the run
-     * context points rte2d here (ppb_run_ctx.rte2d_study; `run` does, a sweep does not). */
-    ppb_rte2d_study rte2d_study;
 } ppb_experiment;
 
 /* Runs every method. A method that fails is recorded in ex->failed (and said on stderr) while

@@ -478,7 +478,7 @@ static int cmd_run(const cli *c)
         ppb_run_ctx ctx = {.device_selector = c->device,
                            .quiet = c->quiet,
                            .ref_cache = cache,
-                           .rte2d_study = &ex.rte2d_study};
+                           .extras = 1};
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);

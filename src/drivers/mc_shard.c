@@ -7,6 +7,7 @@
 #include "base/atomic_file.h"
 #include "drivers/experiment.h"
 #include "methods/mc/method_mc.h"
+#include "methods/registry.h"
 
 /* Photons of part i of n: a contiguous range, the remainder spread over the first parts. */
 static void part_range(long long total, int i, int n, long long *first, long long *count)
@@ -20,8 +21,9 @@ static void part_range(long long total, int i, int n, long long *first, long lon
 int ppb_mc_shard_run(const ppb_config *cfg, const char *device, int quiet, int i, int n,
                      ppb_err *err)
 {
-    if (!ppb_config_has_method(cfg, "mc"))
-        return ppb_fail(err, "%s: [experiment] methods has no mc to shard", cfg->path);
+    const char *ref = ppb_method_reference()->id;
+    if (!ppb_config_has_method(cfg, ref))
+        return ppb_fail(err, "%s: [experiment] methods has no %s to shard", cfg->path, ref);
     long long first, count;
     part_range(cfg->mc.photons, i, n, &first, &count);
     ppb_mc_tallies t;
@@ -158,9 +160,10 @@ int ppb_mc_shard_merge(const ppb_config *cfg, const char *const *dirs, int ndirs
     ppb_layout lo = ppb_scene_layout(&cfg->scene);
     ex.cfg = cfg;
     ex.n = 0;
-    if (rc == 0 && (rc = ppb_result_init(&ex.res[0], "mc", &lo, err)) == 0)
+    const ppb_method *ref = ppb_method_reference();
+    if (rc == 0 && (rc = ppb_result_init(&ex.res[0], ref->id, &lo, err)) == 0)
         ex.n = 1;
-    if (rc == 0 && (rc = ppb_result_init(&ex.res[1], "mc1", &lo, err)) == 0)
+    if (rc == 0 && (rc = ppb_result_init(&ex.res[1], ref->also, &lo, err)) == 0)
         ex.n = 2;
     if (rc == 0) {
         ppb_mc_tallies_to_results(&sum, &cfg->scene, &ex.res[0], &ex.res[1]);

@@ -3,10 +3,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "drivers/perf_march.h"
-#include "drivers/perf_mc.h"
 #include "drivers/perf_pp.h"
-#include "drivers/perf_rte2d.h"
+#include "methods/registry.h"
+
+/* Method i's benchmark under its heading; blank line before all but the first section. */
+static int perf_method(const ppb_method *m, ppb_run_ctx *ctx, FILE *out, int first, ppb_err *err)
+{
+    fprintf(out, "%s== %s\n", first ? "" : "\n", m->perf_title);
+    return m->perf(ctx, out, err);
+}
 
 int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
 {
@@ -19,34 +24,26 @@ int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
         ctx->cfg = &defaults;
     }
     setvbuf(out, NULL, _IOLBF, 0);
-    /* $PPBENCH_PERF_ONLY=mc runs the Monte Carlo alone (paired timing runs of two builds),
-     * =rte2d rte2d alone. */
+    /* $PPBENCH_PERF_ONLY=ID runs method ID's benchmark alone (paired timing runs of two
+     * builds). */
     const char *only = getenv("PPBENCH_PERF_ONLY");
-    if (only && strcmp(only, "mc") == 0) {
-        fprintf(out, "== Monte Carlo (OpenCL)\n");
-        int rc = ppb_perf_mc(ctx, out, err);
-        ctx->cfg = given;
-        return rc;
-    }
-    if (only && strcmp(only, "rte2d") == 0) { /* rte2d alone, likewise */
-        fprintf(out, "== rte2d: the refinement iterated (OpenCL marches)\n");
-        int rc = ppb_perf_rte2d(ctx, out, err);
+    int rc = 0;
+    if (only && *only) {
+        const ppb_method *m = ppb_method_find(NULL, only);
+        rc = m && m->perf ? perf_method(m, ctx, out, 1, err)
+                          : ppb_fail(err,
+                                     "$PPBENCH_PERF_ONLY=%s: no method of that id has a "
+                                     "benchmark",
+                                     only);
         ctx->cfg = given;
         return rc;
     }
     fprintf(out, "== plane-parallel solver (host, LAPACKE)\n");
-    int rc = ppb_perf_ppsolver(out, err);
-    if (rc == 0) {
-        fprintf(out, "\n== ray marcher (OpenCL)\n");
-        rc = ppb_perf_march(ctx, out, err);
-    }
-    if (rc == 0) {
-        fprintf(out, "\n== Monte Carlo (OpenCL)\n");
-        rc = ppb_perf_mc(ctx, out, err);
-    }
-    if (rc == 0) {
-        fprintf(out, "\n== rte2d: the refinement iterated (OpenCL marches)\n");
-        rc = ppb_perf_rte2d(ctx, out, err);
+    rc = ppb_perf_ppsolver(out, err);
+    for (int i = 0; rc == 0 && i < ppb_method_count(); i++) {
+        const ppb_method *m = ppb_method_at(i);
+        if (m->perf)
+            rc = perf_method(m, ctx, out, 0, err);
     }
     ctx->cfg = given; /* the defaults live on this stack frame only */
     return rc;

@@ -9,41 +9,21 @@
 
 #include "base/atomic_file.h"
 #include "base/csv_read.h"
+#include "methods/registry.h"
+#include "model/paper.h"
 
-/* Shinya et al. 2009, Table 2: RMS error against MC in percent, per case and cell, for the
- * proposed method (pp), MP (mp), MP+S (mp+ss) and S (ss). */
-typedef struct paper_row {
-    const char *case_name, *cell;
-    double pp, mp, mpss, ss;
-} paper_row;
-
-static const paper_row paper[] = {
-    {"uniform_g0_normal", "R_x0", 13, 13, 23, 65},
-    {"uniform_g0_normal", "T_x0", 4, 72, 24, 56},
-    {"uniform_g0_oblique", "R_x0", 10, 43, 101, 57},
-    {"uniform_g0_oblique", "T_x0", 8, 210, 302, 89},
-    {"uniform_gm05_normal", "R_x0", 20, 23, 51, 48},
-    {"uniform_gm05_normal", "T_x0", 5, 84, 189, 47},
-    {"uniform_gp05_normal", "R_x0", 24, 19, 6, 81},
-    {"uniform_gp05_normal", "T_x0", 7, 58, 26, 66},
-};
-
+/* The paper's Table 2 value for a method of ppbench: its registry entry names its column. */
 static double paper_value(const char *case_name, const char *cell, const char *method)
 {
-    for (size_t i = 0; i < sizeof paper / sizeof paper[0]; i++) {
-        const paper_row *r = &paper[i];
-        if (strcmp(r->case_name, case_name) || strcmp(r->cell, cell))
-            continue;
-        if (!strcmp(method, "pp"))
-            return r->pp;
-        if (!strcmp(method, "mp"))
-            return r->mp;
-        if (!strcmp(method, "mp+ss"))
-            return r->mpss;
-        if (!strcmp(method, "ss"))
-            return r->ss;
-    }
-    return NAN;
+    const ppb_method *m = ppb_method_find(NULL, method);
+    return m ? ppb_paper_table2(case_name, cell, m->paper_column) : NAN;
+}
+
+/* A method's place in the paper's column order, -1 when the paper has no column for it. */
+static int paper_rank(const char *method)
+{
+    const ppb_method *m = ppb_method_find(NULL, method);
+    return m ? ppb_paper_column_rank(m->paper_column) : -1;
 }
 
 typedef struct summary_row {
@@ -331,15 +311,12 @@ enum { MAX_COLS = 32 };
 
 static int table_methods(const case_data *cd, int ncases, char cols[][32])
 {
-    static const char *const paper_order[] = {"pp", "mp", "mp+ss", "ss"};
     int n = 0;
     for (int pass = 0; pass < 2; pass++)
         for (int c = 0; c < ncases; c++)
             for (int i = 0; i < cd[c].n && n < MAX_COLS; i++) {
                 const char *m = cd[c].rows[i].method;
-                int in_paper = 0, seen = 0;
-                for (size_t k = 0; k < sizeof paper_order / sizeof paper_order[0]; k++)
-                    in_paper |= !strcmp(m, paper_order[k]);
+                int in_paper = paper_rank(m) >= 0, seen = 0;
                 for (int k = 0; k < n; k++)
                     seen |= !strcmp(m, cols[k]);
                 if (seen || !is_table2_cell(cd[c].rows[i].cell) || in_paper != (pass == 0))
@@ -349,17 +326,13 @@ static int table_methods(const case_data *cd, int ncases, char cols[][32])
     /* The paper's methods found in the first pass came in case order: put them in its order. */
     int np = 0;
     char sorted[MAX_COLS][32];
-    for (size_t k = 0; k < sizeof paper_order / sizeof paper_order[0]; k++)
+    for (int k = 0; ppb_paper_columns[k]; k++)
         for (int j = 0; j < n; j++)
-            if (!strcmp(cols[j], paper_order[k]))
+            if (paper_rank(cols[j]) == k)
                 memcpy(sorted[np++], cols[j], sizeof sorted[0]);
-    for (int j = 0; j < n; j++) {
-        int in_paper = 0;
-        for (size_t k = 0; k < sizeof paper_order / sizeof paper_order[0]; k++)
-            in_paper |= !strcmp(cols[j], paper_order[k]);
-        if (!in_paper)
+    for (int j = 0; j < n; j++)
+        if (paper_rank(cols[j]) < 0)
             memcpy(sorted[np++], cols[j], sizeof sorted[0]);
-    }
     memcpy(cols, sorted, (size_t)n * sizeof sorted[0]);
     return n;
 }

@@ -13,6 +13,7 @@
 #include "base/atomic_file.h"
 #include "base/hash.h"
 #include "drivers/sweep.h"
+#include "methods/registry.h"
 
 /* Copies src into dst[cap], cut to fit (callers check lengths where a cut would matter). */
 static void copy_str(char *dst, size_t cap, const char *src)
@@ -679,11 +680,12 @@ static int check_job(const ppb_config *cfg, const ppb_grid *grid, const ppb_slur
             if (ppb_config_point(cfg, grid, i, &pt, err))
                 return -1;
     } else {
-        if (!ppb_config_has_method(cfg, "mc"))
+        const char *ref = ppb_method_reference()->id;
+        if (!ppb_config_has_method(cfg, ref))
             return ppb_fail(err,
-                            "%s: no key holds a list and [experiment] methods has no mc: nothing "
+                            "%s: no key holds a list and [experiment] methods has no %s: nothing "
                             "to shard (a sweep or a Monte Carlo)",
-                            cfg->path);
+                            cfg->path, ref);
         job->units = cfg->mc.photons;
     }
     if (o->shards > job->units)
@@ -739,7 +741,7 @@ int ppb_slurm_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_slurm_o
         goto out;
     job_name(cfg, job.dir, job.name, sizeof job.name);
     snprintf(job.stamp, sizeof job.stamp, "%s shards=%d config=%016llx build=%016llx",
-             job.kind == PPB_SLURM_SWEEP ? "sweep" : "mc", job.shards,
+             job.kind == PPB_SLURM_SWEEP ? "sweep" : ppb_method_reference()->id, job.shards,
              (unsigned long long)ppb_hash64(conf, strlen(conf)),
              (unsigned long long)ppb_hash64(bin, bin_len));
 

@@ -17,7 +17,6 @@
 #include "base/csv_read.h"
 #include "base/hash.h"
 #include "drivers/experiment.h"
-#include "physics/march_tables.h"
 #include "model/metrics.h"
 #include "base/progress.h"
 #include "drivers/sweep_failures.h"
@@ -374,11 +373,9 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t
     ppb_config pt;
     ppb_progress pr;
     ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
-    /* Points that share a medium share the marcher's tables: built once per process. */
-    ppb_run_ctx ctx = {.device_selector = o->device,
-                       .quiet = 1,
-                       .march_cache = ppb_march_cache_new(),
-                       .ref_cache = o->ref_cache};
+    /* One context for every point: what methods keep in it (the marcher's tables, shared by
+     * the points of one medium) is built once per process. */
+    ppb_run_ctx ctx = {.device_selector = o->device, .quiet = 1, .ref_cache = o->ref_cache};
     long long done = 0;
     int rc = 0;
     for (long long i = part; i < n && rc == 0 && !ppb_interrupted(); i += parts) {
@@ -392,7 +389,6 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t
             ppb_progress_update(&pr, (double)++done * parts);
     }
     ppb_ctx_close(&ctx);
-    ppb_march_cache_free(ctx.march_cache);
     if (end_line)
         ppb_progress_end(&pr, (double)done);
     return rc;

@@ -12,33 +12,56 @@
 #include "runtime/ocl.h"
 #include "model/result.h"
 
-struct ppb_march_cache;
-struct ppb_rte2d_study;
+#include <stdio.h>
 
-/* What a method gets: the experiment, an OpenCL device opened on first use, caches that
- * outlive one experiment (a sweep reuses the marcher's tables across grid points), and the
- * results of the methods that ran before it in this experiment. */
+/* State a method keeps for the rest of the run (the marcher's tables, which a sweep's points
+ * share), under a key of its own; the context releases it when it closes. */
+typedef struct ppb_method_state {
+    char key[32];
+    void *data;
+    void (*release)(void *data);
+} ppb_method_state;
+
+#define PPB_MAX_STATES 8
+
+struct ppb_method;
+
+/* What a method gets: the experiment, an OpenCL device opened on first use, the state methods
+ * keep across the experiments of one run (a sweep's points), and the results of the methods
+ * that ran before it in this experiment. */
 typedef struct ppb_run_ctx {
     const ppb_config *cfg;
     const char *device_selector; /* --device, or NULL */
     ppb_ocl ocl;
     int ocl_open;
-    int quiet;                           /* no progress lines */
-    struct ppb_march_cache *march_cache; /* owned by the caller; NULL = build afresh */
+    int quiet; /* no progress lines */
+    /* 1: methods attach their own outputs to their results (ppb_result.extra; `run` writes them
+     * with the output set); 0: none are made (a sweep point, which writes no set). */
+    int extras;
     /* The experiment's results so far, set by the runner before each method (NULL, 0: none).
-     * A method that combines others' results (mp+ss) takes them from here when they ran,
+     * A method that combines others' results (a sum) takes them from here when they ran,
      * byte-identical to computing them again, and computes them itself otherwise. */
     const ppb_result *prior;
     int nprior;
-    const char *ref_cache; /* --ref-cache DIR: mc's tallies reused from there (mc_cache.h) */
-    /* Owned by the caller: where rte2d records its refinement study (method_rte2d.h), which
-     * `run` writes with the output set; NULL: none is run (a sweep point writes no table). */
-    struct ppb_rte2d_study *rte2d_study;
+    const struct ppb_method *self; /* the method running, set by the runner */
+    const char *ref_cache;         /* --ref-cache DIR: mc's tallies reused from there */
+    ppb_method_state state[PPB_MAX_STATES];
+    int nstate;
 } ppb_run_ctx;
 
 /* The device, opened on first call and shared by every method of the run. */
 int ppb_ctx_ocl(ppb_run_ctx *ctx, ppb_ocl **ocl, ppb_err *err);
+/* Closes the device and releases every method's state. */
 void ppb_ctx_close(ppb_run_ctx *ctx);
+/* Releases every method's state only (a context that borrows its device). */
+void ppb_ctx_drop_state(ppb_run_ctx *ctx);
+
+/* The state kept under key, or NULL. */
+void *ppb_ctx_state(const ppb_run_ctx *ctx, const char *key);
+/* Keeps data under key until the context closes (release(data) then); fails, releasing data,
+ * when every slot is taken. */
+int ppb_ctx_keep(ppb_run_ctx *ctx, const char *key, void *data, void (*release)(void *),
+                 ppb_err *err);
 
 /* The complete (not partial) result `id` among ctx->prior, or NULL. */
 const ppb_result *ppb_ctx_prior(const ppb_run_ctx *ctx, const char *id);
@@ -47,6 +70,8 @@ const ppb_result *ppb_ctx_prior(const ppb_run_ctx *ctx, const char *id);
  * initialised to zero with the scene's layout and their ids. */
 typedef int (*ppb_method_fn)(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
+/* Everything the runner, the writers, the report and the benchmarks need from a method; none
+ * of them names one (docs/reference.md: Methods, "Adding a method"). */
 typedef struct ppb_method {
     const char *id;
     const char *also; /* id of a companion result, or NULL */
@@ -58,6 +83,27 @@ typedef struct ppb_method {
     /* Refuses, before any work, a config where the method's model has no meaning (mp at albedo
      * 1); NULL: every valid config is fine. */
     int (*check)(const ppb_config *cfg, ppb_err *err);
+    /* A sum of other methods' results, cell by cell (mp+ss = mp + ss): their ids, NULL-ended;
+     * run and check are then ppb_method_sum's (method.c). NULL: not a sum. */
+    const char *const *sum_of;
+    /* The config section of the method's settings ("rte2d"), or NULL. */
+    const char *section;
+    /* Its column in the paper's Table 2 ("MP+S"; model/paper.h), or NULL: not in the paper. */
+    const char *paper_column;
+    /* Prints "NAME: ID: work: ..." for a method whose work scales with the settings, before it
+     * runs (id: the config's id, a sum's for its parts); NULL: nothing to say. */
+    void (*work)(const ppb_config *cfg, const char *id, FILE *f);
+    /* Its benchmark in `ppbench perf` under the heading perf_title; NULL: none. */
+    const char *perf_title;
+    int (*perf)(ppb_run_ctx *ctx, FILE *out, ppb_err *err);
 } ppb_method;
+
+/* A sum method's run and check (ppb_method.sum_of): the parts are found through the registry
+ * by the caller-supplied lookup, taken from ctx->prior when they ran before and computed
+ * otherwise. The sum's totals are its first part's with R, T and sides of the others added:
+ * a part's light counts as often as it is summed (the paper's MP+S counts single scattering
+ * twice, docs/reference.md: Methods). */
+int ppb_method_sum(ppb_run_ctx *ctx, ppb_result *out,
+                   const ppb_method *(*find)(const ppb_config *, const char *), ppb_err *err);
 
 #endif

@@ -3,44 +3,85 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "methods/mc/method_mc.h"
 #include "methods/external/method_external.h"
+#include "methods/mc/method_mc.h"
+#include "methods/mc/perf_mc.h"
 #include "methods/mp/method_mp.h"
 #include "methods/pp/method_pp.h"
+#include "methods/pp/method_ss.h"
+#include "methods/pp/perf_march.h"
 #include "methods/ppslab/method_ppslab.h"
 #include "methods/rte2d/method_rte2d.h"
-#include "methods/pp/method_ss.h"
+#include "methods/rte2d/perf_rte2d.h"
 
-/* The registry: the order here is the order of outputs. */
+static const ppb_method *builtin(const char *id);
+
+/* mp+ss and any other sum of methods (method.h: ppb_method_sum): parts found among the
+ * built-in methods. */
+static int run_sum(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+/* The registry: the order here is the order of outputs; adding a method is one line here
+ * (docs/reference.md: Methods, "Adding a method"). */
 static const ppb_method methods[] = {
     {.id = "mc",
      .also = "mc1",
      .reference = 1,
      .summary = "photon Monte Carlo reference (mc1: its once-scattered part)",
-     .run = ppb_method_mc},
+     .run = ppb_method_mc,
+     .section = "mc",
+     .work = ppb_mc_work,
+     .perf_title = "Monte Carlo (OpenCL)",
+     .perf = ppb_perf_mc},
     {.id = "pp",
      .summary = "plane-parallel ray marching, the paper's method",
      .run = ppb_method_pp,
-     .check = ppb_pp_check},
+     .check = ppb_pp_check,
+     .section = "pp",
+     .paper_column = "proposed",
+     .work = ppb_pp_work,
+     .perf_title = "ray marcher (OpenCL)",
+     .perf = ppb_perf_march},
     {.id = "ss",
      .summary = "single scattering by ray marching",
      .run = ppb_method_ss,
-     .check = ppb_ss_check},
-    {.id = "mp", .summary = "multipole diffusion", .run = ppb_method_mp, .check = ppb_mp_check},
+     .check = ppb_ss_check,
+     .paper_column = "S",
+     .work = ppb_pp_work},
+    {.id = "mp",
+     .summary = "multipole diffusion",
+     .run = ppb_method_mp,
+     .check = ppb_mp_check,
+     .section = "mp",
+     .paper_column = "MP"},
     {.id = "mp+ss",
      .summary = "multipole diffusion plus single scattering",
-     .run = ppb_method_mp_ss,
-     .check = ppb_mp_ss_check},
+     .run = run_sum,
+     .sum_of = (const char *const[]){"mp", "ss", NULL},
+     .paper_column = "MP+S"},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,
      .summary = "plane-parallel solution at the slab faces (slab mode only)",
      .run = ppb_method_ppslab},
     {.id = "rte2d",
-     .reference = 2, /* noise-free in the tube: summary_rte2d.csv (issue 19) */
+     .reference = 2, /* noise-free in the tube: summary_rte2d.csv */
      .summary = "the tube's transfer solved: the paper's refinement iterated",
-     .run = ppb_method_rte2d},
+     .run = ppb_method_rte2d,
+     .section = "rte2d",
+     .perf_title = "rte2d: the refinement iterated (OpenCL marches)",
+     .perf = ppb_perf_rte2d},
 };
+
+static const ppb_method *find_builtin(const ppb_config *cfg, const char *id)
+{
+    (void)cfg;
+    return builtin(id);
+}
+
+static int run_sum(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
+{
+    return ppb_method_sum(ctx, out, find_builtin, err);
+}
 
 /* Every method a config defines ([method.NAME], model/config.h) is run by
  * methods/method_external.c, which reads its command from the experiment's config: one
@@ -59,6 +100,14 @@ int ppb_method_count(void)
 const ppb_method *ppb_method_at(int i)
 {
     return (i >= 0 && i < ppb_method_count()) ? &methods[i] : NULL;
+}
+
+const ppb_method *ppb_method_reference(void)
+{
+    for (int i = 0; i < ppb_method_count(); i++)
+        if (methods[i].reference == 1)
+            return &methods[i];
+    return NULL;
 }
 
 static const ppb_method *builtin(const char *id)
@@ -105,9 +154,15 @@ int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
         if (m->slab_only && !slab)
             return ppb_config_key_fail(cfg, "experiment", "methods", err,
                                        "method '%s' runs in slab mode only", cfg->methods[i]);
-        /* A point where the method's model has no meaning is refused here, before any work. */
+        /* A point where the method's model has no meaning is refused here, before any work; a
+         * sum has a meaning where each of its parts has. */
         if (m->check && m->check(cfg, err))
             return -1;
+        for (int k = 0; m->sum_of && m->sum_of[k]; k++) {
+            const ppb_method *p = builtin(m->sum_of[k]);
+            if (p && p->check && p->check(cfg, err))
+                return -1;
+        }
     }
     return 0;
 }

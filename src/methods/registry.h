@@ -16,6 +16,9 @@
  * lookup goes through cfg's own list: the registry keeps no state of its own. */
 const ppb_method *ppb_method_find(const ppb_config *cfg, const char *id);
 int ppb_method_count(void);
+/* The reference every other method is measured against (reference == 1: the Monte Carlo),
+ * whose shards `ppbench mc-shard` traces and `mc-merge` joins. */
+const ppb_method *ppb_method_reference(void);
 const ppb_method *ppb_method_at(int i); /* NULL outside [0, ppb_method_count()) */
 
 /* Every id of cfg->methods names a method, and no slab-only method runs in tube mode (reference:

@@ -18,11 +18,19 @@ int ppb_result_init(ppb_result *r, const char *method, const ppb_layout *lo, ppb
     return 0;
 }
 
+int ppb_result_write_extra(const ppb_result *r, const char *dir, ppb_err *err)
+{
+    return r->extra.data && r->extra.write ? r->extra.write(r->extra.data, dir, err) : 0;
+}
+
 void ppb_result_free(ppb_result *r)
 {
     free(r->radiance);
     free(r->se);
     r->radiance = r->se = NULL;
+    if (r->extra.data && r->extra.release)
+        r->extra.release(r->extra.data);
+    r->extra.data = NULL;
 }
 
 void ppb_totals_complete(ppb_totals *t)

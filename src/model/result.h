@@ -13,6 +13,14 @@ typedef struct ppb_totals {
     int absorbed_tracked; /* 0: the writer reports absorbed = 1 - the rest (reference: Bins) */
 } ppb_totals;
 
+/* Outputs a method makes beside the common set (rte2d's refinement study, reference: Outputs):
+ * written into the output set's directory with the rest, released with the result. */
+typedef struct ppb_result_extra {
+    void *data; /* NULL: none */
+    int (*write)(const void *data, const char *dir, ppb_err *err);
+    void (*release)(void *data);
+} ppb_result_extra;
+
 typedef struct ppb_result {
     char method[32];
     ppb_layout layout;
@@ -21,10 +29,13 @@ typedef struct ppb_result {
     ppb_totals totals;
     int partial;       /* 1: interrupted before the full budget (Monte Carlo) */
     long long photons; /* Monte Carlo photons traced; 0 otherwise */
+    ppb_result_extra extra;
 } ppb_result;
 
 int ppb_result_init(ppb_result *r, const char *method, const ppb_layout *lo, ppb_err *err);
 void ppb_result_free(ppb_result *r);
+/* Writes r's extra outputs into dir (nothing when it has none). */
+int ppb_result_write_extra(const ppb_result *r, const char *dir, ppb_err *err);
 
 /* Sets absorbed = 1 - (R + T + sides + ballistic + specular) when the method does not track
  * it. */

@@ -301,8 +301,7 @@ enum { NINC = 3 };
 static void include_dirs(const char *path, char dirs[NINC][1024])
 {
     const char *slash = strrchr(path, '/');
-    snprintf(dirs[0], sizeof dirs[0], "%.*s", slash ? (int)(slash - path) : 1,
-             slash ? path : ".");
+    snprintf(dirs[0], sizeof dirs[0], "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
     snprintf(dirs[1], sizeof dirs[1], "%s/kernels", source_root());
     snprintf(dirs[2], sizeof dirs[2], "/usr/include");
 }
@@ -311,7 +310,8 @@ static char *read_file(const char *path, ppb_err *err)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
-        ppb_fail(err, "%s: cannot open kernel source (set PPBENCH_SOURCE to the ppbench source tree)",
+        ppb_fail(err,
+                 "%s: cannot open kernel source (set PPBENCH_SOURCE to the ppbench source tree)",
                  path);
         return NULL;
     }

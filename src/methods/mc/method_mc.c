@@ -489,3 +489,28 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     ppb_mc_tallies_free(&t);
     return status;
 }
+
+/* Expected scattering events per Monte Carlo photon: with implicit capture a photon's weight
+ * after k events is albedo^k, rouletted below PPB_MC_ROULETTE_W, so about
+ * ln(w) / ln(albedo) events; a walk leaves a medium of optical size L (the tube's smaller side,
+ * the slab's thickness) after about 1 + L + L^2 events (diffusion); capped at PPB_MC_EVENT_CAP
+ * (mc_params.h). The least of the three. */
+double ppb_mc_events_per_photon(const ppb_config *cfg)
+{
+    const ppb_scene *sc = &cfg->scene;
+    double a = sc->albedo;
+    if (sc->step == PPB_STEP_ALBEDO && sc->albedo_right > a)
+        a = sc->albedo_right;
+    double by_weight = a <= 0.0 ? 1.0 : a >= 1.0 ? INFINITY : 1.0 + log(PPB_MC_ROULETTE_W) / log(a);
+    double size = sc->geometry == PPB_GEOM_SLAB ? sc->height : fmin(sc->width, sc->height);
+    double L = size * fmax(sc->sigma_t, sc->step == PPB_STEP_DENSITY ? sc->sigma_t_right : 0.0);
+    double by_size = 1.0 + L + L * L;
+    return fmin(fmin(by_weight, by_size), (double)PPB_MC_EVENT_CAP);
+}
+
+void ppb_mc_work(const ppb_config *cfg, const char *id, FILE *f)
+{
+    double e = ppb_mc_events_per_photon(cfg);
+    fprintf(f, "%s: %s: work: %lld photons x about %.3g events = %.3g events\n", cfg->name, id,
+            cfg->mc.photons, e, (double)cfg->mc.photons * e);
+}

@@ -7,6 +7,8 @@
 #ifndef PPB_METHOD_MC_H
 #define PPB_METHOD_MC_H
 
+#include <stdio.h>
+
 #include "methods/mc/mc_tally.h"
 #include "methods/method.h"
 
@@ -31,5 +33,10 @@ typedef struct ppb_mc_trace_info {
  * a run of that many photons. info may be NULL. */
 int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
                  ppb_mc_trace_info *info, ppb_err *err);
+
+/* Expected scattering events per photon at cfg's medium (an order of magnitude). */
+double ppb_mc_events_per_photon(const ppb_config *cfg);
+/* The work line (the registry's work hook): photons x events per photon. */
+void ppb_mc_work(const ppb_config *cfg, const char *id, FILE *f);
 
 #endif

@@ -1,4 +1,4 @@
-/* method_mp.c: the `mp` and `mp+ss` methods (reference: Methods), the paper's multipole baseline.
+/* method_mp.c: the `mp` method (reference: Methods), the paper's multipole baseline.
  *
  * Slab mode: the multipole's plane-integrated R and T (Donner & Jensen 2005) as a Lambertian
  * exit radiance cos(theta_L) R / pi on S1 and cos(theta_L) T / pi on S2.
@@ -36,7 +36,6 @@
 
 #include "base/progress.h"
 #include "kernels/ppb_fresnel.h"
-#include "methods/pp/method_ss.h"
 #include "methods/result_check.h"
 #include "physics/maps.h"
 #include "methods/mp/multipole.h"
@@ -305,8 +304,6 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         ppb_progress_end(&pr, nseg);
     if (rc || ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
-    if (strcmp(out->method, "mp") != 0)
-        return 0; /* mp+ss checks its own sum */
     ppb_totals t = out->totals;
     ppb_totals_complete(&t);
     ppb_result probe = *out;
@@ -330,47 +327,4 @@ int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
             "mp, mp+ss: albedo = 1 gives sigma_tr = 0, where the multipole's image series of a "
             "finite slab converges only conditionally; use albedo < 1 or leave mp out");
     return 0; /* n > 1: mp has the Fresnel boundary (file comment) */
-}
-
-int ppb_mp_ss_check(const ppb_config *cfg, ppb_err *err)
-{
-    return ppb_mp_check(cfg, err) || ppb_ss_check(cfg, err) ? -1 : 0;
-}
-
-/* mp + ss, cell by cell. The parts are this experiment's mp and ss results when they ran before
- * (ctx->prior: the same numbers, so nothing is computed twice), else computed here. */
-int ppb_method_mp_ss(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
-{
-    const ppb_result *mp = ppb_ctx_prior(ctx, "mp"), *ss = ppb_ctx_prior(ctx, "ss");
-    int reused = (mp != NULL) + (ss != NULL);
-    ppb_progress pr;
-    ppb_progress_begin(&pr, out->method, reused == 2 ? "cells, mp and ss reused," : "cells",
-                       (double)out->layout.ncells, ctx->quiet);
-    if (mp) {
-        memcpy(out->radiance, mp->radiance, out->layout.ncells * sizeof *out->radiance);
-        out->totals = mp->totals;
-    } else if (ppb_method_mp(ctx, out, err)) {
-        return -1;
-    }
-    ppb_result own = {0};
-    if (!ss) {
-        if (ppb_result_init(&own, "ss", &out->layout, err))
-            return -1;
-        if (ppb_method_ss(ctx, &own, err)) {
-            ppb_result_free(&own);
-            return -1;
-        }
-        ss = &own;
-    }
-    for (size_t i = 0; i < out->layout.ncells; i++)
-        out->radiance[i] += ss->radiance[i];
-    out->totals.R += ss->totals.R; /* the diffusion already holds single scattering: MP+S counts */
-    out->totals.T += ss->totals.T; /* it twice, as the paper's energy remark says */
-    out->totals.sides += ss->totals.sides;
-    out->partial |= ss->partial;
-    ppb_result_free(&own);
-    ppb_progress_end(&pr, (double)out->layout.ncells);
-    ppb_result probe = *out;
-    ppb_totals_complete(&probe.totals);
-    return ppb_totals_check(ctx->cfg->name, &probe, err);
 }

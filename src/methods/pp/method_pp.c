@@ -2,6 +2,7 @@
  * the paper's Fig. 3, from the light maps through the slab tables to the march. */
 #include "methods/pp/method_pp.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -26,6 +27,22 @@ static int pp_memory_check(const ppb_config *cfg, int with_modes, ppb_err *err)
     return ppb_memory_check(total, cfg->memory_limit, with_modes ? "pp" : "ss", detail, err);
 }
 
+/* The marcher's tables, kept for the run: a sweep's points, or pp and ss of one experiment,
+ * that share a medium build them once (a hit is byte-identical to a fresh build,
+ * march_tables.h). */
+static ppb_march_cache *march_cache(ppb_run_ctx *ctx, ppb_err *err)
+{
+    static const char key[] = "pp.march_tables";
+    ppb_march_cache *c = ppb_ctx_state(ctx, key);
+    if (c)
+        return c;
+    if (!(c = ppb_march_cache_new())) {
+        ppb_fail(err, "pp: out of memory for the march tables' cache");
+        return NULL;
+    }
+    return ppb_ctx_keep(ctx, key, c, (void (*)(void *))ppb_march_cache_free, err) ? NULL : c;
+}
+
 int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
@@ -36,21 +53,14 @@ int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *
     /* 1. The light maps over the cross-section: optical depth D along the light path and its
      *    average albedo (Sec. 3.3). */
     ppb_maps maps = {0};
-    ppb_march_tables own = {0};
-    const ppb_march_tables *tab = &own;
+    const ppb_march_tables *tab = NULL;
     if (pp_memory_check(cfg, with_modes, err) || ppb_maps_build(sc, cfg->pp.map_res, &maps, err))
         return -1;
     /* 2. The integral tables R or S from the plane-parallel solution of each column's slab
      *    (Sec. 3.2, Eq. 15-17); `ss` keeps the direct beam's term only. */
-    int rc;
-    if (ctx->march_cache)
-        /* A sweep's earlier grid point may have built these very tables (byte-identical). */
-        rc = ppb_march_cache_tables(ctx->march_cache, sc, &cfg->pp, cfg->samples_dir,
-                                    PPB_MARCH_TAU_PER_MFP, with_modes, &tab, err);
-    else
-        rc = with_modes ? ppb_march_tables_pp(sc, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
-                                              &own, err)
-                        : ppb_march_tables_ss(sc, cfg->samples_dir, &own, err);
+    ppb_march_cache *cache = march_cache(ctx, err);
+    int rc = !cache || ppb_march_cache_tables(cache, sc, &cfg->pp, cfg->samples_dir,
+                                              PPB_MARCH_TAU_PER_MFP, with_modes, &tab, err);
     if (rc) {
         ppb_maps_free(&maps);
         return -1;
@@ -69,7 +79,6 @@ int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *
         ppb_march_totals(sc, &out->layout, out->radiance, &out->totals);
         rc = ppb_totals_check(cfg->name, out, err);
     }
-    ppb_march_tables_free(&own);
     ppb_maps_free(&maps);
     return rc;
 }
@@ -87,4 +96,31 @@ int ppb_pp_check(const ppb_config *cfg, ppb_err *err)
     (void)cfg;
     (void)err;
     return 0;
+}
+
+/* Rays the marcher traces (cells x samples_dir^2 x samples_seg) and steps along the longest
+ * (the tube's diagonal or the slab's thickness at the bins' most grazing direction, over the
+ * march step). */
+static void work_march(const ppb_config *cfg, double *rays, double *steps)
+{
+    const ppb_scene *sc = &cfg->scene;
+    double cells = (double)ppb_scene_layout(sc).ncells;
+    *rays = cells * cfg->samples_dir * cfg->samples_dir * cfg->samples_seg;
+    /* The most grazing direction sampled: the last theta bin's outer edge is 90 deg, its
+     * samples lie inside it, at about 1 / (2 theta_bins samples_dir) of the projected solid
+     * angle from it. */
+    double mu = sqrt(1.0 / (2.0 * sc->ntheta * cfg->samples_dir));
+    double len = sc->geometry == PPB_GEOM_SLAB
+                     ? sc->height / mu
+                     : sqrt(sc->width * sc->width + sc->height * sc->height);
+    *steps = ceil(len / cfg->pp.step);
+}
+
+/* The marcher's work (pp, ss, and a sum that holds one of them): rays x steps. */
+void ppb_pp_work(const ppb_config *cfg, const char *id, FILE *f)
+{
+    double rays, steps;
+    work_march(cfg, &rays, &steps);
+    fprintf(f, "%s: %s: work: %.3g rays x up to %.3g steps = %.3g steps\n", cfg->name, id, rays,
+            steps, rays * steps);
 }

@@ -4,6 +4,8 @@
 #ifndef PPB_METHOD_PP_H
 #define PPB_METHOD_PP_H
 
+#include <stdio.h>
+
 #include "methods/method.h"
 
 /* Fills out[0] with the bin-averaged exit radiance and the totals (reference: Bins). */
@@ -15,5 +17,8 @@ int ppb_pp_check(const ppb_config *cfg, ppb_err *err);
 /* The pipeline itself: maps, tables, march, totals. with_modes = 0 keeps only the attenuated
  * direct beam's single scattering in the tables: that is `ss` (method_ss.h). */
 int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err);
+
+/* The work line of pp and ss (the registry's work hook): rays x steps of the march. */
+void ppb_pp_work(const ppb_config *cfg, const char *id, FILE *f);
 
 #endif

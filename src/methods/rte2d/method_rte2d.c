@@ -549,6 +549,12 @@ static int record_refinements(rte_solver *s, const ppb_config *cfg, const ppb_la
     return rc;
 }
 
+/* The study as the result's extra output (model/result.h). */
+static int write_study(const void *study, const char *dir, ppb_err *err)
+{
+    return ppb_rte2d_write_refinements(study, dir, err);
+}
+
 int ppb_rte2d_write_refinements(const ppb_rte2d_study *study, const char *dir, ppb_err *err)
 {
     if (!study || study->n == 0)
@@ -644,10 +650,14 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
     const ppb_layout *lo = &out->layout;
     ppb_rte2d_stats st;
     memset(&st, 0, sizeof st);
-    /* The study follows a converged solve, where the run keeps a record of it. */
-    ppb_rte2d_study *study = cfg->rte2d.refinements == 0 ? ctx->rte2d_study : NULL;
-    if (ctx->rte2d_study)
-        ctx->rte2d_study->n = 0;
+    /* The study follows a converged solve where the run writes extra outputs: the result
+     * carries it (ppb_result.extra), a sweep point makes none. */
+    ppb_rte2d_study *study = NULL;
+    if (cfg->rte2d.refinements == 0 && ctx->extras) {
+        if (!(study = calloc(1, sizeof *study)))
+            return ppb_fail(err, "rte2d: out of memory (refinement study)");
+        out->extra = (ppb_result_extra){study, write_study, free};
+    }
     ppb_ocl *ocl;
     if (rte_memory_check(cfg, lo, study != NULL, err) || ppb_ctx_ocl(ctx, &ocl, err))
         return -1;

@@ -38,10 +38,10 @@ typedef struct ppb_rte2d_stats {
     double t_record;   /* seconds it took (in t_total) */
 } ppb_rte2d_stats;
 
-/* The refinement study of a converged run (reference: rte2d_refinements.csv), the run's own
- * record: its caller owns it and hands it over as ppb_run_ctx.rte2d_study (`ppbench run` does,
- * per config, and writes it with the output set; a sweep point, which writes no table, does
- * not, and runs no study). */
+/* The refinement study of a converged run (reference: rte2d_refinements.csv): run where the
+ * context asks for extra outputs (ppb_run_ctx.extras: `ppbench run` does, and writes it with
+ * the output set; a sweep point, which writes no table, does not), and carried by the result
+ * (ppb_result.extra.data). */
 #define PPB_RTE2D_RUNGS 10
 typedef struct ppb_rte2d_study {
     int n;                                   /* rungs recorded; 0: none */
@@ -52,7 +52,7 @@ typedef struct ppb_rte2d_study {
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
 /* The method, reporting what it took (tests, `make perf`; stats may be NULL): the refinement
- * study runs after a converged solve where ctx->rte2d_study is set. */
+ * study runs after a converged solve where ctx->extras is set. */
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
 
 /* Writes dir/rte2d_refinements.csv (reference: Outputs) from study; nothing when study is NULL

@@ -4,8 +4,8 @@
  * target, and the figure of merit of issue 21: the seconds to reach a 1% and a 0.5% noise floor
  * at the Table 2 cells (noise_rel at the x = 0 cells of S1 and S2, the larger), from the timed
  * run's noise scaled as 1/sqrt(photons). */
-#ifndef PPB_PERF_MC_H
-#define PPB_PERF_MC_H
+#ifndef PPB_MC_PERF_H
+#define PPB_MC_PERF_H
 
 #include <stdio.h>
 

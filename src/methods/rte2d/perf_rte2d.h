@@ -2,8 +2,8 @@
  * config, default the uniform g = 0 tube) on the device, its time per case (with the refinement
  * study, as `ppbench run` pays it) and per refinement (one march over the grid), the study's
  * share, and the solve's size. */
-#ifndef PPB_PERF_RTE2D_H
-#define PPB_PERF_RTE2D_H
+#ifndef PPB_RTE2D_PERF_H
+#define PPB_RTE2D_PERF_H
 
 #include <stdio.h>
 

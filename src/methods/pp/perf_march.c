@@ -1,5 +1,5 @@
 /* perf_march.c: the ray marcher's benchmark (perf_march.h). */
-#include "drivers/perf_march.h"
+#include "methods/pp/perf_march.h"
 
 #include "methods/pp/march.h"
 #include "base/progress.h"

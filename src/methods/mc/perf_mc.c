@@ -1,4 +1,4 @@
-#include "drivers/perf_mc.h"
+#include "methods/mc/perf_mc.h"
 
 #include <math.h>
 #include <stdlib.h>
