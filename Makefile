@@ -22,7 +22,7 @@ TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
 BIN   ?= ppbench
 
-.PHONY: all deps test layers docs unit asan bench perf format format-check clean
+.PHONY: all deps test layers methods-check docs unit asan bench perf format format-check clean
 all: $(BIN)
 
 # Dependencies first: the pkg-config flags are only asked for once the packages are there.
@@ -88,11 +88,15 @@ unit: $(BIN) $(TESTS)
 
 # The layer check first: it reads includes only and fails in a second. Then the reference's
 # check (docs/reference.md against what a few tiny runs write, a few seconds).
-test: layers docs unit
+test: layers methods-check docs unit
 	@bash tests/regress.sh
 
 layers:
 	@bash scripts/check_layers.sh
+
+# No method is named outside its slice and the registry (docs/reference.md: Adding a method).
+methods-check:
+	@bash scripts/check_methods.sh
 
 docs: $(BIN)
 	@mkdir -p $(BUILD)/tmp
