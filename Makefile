@@ -97,6 +97,7 @@ layers:
 # No method is named outside its slice and the registry (docs/reference.md: Adding a method).
 methods-check:
 	@bash scripts/check_methods.sh
+	@bash tests/test_check_methods.sh
 
 docs: $(BIN)
 	@mkdir -p $(BUILD)/tmp

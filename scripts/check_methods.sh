@@ -33,7 +33,10 @@ while read -r id run; do
   while IFS= read -r hit; do
     f=${hit%%:*}
     text=${hit#*:*:}
-    [[ $text =~ ^[[:space:]]*(/\*|\*|//|#) ]] && continue
+    case $f in
+      *.sh|*.gp) [[ $text =~ ^[[:space:]]*# ]] && continue ;;
+      *) [[ $text =~ ^[[:space:]]*(/\*|\*|//) ]] && continue ;;
+    esac
     case $f in
       "$reg"|src/model/config.c) continue ;;
     esac
