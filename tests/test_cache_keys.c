@@ -151,6 +151,33 @@ static void test_keys_hit_miss(void **state)
     assert_int_equal(bad, 0);
 }
 
+/* The tallies' own scene fingerprint (mc_tally.h: what a shard merge checks) changes with every
+ * key the table marks PPB_MC_KEY outside [mc] (the photon range, seed and batches are checked
+ * apart): a scene key added to the table and flagged is caught here if the fingerprint misses
+ * it. */
+static void test_scene_fingerprint_keys(void **state)
+{
+    (void)state;
+    ppb_config base;
+    small_config(&base);
+    uint64_t f0 = ppb_mc_scene_fingerprint(&base.scene);
+    int bad = 0;
+    for (int k = 0; k < ppb_config_nkeys(); k++) {
+        ppb_key_info in;
+        ppb_config_key_info(k, &in);
+        if (in.mc != PPB_MC_KEY || strcmp(in.section, "mc") == 0)
+            continue;
+        ppb_config c = base;
+        change_key(&c, k);
+        if (ppb_mc_scene_fingerprint(&c.scene) == f0) {
+            print_message("%s.%s changed: the tallies' scene fingerprint did not\n", in.section,
+                          in.key);
+            bad++;
+        }
+    }
+    assert_int_equal(bad, 0);
+}
+
 /* With a target noise the photons per launch are in the key: mc.chunk and, when it is 0,
  * $PPBENCH_MC_LANES (the device's size: compute units x 1024 x lanes x 64 on a CPU). Without
  * one they are not: the tallies of a whole budget do not depend on them (test_mc.c). */
@@ -239,9 +266,8 @@ static void test_noise_chunk_run(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_every_key_decided),
-        cmocka_unit_test(test_keys_hit_miss),
-        cmocka_unit_test(test_noise_chunk_key),
+        cmocka_unit_test(test_every_key_decided),      cmocka_unit_test(test_keys_hit_miss),
+        cmocka_unit_test(test_scene_fingerprint_keys), cmocka_unit_test(test_noise_chunk_key),
         cmocka_unit_test(test_noise_chunk_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
