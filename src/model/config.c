@@ -1208,7 +1208,7 @@ void ppb_config_key_info(int key, ppb_key_info *info)
     info->min = k->min;
     info->max = k->max;
     info->def = k->def;
-    for (int i = 0; k->enums && k->enums[i].name && i < 7; i++)
+    for (int i = 0; k->enums && k->enums[i].name && i < 15; i++)
         info->enums[i] = k->enums[i].name;
 }
 

@@ -172,8 +172,8 @@ typedef struct ppb_key_info {
     int number;  /* 1: an integer or real in [min, max] */
     int integer; /* 1: an integer */
     double min, max;
-    const char *def;      /* the default as written in the table */
-    const char *enums[8]; /* an enum key's value names, NULL-terminated; else enums[0] NULL */
+    const char *def;       /* the default as written in the table */
+    const char *enums[16]; /* an enum key's value names, NULL-terminated; else enums[0] NULL */
 } ppb_key_info;
 int ppb_config_nkeys(void);
 void ppb_config_key_info(int key, ppb_key_info *info);
