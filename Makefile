@@ -91,8 +91,10 @@ unit: $(BIN) $(TESTS)
 test: layers methods-check docs unit
 	@bash tests/regress.sh
 
+# The layer order is src/LAYERS; tests/test_layers.sh plants one violation of each rule.
 layers:
 	@bash scripts/check_layers.sh
+	@bash tests/test_layers.sh
 
 # No method is named outside its slice and the registry (docs/reference.md: Adding a method).
 methods-check:

@@ -1,6 +1,7 @@
-/* test_directions.c: the equal-area direction cells (src/physics/directions.h): ring and cell
- * areas, solid angles and mean cosines against a Monte Carlo over the sphere, the two mirror
- * symmetries, closure under w -> -w, cell lookup, and the quadrature nodes. */
+/* test_directions.c: the equal-area direction cells (src/physics/directions.h): cell areas
+ * and mean cosines from the cells' edges as the membership function draws them, solid angles
+ * and mean cosines against a Monte Carlo over the sphere, the two mirror symmetries, closure
+ * under w -> -w, cell lookup, and the quadrature nodes. */
 #include "testutil.h"
 
 #include <math.h>
@@ -11,33 +12,106 @@
 
 static const int sizes[] = {2, 7, 64, 334, 1000};
 
-/* Both partitions (default and antipodal): each ring's mu span times 2 pi is its cells' total
- * (dOmega = dmu dphi: the exact area of a (mu, phi) rectangle), the rings tile [0, 1] in mu, and
- * every cell's own (mu, phi) rectangle has the area |Omega| = 2 pi / N. */
-static void test_ring_areas(void **state)
+/* The direction at (mu, phi) (directions.h's frame: mu = w.y, phi from +x toward +z). */
+static int cell_at(const pp_dirs *d, double mu, double phi)
+{
+    double st = sqrt(fmax(0.0, 1.0 - mu * mu));
+    double w[3] = {st * cos(phi), mu, st * sin(phi)};
+    return pp_dirs_cell_of(d, w);
+}
+
+/* Where cell i ends, found with the membership function alone: from t0 (inside) along mu at
+ * phi = fixed (walk_mu) or along phi at mu = fixed, in steps of step until the cell changes or
+ * the walk reaches end, then bisected to 1e-14. *open: the cell still holds end (the pole, or a
+ * whole turn in phi). */
+static double edge_of(const pp_dirs *d, int i, int walk_mu, double fixed, double t0, double step,
+                      double end, int *open)
+{
+    double a = t0, b = t0;
+    *open = 0;
+    for (;;) {
+        b = a + step;
+        if ((step > 0) == (b >= end)) {
+            b = end;
+            if ((walk_mu ? cell_at(d, end, fixed) : cell_at(d, fixed, end)) == i) {
+                *open = 1;
+                return end;
+            }
+            break;
+        }
+        if ((walk_mu ? cell_at(d, b, fixed) : cell_at(d, fixed, b)) != i)
+            break;
+        a = b;
+    }
+    while (fabs(b - a) > 1e-14) {
+        double m = 0.5 * (a + b);
+        if ((walk_mu ? cell_at(d, m, fixed) : cell_at(d, fixed, m)) == i)
+            a = m;
+        else
+            b = m;
+    }
+    return 0.5 * (a + b);
+}
+
+/* Each cell's solid angle from its boundaries, found by probing the membership function
+ * pp_dirs_cell_of (not from the partition's tables): walks from a point of the cell along its
+ * meridian and its parallel to where the cell ends (edge_of), checks that the cell is the
+ * (mu, phi) rectangle those edges bound (9 points inside belong to it; points 1e-9 beyond each
+ * edge, 3 per edge, do not), and integrates dOmega = dmu dphi over it analytically (Archimedes:
+ * the area of a zone is 2 pi times its height): |Omega_i| = (mu_hi - mu_lo)(phi_hi - phi_lo).
+ * Every cell must have 2 pi / N (directions.h) to 1e-11, the cells must cover 4 pi, and the mean
+ * cosine of a (mu, phi) rectangle, (mu_lo + mu_hi) / 2, must be k_i (reference: Corrections). The
+ * bisection leaves each edge within 1e-14, so the area within about 1e-13. Both partitions. */
+static void test_cell_areas_from_membership(void **state)
 {
     (void)state;
     for (size_t t = 0; t < 2 * sizeof sizes / sizeof *sizes; t++) {
         pp_dirs d;
         ppb_err err;
-        int n = sizes[t % (sizeof sizes / sizeof *sizes)];
-        assert_int_equal(t < sizeof sizes / sizeof *sizes ? pp_dirs_make(n, &d, &err)
-                                                          : pp_dirs_make_antipodal(n, &d, &err),
-                         0);
-        double mu_sum = 0.0;
-        for (int r = 0; r < d.nrings; r++) {
-            int count = d.ring_first[r + 1] - d.ring_first[r];
-            double area = (d.mu_edge[r] - d.mu_edge[r + 1]) * 2 * PI;
-            assert_close(area, count * d.solid, 1e-13);
-            mu_sum += d.mu_edge[r] - d.mu_edge[r + 1];
+        int n = sizes[t % (sizeof sizes / sizeof *sizes)], anti = t >= sizeof sizes / sizeof *sizes;
+        assert_int_equal(anti ? pp_dirs_make_antipodal(n, &d, &err) : pp_dirs_make(n, &d, &err), 0);
+        double total = 0.0, hmu = 1.0 / (16.0 * n), hphi = 2.0 * PI / (16.0 * n);
+        for (int i = 0; i < 2 * n; i++) {
+            /* a point of the cell: its centre (checked to be in it) */
+            const double *c = d.centre + 3 * i;
+            double mu0 = c[1], phi0 = atan2(c[2], c[0]);
+            assert_int_equal(cell_at(&d, mu0, phi0), i);
+            int open_hi, open_lo, open_p, open_m;
+            double mu_hi = edge_of(&d, i, 1, phi0, mu0, hmu, 1.0, &open_hi);
+            double mu_lo = edge_of(&d, i, 1, phi0, mu0, -hmu, -1.0, &open_lo);
+            double phi_hi = edge_of(&d, i, 0, mu0, phi0, hphi, phi0 + 2 * PI, &open_p);
+            double phi_lo = edge_of(&d, i, 0, mu0, phi0, -hphi, phi0 - 2 * PI, &open_m);
+            int whole = open_p || open_m; /* a polar cap: the whole turn */
+            if (whole)
+                phi_lo = phi0 - PI, phi_hi = phi0 + PI;
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++) {
+                    double f[3] = {0.1, 0.5, 0.9};
+                    double mu = mu_lo + f[a] * (mu_hi - mu_lo),
+                           ph = phi_lo + f[b] * (phi_hi - phi_lo);
+                    if (cell_at(&d, mu, ph) != i)
+                        fail_msg("N = %d cell %d: (mu %.6f, phi %.6f) inside its edges is cell %d",
+                                 n, i, mu, ph, cell_at(&d, mu, ph));
+                    double mu_f = mu_lo + f[a] * (mu_hi - mu_lo);
+                    if (!open_hi && mu_hi + 1e-9 <= 1.0 && cell_at(&d, mu_hi + 1e-9, ph) == i)
+                        fail_msg("N = %d cell %d extends above mu %.15f", n, i, mu_hi);
+                    if (!open_lo && mu_lo - 1e-9 >= -1.0 && cell_at(&d, mu_lo - 1e-9, ph) == i)
+                        fail_msg("N = %d cell %d extends below mu %.15f", n, i, mu_lo);
+                    if (!whole && (cell_at(&d, mu_f, phi_hi + 1e-9) == i ||
+                                   cell_at(&d, mu_f, phi_lo - 1e-9) == i))
+                        fail_msg("N = %d cell %d extends beyond phi [%.15f, %.15f]", n, i, phi_lo,
+                                 phi_hi);
+                }
+            double area = (mu_hi - mu_lo) * (phi_hi - phi_lo);
+            if (fabs(area - 2 * PI / n) > 1e-11 || fabs(0.5 * (mu_lo + mu_hi) - d.k[i]) > 1e-12)
+                fail_msg("N = %d%s cell %d: mu [%.15f, %.15f], phi [%.15f, %.15f]: area %.15g "
+                         "(2 pi / N = %.15g), mean cosine %.15g (k = %.15g)",
+                         n, anti ? " antipodal" : "", i, mu_lo, mu_hi, phi_lo, phi_hi, area,
+                         2 * PI / n, 0.5 * (mu_lo + mu_hi), d.k[i]);
+            total += area;
         }
-        assert_close(mu_sum, 1.0, 1e-15);
-        assert_close(d.mu_edge[d.nrings], 0.0, 0.0);
-        for (int i = 0; i < 2 * d.n; i++) {
-            double mu_lo, mu_hi, phi_lo, phi_hi;
-            pp_dirs_bounds(&d, i, &mu_lo, &mu_hi, &phi_lo, &phi_hi);
-            assert_close((mu_hi - mu_lo) * (phi_hi - phi_lo), d.solid, 1e-13);
-        }
+        assert_close(total, 4 * PI, 1e-10);
+        assert_close(d.solid, 2 * PI / n, 1e-15);
         pp_dirs_free(&d);
     }
 }
@@ -214,7 +288,7 @@ static void test_nodes_lie_in_their_cell(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_ring_areas),
+        cmocka_unit_test(test_cell_areas_from_membership),
         cmocka_unit_test(test_cells_by_monte_carlo),
         cmocka_unit_test(test_mean_cosines_exact),
         cmocka_unit_test(test_mirror_symmetries),

@@ -580,7 +580,23 @@ static void test_slab_vs_ppslab(void **state)
     }
 }
 
-/* Builds mc.cl with each of the lane options and runs its self-check kernel `name`
+/* The kernel's source tree, as ppb_ocl_build finds it ($PPBENCH_SOURCE, else the build's). */
+static const char *source_root(void)
+{
+    const char *d = getenv("PPBENCH_SOURCE");
+    return d && *d ? d : PPB_SOURCE_DIR;
+}
+
+/* Builds the self-check kernels (tests/kernels/mc_check.cl, which includes mc.cl whole) with
+ * the lane option opt, mc.cl's folder on the include path. */
+static int build_check(ppb_ocl *ocl, const char *opt, cl_program *prog, ppb_err *err)
+{
+    char extra[2300];
+    snprintf(extra, sizeof extra, "-I %s/src/methods/mc %s", source_root(), opt);
+    return ppb_ocl_build(ocl, "tests/kernels/mc_check.cl", extra, prog, err);
+}
+
+/* Builds mc_check.cl with each of the lane options and runs its self-check kernel `name`
  * (name(arg, __global uint *count)) on 4096 work-items once per value of args (nargs values of
  * arg_size bytes each), with a zeroed counter: every count (mismatches the kernel found) must
  * be 0. */
@@ -596,8 +612,7 @@ static void expect_no_mismatches(const char *name, const char *const *opts, int 
     for (int i = 0; i < nopts; i++) {
         cl_program prog;
         cl_kernel k;
-        if (ppb_ocl_build(ocl, PPB_MC_KERNEL, opts[i], &prog, &err) ||
-            ppb_ocl_kernel(prog, name, &k, &err))
+        if (build_check(ocl, opts[i], &prog, &err) || ppb_ocl_kernel(prog, name, &k, &err))
             fail_msg("%s", err.msg);
         for (int j = 0; j < nargs; j++) {
             cl_int rc;
@@ -673,7 +688,7 @@ static void test_vector_bins_match_conventions(void **state)
     for (int i = 0; i < 2; i++) {
         cl_program prog;
         cl_kernel k;
-        if (ppb_ocl_build(ocl, PPB_MC_KERNEL, opts[i], &prog, &err) ||
+        if (build_check(ocl, opts[i], &prog, &err) ||
             ppb_ocl_kernel(prog, "ppb_mc_bins_check", &k, &err))
             fail_msg("%s", err.msg);
         for (int j = 0; j < 4; j++) {
@@ -821,9 +836,7 @@ static void test_hg_sampler_chi_square(void **state)
     ppb_err err;
     if (ppb_ctx_ocl(&f.ctx, &ocl, &err))
         fail_msg("%s", err.msg);
-    const char *dir = getenv("PPBENCH_SOURCE") && *getenv("PPBENCH_SOURCE")
-                          ? getenv("PPBENCH_SOURCE")
-                          : PPB_SOURCE_DIR;
+    const char *dir = source_root();
     char opts[2200];
     snprintf(opts, sizeof opts, "-I %s/kernels -I /usr/include", dir); /* as ppb_ocl_build */
     cl_int rc;

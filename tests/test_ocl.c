@@ -77,7 +77,7 @@ static void test_kernel_matches_host(void **state)
     ppb_ocl ocl;
     assert_int_equal(ppb_ocl_open(&ocl, NULL, &err), 0);
     cl_program prog;
-    if (ppb_ocl_build(&ocl, "kernels/selftest.cl", NULL, &prog, &err))
+    if (ppb_ocl_build(&ocl, "tests/kernels/selftest.cl", NULL, &prog, &err))
         fail_msg("%s", err.msg);
     cl_kernel k;
     assert_int_equal(ppb_ocl_kernel(prog, "bins_of", &k, &err), 0);

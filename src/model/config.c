@@ -52,6 +52,11 @@ _Static_assert(sizeof(ppb_geometry) == sizeof(int), "enum keys are stored as int
 typedef struct key_def {
     const char *section, *key;
     key_type type;
+    /* Whether the key changes the Monte Carlo's result (config.h, ppb_mc_key): the reference
+     * cache's key hashes exactly the PPB_MC_KEY keys (methods/mc/mc_cache.h). Required: it
+     * stands before the offset, so an entry that leaves it out does not compile, and 0 is
+     * refused by the key table's test (tests/test_cache_keys.c). */
+    ppb_mc_key mc;
     size_t offset;
     double min, max;
     const char *def;
@@ -62,83 +67,89 @@ typedef struct key_def {
 #define F(field) offsetof(ppb_config, field)
 /* The one table: parsing, defaults, ranges, sweeps and configs/README.md all come from it. */
 static const key_def keys[] = {
-    {"experiment", "name", K_NAME, F(name), 0, 0, "", NULL,
+    {"experiment", "name", K_NAME, PPB_NOT_MC_KEY, F(name), 0, 0, "", NULL,
      "experiment name; default: the config file's base name"},
-    {"experiment", "geometry", K_ENUM, F(scene.geometry), 0, 0, "tube", geometry_names,
+    {"experiment", "geometry", K_ENUM, PPB_MC_KEY, F(scene.geometry), 0, 0, "tube", geometry_names,
      "the tube (docs/reference.md: Geometry), or the infinite slab of thickness `height`"},
-    {"experiment", "methods", K_METHODS, F(methods), 0, 0, "mc, pp, ss, mp, mp+ss", NULL,
-     "method ids, comma-separated (`ppbench --help` lists them)"},
-    {"tube", "width", K_REAL, F(scene.width), 0.01, 1000, "10", NULL, "W, mfp (ignored by slab)"},
-    {"tube", "height", K_REAL, F(scene.height), 1e-3, 1000, "3", NULL,
+    {"experiment", "methods", K_METHODS, PPB_NOT_MC_KEY, F(methods), 0, 0, "mc, pp, ss, mp, mp+ss",
+     NULL, "method ids, comma-separated (`ppbench --help` lists them)"},
+    {"tube", "width", K_REAL, PPB_MC_KEY, F(scene.width), 0.01, 1000, "10", NULL,
+     "W, mfp (ignored by slab)"},
+    {"tube", "height", K_REAL, PPB_MC_KEY, F(scene.height), 1e-3, 1000, "3", NULL,
      "H, mfp; the slab thickness in slab mode"},
-    {"tube", "segments_top", K_INT, F(scene.segments_top), 1, 4096, "128", NULL,
+    {"tube", "segments_top", K_INT, PPB_MC_KEY, F(scene.segments_top), 1, 4096, "128", NULL,
      "segments of S1 and S2"},
-    {"tube", "segments_side", K_INT, F(scene.segments_side), 1, 4096, "36", NULL,
+    {"tube", "segments_side", K_INT, PPB_MC_KEY, F(scene.segments_side), 1, 4096, "36", NULL,
      "segments of S3 and S4"},
-    {"medium", "sigma_t", K_REAL, F(scene.sigma_t), 1e-3, 1000, "1", NULL,
+    {"medium", "sigma_t", K_REAL, PPB_MC_KEY, F(scene.sigma_t), 1e-3, 1000, "1", NULL,
      "extinction, 1/mfp (left of the step)"},
-    {"medium", "albedo", K_REAL, F(scene.albedo), 0, 1, "0.95", NULL,
+    {"medium", "albedo", K_REAL, PPB_MC_KEY, F(scene.albedo), 0, 1, "0.95", NULL,
      "single-scattering albedo (left of the step)"},
-    {"medium", "g", K_REAL, F(scene.g), -0.95, 0.95, "0", NULL, "Henyey-Greenstein asymmetry"},
-    {"medium", "n", K_REAL, F(scene.n), 1, 2.5, "1", NULL,
+    {"medium", "g", K_REAL, PPB_MC_KEY, F(scene.g), -0.95, 0.95, "0", NULL,
+     "Henyey-Greenstein asymmetry"},
+    {"medium", "n", K_REAL, PPB_MC_KEY, F(scene.n), 1, 2.5, "1", NULL,
      "refractive index inside (outside is 1): smooth Fresnel boundaries"},
-    {"medium", "step", K_ENUM, F(scene.step), 0, 0, "none", step_names,
+    {"medium", "step", K_ENUM, PPB_MC_KEY, F(scene.step), 0, 0, "none", step_names,
      "what changes at x = step_x (tube only)"},
-    {"medium", "step_x", K_REAL, F(scene.step_x), -500, 500, "0", NULL,
+    {"medium", "step_x", K_REAL, PPB_MC_KEY, F(scene.step_x), -500, 500, "0", NULL,
      "position of the step, mfp; inside the tube"},
-    {"medium", "sigma_t_right", K_REAL, F(scene.sigma_t_right), 1e-3, 1000, "0.5", NULL,
+    {"medium", "sigma_t_right", K_REAL, PPB_MC_KEY, F(scene.sigma_t_right), 1e-3, 1000, "0.5", NULL,
      "extinction for x >= step_x (step = density)"},
-    {"medium", "albedo_right", K_REAL, F(scene.albedo_right), 0, 1, "0.475", NULL,
+    {"medium", "albedo_right", K_REAL, PPB_MC_KEY, F(scene.albedo_right), 0, 1, "0.475", NULL,
      "albedo for x >= step_x (step = albedo)"},
-    {"light", "theta_deg", K_REAL, F(scene.theta_deg), 0, 89, "0", NULL,
+    {"light", "theta_deg", K_REAL, PPB_MC_KEY, F(scene.theta_deg), 0, 89, "0", NULL,
      "incidence angle from the S1 normal, degrees"},
-    {"bins", "theta", K_INT, F(scene.ntheta), 1, 64, "8", NULL,
+    {"bins", "theta", K_INT, PPB_MC_KEY, F(scene.ntheta), 1, 64, "8", NULL,
      "theta bins (equal projected solid angle)"},
-    {"bins", "phi", K_INT, F(scene.nphi), 1, 64, "8", NULL, "phi bins over [0, 180] deg"},
-    {"bins", "samples_dir", K_INT, F(samples_dir), 1, 64, "4", NULL,
+    {"bins", "phi", K_INT, PPB_MC_KEY, F(scene.nphi), 1, 64, "8", NULL,
+     "phi bins over [0, 180] deg"},
+    {"bins", "samples_dir", K_INT, PPB_NOT_MC_KEY, F(samples_dir), 1, 64, "4", NULL,
      "deterministic methods: n x n directions averaged per bin"},
-    {"bins", "samples_seg", K_INT, F(samples_seg), 1, 64, "4", NULL,
+    {"bins", "samples_seg", K_INT, PPB_NOT_MC_KEY, F(samples_seg), 1, 64, "4", NULL,
      "deterministic methods: points averaged per segment"},
-    {"mc", "photons", K_LLONG, F(mc.photons), 1, 1e13, "1e7", NULL, "photon budget"},
-    {"mc", "batches", K_INT, F(mc.batches), 2, 1024, "16", NULL,
+    {"mc", "photons", K_LLONG, PPB_MC_KEY, F(mc.photons), 1, 1e13, "1e7", NULL, "photon budget"},
+    {"mc", "batches", K_INT, PPB_MC_KEY, F(mc.batches), 2, 1024, "16", NULL,
      "independent batches for standard errors"},
-    {"mc", "seed", K_LLONG, F(mc.seed), 0, 9.2e18, "1", NULL, "random seed (Philox key)"},
-    {"mc", "workgroup", K_INT, F(mc.workgroup), 0, 4096, "0", NULL,
+    {"mc", "seed", K_LLONG, PPB_MC_KEY, F(mc.seed), 0, 9.2e18, "1", NULL,
+     "random seed (Philox key)"},
+    {"mc", "workgroup", K_INT, PPB_NOT_MC_KEY, F(mc.workgroup), 0, 4096, "0", NULL,
      "work-group size, 0 = ppbench picks (1 on a CPU, 64 on a GPU); results do not depend on it"},
-    {"mc", "chunk", K_LLONG, F(mc.chunk), 0, 1e12, "0", NULL,
-     "photons per kernel launch, 0 = sized to the device (results do not depend on it)"},
-    {"mc", "first", K_LLONG, F(mc.first), 0, 1e13, "0", NULL,
+    {"mc", "chunk", K_LLONG, PPB_NOT_MC_KEY, F(mc.chunk), 0, 1e12, "0", NULL,
+     "photons per kernel launch, 0 = sized to the device (results do not depend on it, "
+     "except where target_noise stops the run after a launch)"},
+    {"mc", "first", K_LLONG, PPB_MC_KEY, F(mc.first), 0, 1e13, "0", NULL,
      "index of the first photon (a shard of one run)"},
-    {"mc", "target_noise", K_REAL, F(mc.target_noise), 0, 1, "0", NULL,
+    {"mc", "target_noise", K_REAL, PPB_MC_KEY, F(mc.target_noise), 0, 1, "0", NULL,
      "stop when noise_rel at the x = 0 cells falls below this; 0 = run the whole budget"},
-    {"pp", "directions", K_INT, F(pp.directions), 2, 4000, "334", NULL,
+    {"pp", "directions", K_INT, PPB_NOT_MC_KEY, F(pp.directions), 2, 4000, "334", NULL,
      "direction cells per hemisphere (M = 2 x directions)"},
-    {"pp", "modes", K_INT, F(pp.modes), 0, 8000, "0", NULL,
+    {"pp", "modes", K_INT, PPB_NOT_MC_KEY, F(pp.modes), 0, 8000, "0", NULL,
      "n_e: modes kept by the march, 0 = all"},
-    {"pp", "table", K_ENUM, F(pp.table), 0, 0, "S", table_names,
+    {"pp", "table", K_ENUM, PPB_NOT_MC_KEY, F(pp.table), 0, 0, "S", table_names,
      "integral table of the march: R (Eq. 15) or S (Eq. 16-17)"},
-    {"pp", "step", K_REAL, F(pp.step), 1e-4, 1, "0.05", NULL, "ray-march step, mfp"},
-    {"pp", "albedos", K_INT, F(pp.albedos), 2, 64, "9", NULL,
+    {"pp", "step", K_REAL, PPB_NOT_MC_KEY, F(pp.step), 1e-4, 1, "0.05", NULL,
+     "ray-march step, mfp"},
+    {"pp", "albedos", K_INT, PPB_NOT_MC_KEY, F(pp.albedos), 2, 64, "9", NULL,
      "albedo nodes of the tables (Sec. 3.3)"},
-    {"pp", "map_res", K_INT, F(pp.map_res), 1, 4096, "64", NULL,
+    {"pp", "map_res", K_INT, PPB_NOT_MC_KEY, F(pp.map_res), 1, 4096, "64", NULL,
      "cells per mfp of the optical-depth and albedo maps"},
-    {"mp", "pairs", K_INT, F(mp.pairs), 0, 200, "10", NULL,
+    {"mp", "pairs", K_INT, PPB_NOT_MC_KEY, F(mp.pairs), 0, 200, "10", NULL,
      "dipole pairs beyond the first (0 = dipole)"},
-    {"mp", "samples", K_INT, F(mp.samples), 1, 256, "16", NULL,
+    {"mp", "samples", K_INT, PPB_NOT_MC_KEY, F(mp.samples), 1, 256, "16", NULL,
      "quadrature nodes per mfp over the lit strip"},
-    {"rte2d", "spacing", K_REAL, F(rte2d.spacing), 0.005, 10, "0.1", NULL,
+    {"rte2d", "spacing", K_REAL, PPB_NOT_MC_KEY, F(rte2d.spacing), 0.005, 10, "0.1", NULL,
      "rte2d: grid node spacing over the cross-section, mfp"},
-    {"rte2d", "directions", K_INT, F(rte2d.directions), 2, 2000, "128", NULL,
+    {"rte2d", "directions", K_INT, PPB_NOT_MC_KEY, F(rte2d.directions), 2, 2000, "128", NULL,
      "rte2d: direction cells per hemisphere"},
-    {"rte2d", "step", K_REAL, F(rte2d.step), 1e-3, 1, "0.05", NULL,
+    {"rte2d", "step", K_REAL, PPB_NOT_MC_KEY, F(rte2d.step), 1e-3, 1, "0.05", NULL,
      "rte2d: largest track spacing of the sweep and march step of the exit, in the plane, mfp"},
-    {"rte2d", "tolerance", K_REAL, F(rte2d.tol), 1e-12, 0.1, "1e-7", NULL,
+    {"rte2d", "tolerance", K_REAL, PPB_NOT_MC_KEY, F(rte2d.tol), 1e-12, 0.1, "1e-7", NULL,
      "rte2d: relative residual at which the solve stops"},
-    {"rte2d", "refinements", K_INT, F(rte2d.refinements), 0, 10000, "0", NULL,
+    {"rte2d", "refinements", K_INT, PPB_NOT_MC_KEY, F(rte2d.refinements), 0, 10000, "0", NULL,
      "rte2d: K steps of Eq. 5 from I_pp (1 = the paper's method on the grid); 0 = converge"},
-    {"output", "dir", K_PATH, F(out_dir), 0, 0, "", NULL,
+    {"output", "dir", K_PATH, PPB_NOT_MC_KEY, F(out_dir), 0, 0, "", NULL,
      "output directory; default results/<name>"},
-    {"run", "memory_limit", K_REAL, F(memory_limit), 0, 1e6, "0", NULL,
+    {"run", "memory_limit", K_REAL, PPB_NOT_MC_KEY, F(memory_limit), 0, 1e6, "0", NULL,
      "GB a method may allocate, estimated before it allocates (over it: refused); 0 = half "
      "the machine's memory"},
 };
@@ -1178,6 +1189,34 @@ double ppb_config_key_value(const ppb_config *cfg, int key)
     if (k->type == K_LLONG)
         return (double)*(const long long *)p;
     return k->type == K_REAL ? *(const double *)p : 0.0;
+}
+
+int ppb_config_nkeys(void)
+{
+    return NKEYS;
+}
+
+void ppb_config_key_info(int key, ppb_key_info *info)
+{
+    const key_def *k = &keys[key];
+    memset(info, 0, sizeof *info);
+    info->section = k->section;
+    info->key = k->key;
+    info->mc = k->mc;
+    info->integer = k->type == K_INT || k->type == K_LLONG;
+    info->number = info->integer || k->type == K_REAL;
+    info->min = k->min;
+    info->max = k->max;
+    info->def = k->def;
+    for (int i = 0; k->enums && k->enums[i].name && i < 15; i++)
+        info->enums[i] = k->enums[i].name;
+}
+
+void ppb_config_write_key(const ppb_config *cfg, int key, FILE *out)
+{
+    fprintf(out, "%s.%s = ", keys[key].section, keys[key].key);
+    write_value(cfg, &keys[key], out);
+    fputc('\n', out);
 }
 
 int ppb_config_has_method(const ppb_config *cfg, const char *id)

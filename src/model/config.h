@@ -24,6 +24,12 @@
 #include "model/grid.h"
 #include "model/scene.h"
 
+/* Whether a key of the table changes the Monte Carlo's result (its tallies, for the same device
+ * and kernel): the reference cache's key hashes the resolved value of every PPB_MC_KEY key
+ * (methods/mc/mc_cache.h), and no other. Every entry of the table states one of the two; 0 is
+ * no decision, which the table's test refuses (tests/test_cache_keys.c). */
+typedef enum ppb_mc_key { PPB_MC_KEY = 1, PPB_NOT_MC_KEY = 2 } ppb_mc_key;
+
 #define PPB_MAX_METHODS 16
 #define PPB_MAX_KEYS    64
 
@@ -157,6 +163,23 @@ void ppb_config_write_keys(FILE *out);
 /* Name of key k of the table ("medium.g", as in ppb_axis.key) into buf, and its value in cfg. */
 void ppb_config_key_name(int key, char *buf, size_t cap);
 double ppb_config_key_value(const ppb_config *cfg, int key);
+
+/* What the key table says of key k (0 <= k < ppb_config_nkeys()), for code that iterates the
+ * table: the reference cache's key, and the tests that change every key in turn. */
+typedef struct ppb_key_info {
+    const char *section, *key;
+    ppb_mc_key mc;
+    int number;  /* 1: an integer or real in [min, max] */
+    int integer; /* 1: an integer */
+    double min, max;
+    const char *def;       /* the default as written in the table */
+    const char *enums[16]; /* an enum key's value names, NULL-terminated; else enums[0] NULL */
+} ppb_key_info;
+int ppb_config_nkeys(void);
+void ppb_config_key_info(int key, ppb_key_info *info);
+
+/* Key k's line of ppb_config_write_resolved ("section.key = value\n", the canonical form). */
+void ppb_config_write_key(const ppb_config *cfg, int key, FILE *out);
 
 int ppb_config_has_method(const ppb_config *cfg, const char *id);
 

@@ -1,11 +1,13 @@
 #include "methods/mc/mc_cache.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "base/atomic_file.h"
 #include "base/hash.h"
+#include "model/config.h"
 
 /* The device and its driver, hashed: "platform / device" and CL_DRIVER_VERSION. */
 static int device_hash(ppb_run_ctx *ctx, uint64_t *h, ppb_err *err)
@@ -23,35 +25,60 @@ static int device_hash(ppb_run_ctx *ctx, uint64_t *h, ppb_err *err)
     return 0;
 }
 
-/* DIR/mc-<key>.bin (mc_cache.h lists what the key holds). */
-static int cache_path(ppb_run_ctx *ctx, char *buf, size_t cap, ppb_err *err)
+/* The key's text (mc_cache.h): the canonical line of every key the table marks PPB_MC_KEY,
+ * in table order, so a key added to the table joins the key by its flag alone; the photons per
+ * launch when a target noise stops the trace between launches; the kernel's source and the
+ * device. */
+static int key_text(ppb_run_ctx *ctx, long long chunk, FILE *f, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
-    uint64_t key[9] = {PPB_MC_CACHE_VERSION,
-                       ppb_mc_scene_fingerprint(&cfg->scene),
-                       (uint64_t)cfg->mc.seed,
-                       (uint64_t)cfg->mc.batches,
-                       (uint64_t)cfg->mc.first,
-                       (uint64_t)cfg->mc.photons,
-                       0,
-                       0,
-                       0};
-    memcpy(&key[6], &cfg->mc.target_noise, sizeof key[6]);
-    if (ppb_ocl_source_hash(PPB_MC_KERNEL, &key[7], err) || device_hash(ctx, &key[8], err))
+    uint64_t source, device;
+    if (ppb_ocl_source_hash(PPB_MC_KERNEL, &source, err) || device_hash(ctx, &device, err))
         return -1;
-    snprintf(buf, cap, "%s/mc-%016llx.bin", ctx->ref_cache,
-             (unsigned long long)ppb_hash64(key, sizeof key));
+    fprintf(f, "ppbench mc reference %d\n", PPB_MC_CACHE_VERSION);
+    for (int k = 0; k < ppb_config_nkeys(); k++) {
+        ppb_key_info info;
+        ppb_config_key_info(k, &info);
+        if (info.mc == PPB_MC_KEY)
+            ppb_config_write_key(cfg, k, f);
+        else if (info.mc != PPB_NOT_MC_KEY)
+            return ppb_fail(err,
+                            "mc: key %s.%s: the key table does not say whether it changes "
+                            "the Monte Carlo",
+                            info.section, info.key);
+    }
+    if (cfg->mc.target_noise > 0)
+        fprintf(f, "photons per launch = %lld\n", chunk);
+    fprintf(f, "kernel = %016llx\ndevice = %016llx\n", (unsigned long long)source,
+            (unsigned long long)device);
     return 0;
 }
 
-int ppb_mc_cache_get(ppb_run_ctx *ctx, ppb_mc_tallies *t)
+int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, ppb_err *err)
+{
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    if (!f)
+        return ppb_fail(err, "mc: reference cache: out of memory");
+    int status = key_text(ctx, chunk, f, err);
+    if (fclose(f) && status == 0)
+        status = ppb_fail(err, "mc: reference cache: out of memory");
+    if (status == 0)
+        snprintf(buf, cap, "%s/mc-%016llx.bin", ctx->ref_cache ? ctx->ref_cache : ".",
+                 (unsigned long long)ppb_hash64(text, len));
+    free(text);
+    return status;
+}
+
+int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t)
 {
     const ppb_config *cfg = ctx->cfg;
     char path[PPB_PATH_MAX + 64];
     ppb_err err = {{0}};
     if (!ctx->ref_cache)
         return 0;
-    if (cache_path(ctx, path, sizeof path, &err)) {
+    if (ppb_mc_cache_path(ctx, chunk, path, sizeof path, &err)) {
         fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
         return 0;
     }
@@ -76,7 +103,7 @@ int ppb_mc_cache_get(ppb_run_ctx *ctx, ppb_mc_tallies *t)
     return 1;
 }
 
-void ppb_mc_cache_put(ppb_run_ctx *ctx, ppb_mc_tallies *t, long long traced)
+void ppb_mc_cache_put(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, long long traced)
 {
     const ppb_config *cfg = ctx->cfg;
     char path[PPB_PATH_MAX + 64];
@@ -86,7 +113,7 @@ void ppb_mc_cache_put(ppb_run_ctx *ctx, ppb_mc_tallies *t, long long traced)
     t->budget_first = t->first = (uint64_t)cfg->mc.first;
     t->budget_photons = (uint64_t)cfg->mc.photons;
     t->count = (uint64_t)traced;
-    if (cache_path(ctx, path, sizeof path, &err) || ppb_mkdirs(ctx->ref_cache, &err) ||
-        ppb_mc_tallies_save(t, path, &err))
+    if (ppb_mc_cache_path(ctx, chunk, path, sizeof path, &err) ||
+        ppb_mkdirs(ctx->ref_cache, &err) || ppb_mc_tallies_save(t, path, &err))
         fprintf(stderr, "%s: mc: reference cache: not stored: %s\n", cfg->name, err.msg);
 }

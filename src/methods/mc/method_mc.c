@@ -181,6 +181,20 @@ static long long auto_chunk(const mc_shape *shape)
     return shape->items * shape->lanes * 64;
 }
 
+int ppb_mc_chunk(ppb_run_ctx *ctx, long long *chunk, ppb_err *err)
+{
+    ppb_ocl *ocl;
+    mc_shape shape;
+    if (ctx->cfg->mc.chunk > 0) {
+        *chunk = ctx->cfg->mc.chunk;
+        return 0;
+    }
+    if (ppb_ctx_ocl(ctx, &ocl, err) || device_shape(ocl, &shape, err))
+        return -1;
+    *chunk = auto_chunk(&shape);
+    return 0;
+}
+
 /* One trace in progress: what every chunk needs, gathered so the helpers below share it. */
 typedef struct mc_run {
     const ppb_config *cfg;
@@ -459,7 +473,11 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         return -1;
     ppb_mc_trace_info info = {0};
     int status = 0;
-    if (ctx->ref_cache && ppb_mc_cache_get(ctx, &t)) {
+    /* The cache's key holds the photons per launch under a target noise (mc_cache.h). */
+    long long chunk = 0;
+    if (ctx->ref_cache && cfg->mc.target_noise > 0 && ppb_mc_chunk(ctx, &chunk, err))
+        return -1;
+    if (ctx->ref_cache && ppb_mc_cache_get(ctx, chunk, &t)) {
         /* The same reference was traced before (docs/external.md): no photon is traced now. */
         fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n", cfg->name,
                 (unsigned long long)t.count, ctx->ref_cache);
@@ -468,7 +486,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
             return -1;
         status = ppb_mc_trace(ctx, cfg->mc.first, cfg->mc.photons, &t, &info, err);
         if (status == 0 && !info.interrupted && ctx->ref_cache)
-            ppb_mc_cache_put(ctx, &t, info.traced);
+            ppb_mc_cache_put(ctx, chunk, &t, info.traced);
     }
     if (status == 0) {
         /* Said, not hidden: interactions past the event cap were rouletted (mc_params.h). */

@@ -38,5 +38,10 @@ int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tall
 double ppb_mc_events_per_photon(const ppb_config *cfg);
 /* The work line (the registry's work hook): photons x events per photon. */
 void ppb_mc_work(const ppb_config *cfg, const char *id, FILE *f);
+/* Photons per launch of ctx->cfg's trace on ctx's device: mc.chunk, or when 0 the device's
+ * size (its compute units and lanes, $PPBENCH_MC_LANES included). The tallies do not depend on
+ * it, but with a target noise the run stops between launches, so the photons traced do: the
+ * reference cache's key holds it then (mc_cache.h). */
+int ppb_mc_chunk(ppb_run_ctx *ctx, long long *chunk, ppb_err *err);
 
 #endif
