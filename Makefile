@@ -14,8 +14,8 @@ CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc -I. \
             -Ikernels -DPPB_SOURCE_DIR='"$(CURDIR)"' -DPPB_SCRIPT_DIR='"$(CURDIR)/scripts"'
 LDFLAGS += $(SAN)
 
-# src/<layer>/<module>.c, and src/methods/<slice>/<module>.c for each method; the layers and their order are in README.md (Layout) and checked by
-# scripts/check_layers.sh.
+# src/<layer>/<module>.c, and src/methods/<slice>/<module>.c for each method; the layers and
+# their order are in src/LAYERS, which scripts/check_layers.sh reads.
 SRC   := $(filter-out src/drivers/main.c,$(wildcard src/*/*.c src/methods/*/*.c))
 OBJ   := $(SRC:src/%.c=$(BUILD)/obj/%.o)
 TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
@@ -125,7 +125,7 @@ test-cluster: $(BIN)
 	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= BUILD_DIR=$(CURDIR)/$(BUILD) timeout 900 bash tests/cluster.sh
 
 FORMATTED = $(wildcard src/*/*.[ch] src/methods/*/*.[ch] src/methods/*/*.cl tests/*.[ch] \
-              kernels/*.cl kernels/*.h)
+              tests/kernels/*.cl kernels/*.h)
 format:
 	clang-format -i $(FORMATTED)
 
