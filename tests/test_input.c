@@ -53,8 +53,8 @@ static const char *study_copy(const char *name, const char *sed)
     static char path[1200];
     snprintf(path, sizeof path, "%s/%s.ini", tu_scratch(name), name);
     char cmd[3000];
-    snprintf(cmd, sizeof cmd, "sed '%s' '%s/configs/density_step.ini' > '%s'", sed,
-             PPB_SOURCE_DIR, path);
+    snprintf(cmd, sizeof cmd, "sed '%s' '%s/configs/density_step.ini' > '%s'", sed, PPB_SOURCE_DIR,
+             path);
     assert_int_equal(system(cmd), 0);
     return path;
 }

@@ -475,10 +475,8 @@ static int cmd_run(const cli *c)
     for (int i = 0; i < c->nargs && code == EXIT_OK; i++) {
         const ppb_config *cfg = &cfgs[i];
         ppb_experiment ex = {0};
-        ppb_run_ctx ctx = {.device_selector = c->device,
-                           .quiet = c->quiet,
-                           .ref_cache = cache,
-                           .extras = 1};
+        ppb_run_ctx ctx = {
+            .device_selector = c->device, .quiet = c->quiet, .ref_cache = cache, .extras = 1};
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
