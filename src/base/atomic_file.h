@@ -68,6 +68,22 @@ int ppb_adir_commit(ppb_adir *ad, ppb_err *err);
 /* Removes the staging directory and all in it. */
 void ppb_adir_abort(ppb_adir *ad);
 
+/* Whether the file at path is complete, as far as its kind shows: a regular file of non-zero
+ * size; a PNG ending with its IEND chunk; a PDF ending with %%EOF. A writer that ignores a
+ * full disk (gnuplot's cairo) leaves a 0-byte or cut file with a success status: this finds
+ * it (docs/reference.md: Outputs). Fails naming the path and what is wrong. */
+int ppb_file_complete(const char *path, ppb_err *err);
+/* A PDF made the same bytes by the same run: its /CreationDate (the one thing cairo writes
+ * that changes from run to run) set to D:19700101000000Z, in place and of the same length, so
+ * the cross-reference offsets stay true. A PDF without one is left as it is. */
+int ppb_pdf_fix_date(const char *path, ppb_err *err);
+/* Checks every file under dir (at any depth, never following a link) with ppb_file_complete
+ * and fixes every PDF's date (ppb_pdf_fix_date). A bad file is handed to bad(rel, why, ctx)
+ * (rel: its path under dir): it returns 0 when the file may be left out (it has then removed
+ * it) and -1 to fail the whole check with its own message in err. */
+typedef int (*ppb_bad_file_fn)(const char *rel, const char *why, void *ctx, ppb_err *err);
+int ppb_dir_verify(const char *dir, ppb_bad_file_fn bad, void *ctx, ppb_err *err);
+
 /* The pid in a temporary's name ("<name>.tmp.<pid>", or ".old.<pid>" when old is set), or 0
  * when name is no such temporary. */
 long ppb_temp_pid(const char *name, int old);

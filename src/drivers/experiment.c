@@ -192,7 +192,9 @@ static int write_timings(const ppb_experiment *ex, const char *dir, ppb_err *err
     return ppb_afile_commit(&af, err);
 }
 
-static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *err)
+/* provenance.txt; fig: the figures left out (NULL before they are drawn). */
+static int write_provenance(const ppb_experiment *ex, const char *dir, const ppb_figures *fig,
+                            ppb_err *err)
 {
     char path[PPB_PATH_MAX + 256], when[64];
     out_path(dir, "provenance.txt", path, sizeof path);
@@ -217,6 +219,8 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *
     for (int i = 0; i < ex->nincomplete; i++)
         fprintf(af.f, "%s.incomplete = interrupted before it finished: no rows written\n",
                 ex->incomplete[i]);
+    if (fig) /* before the config: `ppbench score` reads the lines from experiment.name on */
+        fputs(fig->text, af.f);
     ppb_config_write_readable(ex->cfg, af.f);
     return ppb_afile_commit(&af, err);
 }
@@ -308,9 +312,32 @@ int ppb_experiment_claim_out(const char *dir, ppb_err *err)
     return claim_out(dir, &ad, err);
 }
 
-/* Every file of the output set, under dir. */
-static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
+/* A file of the staged set found incomplete (ppb_dir_verify): a figure's is left out, as a
+ * figure that failed; any other fails the write (the previous set stays). */
+static int bad_file(const char *rel, const char *why, void *ctx, ppb_err *err)
 {
+    const ppb_adir *ad = ((void **)ctx)[0];
+    ppb_figures *fig = ((void **)ctx)[1];
+    size_t n = strlen(rel);
+    int figure = (!strncmp(rel, "plots/", 6) || !strncmp(rel, "images/", 7)) && n > 4 &&
+                 (!strcmp(rel + n - 4, ".png") || !strcmp(rel + n - 4, ".pdf"));
+    if (!figure)
+        return ppb_fail(err, "%s", why);
+    char path[PPB_PATH_MAX + 600], name[600];
+    snprintf(path, sizeof path, "%s/%s", ad->tmp, rel);
+    remove(path);
+    snprintf(name, sizeof name, "%.*s", (int)n - 4, rel);
+    ppb_figures_fail(fig, name, why);
+    return 0;
+}
+
+/* Every file of the output set, under ad->tmp: the data first (any failure fails the write),
+ * then the images and figures (one that fails is said, recorded in provenance.txt and left
+ * out; reference: Outputs), then every file is checked complete before the set may be put in
+ * place. */
+static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
+{
+    const char *dir = ad->tmp;
     char path[PPB_PATH_MAX + 256];
     out_path(dir, "radiance.csv", path, sizeof path);
     if (ppb_write_radiance_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
@@ -322,15 +349,28 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     if (ppb_write_angular_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
         return -1;
     if (write_comparisons(ex, dir, err) || write_timings(ex, dir, err) ||
-        ppb_rte2d_write_refinements(&ex->rte2d_study, dir, err) || write_provenance(ex, dir, err) ||
-        write_config_ini(ex, dir, err))
+        ppb_rte2d_write_refinements(&ex->rte2d_study, dir, err) ||
+        write_provenance(ex, dir, NULL, err) || write_config_ini(ex, dir, err))
         return -1;
+    ppb_figures fig = {.who = ex->cfg->name};
     const ppb_result *ref = ppb_experiment_reference(ex);
     const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
+    ppb_err why;
     if (ppb_images_write(dir, &ex->cfg->scene, &meta, ex->res, ex->n,
-                         ref ? (int)(ref - ex->res) : -1, err))
+                         ref ? (int)(ref - ex->res) : -1, &why)) {
+        /* a part of the images would be drawn into figures as if whole: none are kept */
+        out_path(dir, "images", path, sizeof path);
+        ppb_err ignored;
+        ppb_remove_tree(path, &ignored);
+        ppb_figures_fail(&fig, "images", why.msg);
+    }
+    ppb_plots_write(dir, ex->cfg->name, &fig); /* last: the figures read the files above */
+    void *ctx[2] = {(void *)ad, &fig};
+    if (ppb_dir_verify(dir, bad_file, ctx, err))
         return -1;
-    return ppb_plots_write(dir, ex->cfg->name, err); /* last: the figures read the files above */
+    if (fig.nfailed && write_provenance(ex, dir, &fig, err))
+        return -1;
+    return 0;
 }
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
@@ -341,7 +381,7 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
     ppb_adir ad;
     if (claim_out(ex->cfg->out_dir, &ad, err) || ppb_adir_begin(&ad, err))
         return -1;
-    if (write_set(ex, ad.tmp, err)) {
+    if (write_set(ex, &ad, err)) {
         ppb_adir_abort(&ad);
         return -1;
     }

@@ -526,8 +526,9 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_o
     long long missing = assemble(dirs, 1, cfg->out_dir, err);
     if (missing < 0)
         return -1;
-    if (missing == 0 && ppb_sweep_heatmaps(cfg, grid, cfg->out_dir, err))
-        return -1;
+    ppb_figures fig = {.who = cfg->name};
+    if (missing == 0)
+        ppb_sweep_heatmaps(cfg, grid, cfg->out_dir, &fig); /* a figure left out is said there */
     if (!o->quiet && missing)
         fprintf(stderr, "%s: %lld points left to other shards; merge when done\n", cfg->name,
                 missing);

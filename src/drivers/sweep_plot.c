@@ -98,8 +98,9 @@ static void emit_tics(FILE *gp, const char *which, const ppb_axis *a)
     fprintf(gp, ")\n");
 }
 
-/* The heat map script of one method: a row of panels (R, T) per value of the third axis. */
-static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, const cell_row *rows,
+/* The heat map script of one method (its id is ARG3, data to gnuplot): a row of panels (R, T)
+ * per value of the third axis. */
+static void emit_heatmap(FILE *gp, const ppb_grid *grid, const cell_row *rows,
                          int n)
 {
     char xname[64], yname[64], zname[64] = "", rest[512] = "";
@@ -138,9 +139,9 @@ static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, con
     fprintf(gp, "@viridis\nset cbrange [%.6g:%.6g]\nset cblabel 'RMS (%%)' offset 1.5, 0\n", lo,
             hi);
     fprintf(gp,
-            "set multiplot layout %d,2 title '%s: RMS against mc at x = 0 (%%), values in the "
+            "set multiplot layout %d,2 title ARG3.': RMS against mc at x = 0 (%%), values in the "
             "cells%s%s'\n",
-            shown, method, rest, nz > shown ? "; the third key's first values only" : "");
+            shown, rest, nz > shown ? "; the third key's first values only" : "");
     fprintf(gp, "set xrange [-0.5:%d.5]\nset yrange [-0.5:%d.5]\n", grid->axes[0].n - 1,
             grid->axes[1].n - 1);
     emit_tics(gp, "xtics", &grid->axes[0]);
@@ -210,31 +211,30 @@ static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, con
     return 0;
 }
 
-/* Draws one figure as <base>.png and <base>.pdf: method NULL is the 1-D line plot. */
-static int draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, const char *base,
-                const char *method, ppb_err *err)
+/* Draws one figure as <base>.png and <base>.pdf: method NULL is the 1-D line plot. A figure
+ * that cannot be drawn is added to fig and left out (reference: Sweeps). */
+static void draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, const char *base,
+                 const char *method, ppb_figures *fig)
 {
-    char csv[1200];
+    char csv[1200], why[2048];
     snprintf(csv, sizeof csv, "%s/sweep.csv", dir);
     cell_row *rows = NULL;
     int n = 0;
-    if (method && read_rows(grid, csv, method, &rows, &n, err))
-        return -1;
+    ppb_err err;
+    if (method && read_rows(grid, csv, method, &rows, &n, &err)) {
+        ppb_figures_fail(fig, base, err.msg);
+        return;
+    }
     int nz = grid->naxes >= 3 ? grid->axes[2].n : 1;
     int shown = nz <= MAX_ROWS_PANELS ? nz : MAX_ROWS_PANELS;
-    int rc = 0;
-    for (int t = 0; t < 2 && rc == 0; t++) {
+    for (int t = 0; t < 2; t++) {
         char path[1300];
         snprintf(path, sizeof path, "%s/%s.%s", dir, base, t ? "pdf" : "png");
-        ppb_apath ap; /* gnuplot opens the file by name: it writes the temporary */
-        if (ppb_apath_begin(&ap, path, err)) {
-            rc = -1;
-            break;
-        }
-        FILE *gp = popen("gnuplot 2>/dev/null", "w");
+        char *text = NULL;
+        size_t len = 0;
+        FILE *gp = open_memstream(&text, &len);
         if (!gp) {
-            ppb_apath_abort(&ap);
-            rc = ppb_fail(err, "cannot start gnuplot for %s", path);
+            ppb_figures_fail(fig, base, "out of memory");
             break;
         }
         int h = method ? 60 + 330 * shown : 420;
@@ -243,26 +243,31 @@ static int draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, co
                     h / 100.0);
         else
             fprintf(gp, "set terminal pngcairo size 1000,%d font ',10' noenhanced\n", h);
-        fprintf(gp, "set output '%s'\nload '%s/plot_style.gp'\n", ap.tmp, ppb_plots_script_dir());
+        fprintf(gp, "set output ARG1\nload ARG2\n");
+        int rc = 0;
         if (method)
-            emit_heatmap(gp, grid, method, rows, n);
+            emit_heatmap(gp, grid, rows, n);
         else
-            rc = emit_lines(gp, cfg, grid, csv, err);
-        if (pclose(gp) != 0 && rc == 0)
-            rc = ppb_fail(err, "gnuplot failed drawing %s", path);
-        if (rc == 0)
-            rc = ppb_apath_commit(&ap, err);
+            rc = emit_lines(gp, cfg, grid, csv, &err);
+        fclose(gp);
+        if (rc)
+            snprintf(why, sizeof why, "%s", err.msg);
         else
-            ppb_apath_abort(&ap);
+            rc = ppb_gnuplot_figure(path, text, len, method ? method : cfg->name, why, sizeof why);
+        free(text);
+        if (rc) {
+            ppb_figures_fail(fig, base, why);
+            break;
+        }
     }
     free(rows);
-    return rc;
 }
 
-int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir, ppb_err *err)
+void ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir,
+                        ppb_figures *fig)
 {
     if (grid->naxes < 1)
-        return 0;
+        return;
     int has_reference = 0, compared = 0;
     for (int m = 0; m < cfg->nmethods; m++) {
         int ref = ppb_method_find(cfg, cfg->methods[m])->reference == 1;
@@ -272,17 +277,17 @@ int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *
     /* No Monte Carlo: sweep.csv holds no RMS to draw, only totals. The Monte Carlo alone: no
      * method is measured against it, so there is no curve (gnuplot refuses an empty plot). */
     if (!has_reference || compared == 0)
-        return 0;
-    if (grid->naxes == 1)
-        return draw(cfg, grid, dir, "sweep_rms", NULL, err);
+        return;
+    if (grid->naxes == 1) {
+        draw(cfg, grid, dir, "sweep_rms", NULL, fig);
+        return;
+    }
     for (int m = 0; m < cfg->nmethods; m++) {
         const char *id = cfg->methods[m];
         if (ppb_method_find(cfg, id)->reference == 1)
             continue; /* the reference: its RMS against itself is empty */
         char base[128];
         snprintf(base, sizeof base, "heatmap_%s", id);
-        if (draw(cfg, grid, dir, base, id, err))
-            return -1;
+        draw(cfg, grid, dir, base, id, fig);
     }
-    return 0;
 }
