@@ -441,8 +441,8 @@ int ppb_file_complete(const char *path, ppb_err *err)
         bad = "not a regular file";
     else if (st.st_size == 0)
         bad = "0 bytes (a full disk?)";
-    else if (ends_with(path, ".png") && (read_tail(fd, st.st_size, tail, 12) ||
-                                         memcmp(tail, iend, 12)))
+    else if (ends_with(path, ".png") &&
+             (read_tail(fd, st.st_size, tail, 12) || memcmp(tail, iend, 12)))
         bad = "a PNG cut short (no IEND chunk at its end; a full disk?)";
     else if (ends_with(path, ".pdf")) {
         size_t n = st.st_size < 64 ? (size_t)st.st_size : 64;
@@ -489,8 +489,7 @@ int ppb_pdf_fix_date(const char *path, ppb_err *err)
 }
 
 /* ppb_dir_verify below dir/rel (rel "" at the top). */
-static int verify_at(const char *dir, const char *rel, ppb_bad_file_fn bad, void *ctx,
-                     ppb_err *err)
+static int verify_at(const char *dir, const char *rel, ppb_bad_file_fn bad, void *ctx, ppb_err *err)
 {
     char path[PPB_PATH_MAX + 512];
     snprintf(path, sizeof path, "%s%s%s", dir, rel[0] ? "/" : "", rel);

@@ -100,8 +100,7 @@ static void emit_tics(FILE *gp, const char *which, const ppb_axis *a)
 
 /* The heat map script of one method (its id is ARG3, data to gnuplot): a row of panels (R, T)
  * per value of the third axis. */
-static void emit_heatmap(FILE *gp, const ppb_grid *grid, const cell_row *rows,
-                         int n)
+static void emit_heatmap(FILE *gp, const ppb_grid *grid, const cell_row *rows, int n)
 {
     char xname[64], yname[64], zname[64] = "", rest[512] = "";
     ppb_config_key_name(grid->axes[0].key, xname, sizeof xname);

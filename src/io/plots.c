@@ -245,8 +245,8 @@ void ppb_plots_write(const char *dir, const char *name, ppb_figures *fig)
     int out[2];
     if (access(script, R_OK) != 0 || pipe(out) < 0) {
         char why[4200];
-        snprintf(why, sizeof why, "cannot read %s (the plot script; PPBENCH_SCRIPTS names its folder)",
-                 script);
+        snprintf(why, sizeof why,
+                 "cannot read %s (the plot script; PPBENCH_SCRIPTS names its folder)", script);
         ppb_figures_fail(fig, "plots", why);
         return;
     }
