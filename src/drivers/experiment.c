@@ -2,6 +2,10 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -172,7 +176,8 @@ static const char *skip_for(const ppb_result *ref)
 }
 
 /* The first line of provenance.txt: what marks a directory as a ppbench output set. */
-static const char provenance_mark[] = "# ppbench provenance";
+const char ppb_provenance_mark[] = "# ppbench provenance";
+#define provenance_mark ppb_provenance_mark
 
 static void out_path(const char *dir, const char *file, char *buf, size_t n)
 {
@@ -267,8 +272,9 @@ static int write_comparisons(const ppb_experiment *ex, const char *dir, ppb_err 
 }
 
 /* Whether the existing directory ad->path may be replaced: it is empty (but for temporaries,
- * which ppb_adir_clean sorts out) or its provenance.txt says ppbench wrote it. */
-static int check_owned(const ppb_adir *ad, const char *dir, ppb_err *err)
+ * which ppb_adir_clean sorts out) or its provenance.txt starts with mark (the kind of set
+ * this command writes). */
+static int check_owned(const ppb_adir *ad, const char *dir, const char *mark, ppb_err *err)
 {
     DIR *d = opendir(ad->path);
     if (!d)
@@ -289,21 +295,83 @@ static int check_owned(const ppb_adir *ad, const char *dir, ppb_err *err)
             line[0] = '\0';
         fclose(f);
     }
-    if (!strncmp(line, provenance_mark, sizeof provenance_mark - 1))
+    if (!strncmp(line, mark, strlen(mark)) && line[strlen(mark)] == ':')
         return 0;
     return ppb_fail(err,
-                    "%s: holds files ppbench did not write (%s; no ppbench provenance.txt): a run "
-                    "replaces its whole output directory, so it will not take this one; give "
-                    "an empty or new directory",
-                    dir, other);
+                    "%s: holds files this command did not write (%s; no provenance.txt starting "
+                    "\"%s:\"): it replaces its whole output directory, so it will not take this "
+                    "one; give an empty or new directory",
+                    dir, other, mark);
+}
+
+/* The output directories this process holds the lock of (claim_out: at most one a config). */
+static char locked[64][PPB_PATH_MAX];
+static int nlocked;
+
+/* An exclusive lock on <path>.lock beside the directory, held until the process exits: a
+ * second process claiming the same directory is refused at its start, before any work, instead
+ * of computing and then losing the swap (docs/reference.md: Outputs). */
+static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
+{
+    for (int i = 0; i < nlocked; i++)
+        if (!strcmp(locked[i], ad->path))
+            return 0;
+    char path[PPB_PATH_MAX + 16], parent[PPB_PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s.lock", ad->path);
+    snprintf(parent, sizeof parent, "%s", ad->path);
+    char *slash = strrchr(parent, '/');
+    if (slash && slash != parent) {
+        *slash = '\0';
+        if (ppb_mkdirs(parent, err))
+            return -1;
+    }
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0)
+        return ppb_fail(err, "%s: cannot take its lock %s: %s", dir, path, strerror(errno));
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        int e = errno;
+        close(fd);
+        if (e == EWOULDBLOCK)
+            return ppb_fail(err,
+                            "%s: another ppbench is writing it (it holds %s); wait for it or "
+                            "give another directory",
+                            dir, path);
+        return ppb_fail(err, "%s: cannot lock %s: %s", dir, path, strerror(e));
+    }
+    if (nlocked < 64) /* the descriptor stays open: the lock lasts as long as the process */
+        snprintf(locked[nlocked++], sizeof locked[0], "%s", ad->path);
+    return 0;
+}
+
+/* A symbolic link whose target does not exist: refused, rather than replaced by a directory
+ * (the link silently gone, its target never written). */
+static int check_not_dangling(const char *dir, ppb_err *err)
+{
+    struct stat st;
+    char buf[PPB_PATH_MAX];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (size_t n = strlen(buf); n > 1 && buf[n - 1] == '/'; n--)
+        buf[n - 1] = '\0';
+    if (lstat(buf, &st) == 0 && S_ISLNK(st.st_mode) && stat(buf, &st) != 0)
+        return ppb_fail(err,
+                        "%s: a symbolic link to nothing (%s): give the directory it should "
+                        "name, or remove the link",
+                        dir, strerror(errno));
+    return 0;
+}
+
+int ppb_out_claim(const char *dir, const char *mark, ppb_adir *ad, ppb_err *err)
+{
+    if (check_not_dangling(dir, err) || ppb_adir_name(ad, dir, err) ||
+        check_owned(ad, dir, mark, err) || lock_out(ad, dir, err))
+        return -1;
+    return ppb_adir_clean(ad, err);
 }
 
 /* The output directory named and claimed: see experiment.h. */
 static int claim_out(const char *dir, ppb_adir *ad, ppb_err *err)
 {
-    if (ppb_adir_name(ad, dir, err) || check_owned(ad, dir, err))
-        return -1;
-    return ppb_adir_clean(ad, err);
+    return ppb_out_claim(dir, provenance_mark, ad, err);
 }
 
 int ppb_experiment_claim_out(const char *dir, ppb_err *err)
