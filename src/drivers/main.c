@@ -487,12 +487,17 @@ static int cmd_run(const cli *c)
         ppb_ctx_close(&ctx);
         if (rc) {
             fprintf(stderr, "ppbench: %s: %s\n", cfg->path, err.msg);
-            code = EXIT_RUN;
+            code = ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_RUN;
         } else {
-            /* Said under --quiet too (issue 16): where the results went is its one line. */
-            fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
-                    partial ? " (partial: interrupted)" : "");
-            if (partial)
+            /* A signal while writing (after the last check) exits 130 as one earlier does,
+             * though the set is whole (docs/reference.md: Exit codes). */
+            int late = !partial && ppb_interrupted();
+            if (!c->quiet)
+                fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
+                        partial ? " (partial: interrupted)"
+                        : late  ? " (interrupted while writing: the set is whole)"
+                                : "");
+            if (partial || late)
                 code = EXIT_INTERRUPTED;
         }
     }
@@ -630,9 +635,13 @@ static int mc_shard_or_merge(const cli *c, int merge)
                    : ppb_mc_shard_run(&cfg, c->device, c->quiet, c->shard_i, c->shard_n, &err);
     if (rc) {
         fprintf(stderr, "ppbench: %s: %s\n", cfg.path, err.msg);
-        return ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_RUN;
+        return ppb_interrupted()               ? EXIT_INTERRUPTED
+               : rc == PPB_MC_MERGE_BAD_SHARDS ? EXIT_USAGE
+                                               : EXIT_RUN;
     }
-    return EXIT_OK;
+    /* A signal after the last check (while writing): the outputs are whole, but the command
+     * was stopped, as an interrupt earlier says (docs/reference.md: Exit codes). */
+    return ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_OK;
 }
 
 static int cmd_mc_shard(const cli *c)
@@ -753,8 +762,7 @@ static const command commands[] = {
      "score a radiance.csv against the finished experiment\n--ref DIR: its summary, rms and "
      "totals rows into --out\n(default DIR-score, -score-2, ...; DIR is never written)",
      "ppbench score --ref results/uniform_g0_normal mine/radiance.csv",
-     OPT_REF | OPT_OUT | OPT_QUIET, 1,
-     cmd_score},
+     OPT_REF | OPT_OUT | OPT_QUIET, 1, cmd_score},
     {"slurm", "CONFIG", OPT_SHARDS | OPT_OUT,
      "write a Slurm job array into --out DIR (job.sh: shard I\nof a sweep, or of one config's "
      "Monte Carlo; merge.sh:\nits merge into DIR/result) and print the sbatch lines;\n--submit "
