@@ -64,6 +64,13 @@ static int write_errno(FILE *f)
 
 int ppb_afile_commit(ppb_afile *af, ppb_err *err)
 {
+    if (ppb_afile_close(af, err))
+        return -1;
+    return ppb_apath_commit(&af->name, err);
+}
+
+int ppb_afile_close(ppb_afile *af, ppb_err *err)
+{
     int bad = ferror(af->f) != 0, e = bad ? write_errno(af->f) : 0;
     errno = 0;
     if (!bad && fflush(af->f) != 0)
@@ -76,7 +83,24 @@ int ppb_afile_commit(ppb_afile *af, ppb_err *err)
         return ppb_fail(err, "%s: write failed: %s", af->name.path,
                         e ? strerror(e) : "an earlier write failed (the cause has passed)");
     }
-    return ppb_apath_commit(&af->name, err);
+    return 0;
+}
+
+int ppb_apaths_commit(ppb_apath *const *aps, int n, ppb_err *err)
+{
+    sigset_t hold, old;
+    sigemptyset(&hold);
+    sigaddset(&hold, SIGINT);
+    sigaddset(&hold, SIGTERM);
+    sigprocmask(SIG_BLOCK, &hold, &old);
+    int rc = 0;
+    for (int i = 0; i < n; i++)
+        if (rc)
+            ppb_apath_abort(aps[i]);
+        else
+            rc = ppb_apath_commit(aps[i], err);
+    sigprocmask(SIG_SETMASK, &old, NULL); /* a signal held off arrives now */
+    return rc;
 }
 
 void ppb_afile_abort(ppb_afile *af)

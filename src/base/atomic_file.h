@@ -39,6 +39,14 @@ int ppb_afile_open(ppb_afile *af, const char *path, ppb_err *err);
 /* Flushes, checks for write errors, renames; on any failure removes the temporary. */
 int ppb_afile_commit(ppb_afile *af, ppb_err *err);
 void ppb_afile_abort(ppb_afile *af);
+/* The first half of ppb_afile_commit: flushes, checks for write errors and closes, leaving the
+ * complete temporary af->name.tmp for ppb_apath_commit (several files put in place together:
+ * ppb_apaths_commit); on failure removes it. */
+int ppb_afile_close(ppb_afile *af, ppb_err *err);
+/* Renames n closed temporaries into place with SIGINT and SIGTERM held off meanwhile, so an
+ * interrupt never leaves some files new and the others old; on a failure the rest are
+ * removed. */
+int ppb_apaths_commit(ppb_apath *const *aps, int n, ppb_err *err);
 
 /* mkdir -p. */
 int ppb_mkdirs(const char *dir, ppb_err *err);

@@ -298,9 +298,9 @@ static int check_owned(const ppb_adir *ad, const char *dir, const char *mark, pp
     if (!strncmp(line, mark, strlen(mark)) && line[strlen(mark)] == ':')
         return 0;
     return ppb_fail(err,
-                    "%s: holds files this command did not write (%s; no provenance.txt starting "
-                    "\"%s:\"): it replaces its whole output directory, so it will not take this "
-                    "one; give an empty or new directory",
+                    "%s: holds files ppbench did not write as this command's output (%s; no "
+                    "provenance.txt starting \"%s:\"): it replaces its whole output directory, "
+                    "so it will not take this one; give an empty or new directory",
                     dir, other, mark);
 }
 
@@ -308,7 +308,8 @@ static int check_owned(const ppb_adir *ad, const char *dir, const char *mark, pp
 static char locked[64][PPB_PATH_MAX];
 static int nlocked;
 
-/* An exclusive lock on <path>.lock beside the directory, held until the process exits: a
+/* An exclusive lock on .<name>.lock beside the directory (hidden: a listing of the parent shows
+ * the output directories alone), held until the process exits: a
  * second process claiming the same directory is refused at its start, before any work, instead
  * of computing and then losing the swap (docs/reference.md: Outputs). */
 static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
@@ -317,14 +318,16 @@ static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
         if (!strcmp(locked[i], ad->path))
             return 0;
     char path[PPB_PATH_MAX + 16], parent[PPB_PATH_MAX + 16];
-    snprintf(path, sizeof path, "%s.lock", ad->path);
     snprintf(parent, sizeof parent, "%s", ad->path);
     char *slash = strrchr(parent, '/');
-    if (slash && slash != parent) {
+    const char *base = slash ? slash + 1 : parent;
+    if (slash)
         *slash = '\0';
-        if (ppb_mkdirs(parent, err))
-            return -1;
-    }
+    if ((size_t)snprintf(path, sizeof path, "%s/.%s.lock",
+                         slash ? (slash == parent ? "" : parent) : ".", base) >= sizeof path)
+        return ppb_fail(err, "%s: path too long", dir);
+    if (slash && slash != parent && ppb_mkdirs(parent, err))
+        return -1;
     int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
     if (fd < 0)
         return ppb_fail(err, "%s: cannot take its lock %s: %s", dir, path, strerror(errno));
@@ -420,7 +423,7 @@ static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
         ppb_rte2d_write_refinements(&ex->rte2d_study, dir, err) ||
         write_provenance(ex, dir, NULL, err) || write_config_ini(ex, dir, err))
         return -1;
-    ppb_figures fig = {.who = ex->cfg->name};
+    ppb_figures fig = {.who = ex->cfg->name, .staged = ad->tmp, .final = ad->path};
     const ppb_result *ref = ppb_experiment_reference(ex);
     const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
     ppb_err why;

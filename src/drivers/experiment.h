@@ -54,7 +54,7 @@ int ppb_experiment_claim_out(const char *dir, ppb_err *err);
 extern const char ppb_provenance_mark[];
 /* The claim of any command that writes a whole output set (run, mc-merge, score): dir must be
  * new, empty, or hold a set whose provenance.txt starts with "<mark>:"; never a dangling
- * symbolic link; and no other live process may hold it (an exclusive flock on <dir>.lock
+ * symbolic link; and no other live process may hold it (an exclusive flock on .<name>.lock
  * beside it, kept until this process exits). Names its staging in ad and cleans dead
  * processes' leftovers. Fails, having touched nothing but the lock file. */
 int ppb_out_claim(const char *dir, const char *mark, ppb_adir *ad, ppb_err *err);

@@ -727,7 +727,7 @@ static int cmd_report(const cli *c)
     int rc = ppb_report_write(c->args[0], c->args + 1, c->nargs - 1, &err);
     if (rc) {
         fprintf(stderr, "ppbench report: %s\n", err.msg);
-        return rc == PPB_REPORT_REFUSED ? EXIT_USAGE : EXIT_RUN;
+        return rc == PPB_REPORT_REFUSED || rc == PPB_REPORT_BAD_INPUT ? EXIT_USAGE : EXIT_RUN;
     }
     return EXIT_OK;
 }

@@ -24,8 +24,19 @@ const char *ppb_plots_script_dir(void)
 
 void ppb_figures_fail(ppb_figures *f, const char *figure, const char *why)
 {
+    char key[600], said[2048];
+    snprintf(key, sizeof key, "figure.%s = ", figure);
+    if (strstr(f->text, key))
+        return;
+    const char *at = f->staged && f->final ? strstr(why, f->staged) : NULL;
+    if (at)
+        snprintf(said, sizeof said, "%.*s%s%s", (int)(at - why), why, f->final,
+                 at + strlen(f->staged));
+    else
+        snprintf(said, sizeof said, "%s", why);
+    why = said;
     size_t len = strlen(f->text);
-    snprintf(f->text + len, sizeof f->text - len, "figure.%s = not drawn: %.300s\n", figure, why);
+    snprintf(f->text + len, sizeof f->text - len, "%snot drawn: %.300s\n", key, why);
     f->nfailed++;
     fprintf(stderr, "%s: figure %s not drawn (the other outputs are written): %s\n",
             f->who ? f->who : "ppbench", figure, why);

@@ -20,12 +20,16 @@
 /* The figures of one output set left out, for provenance.txt and stderr. */
 typedef struct ppb_figures {
     const char *who; /* the prefix of the stderr lines: the experiment's name */
+    /* A reason naming a file under staged (the staging directory, gone by the time it is
+     * read) names it under final instead; either NULL: as it is. */
+    const char *staged, *final;
     int nfailed;
     char text[4096]; /* provenance lines "figure.<path> = not drawn: <why>\n" */
 } ppb_figures;
 
 /* Records that figure (its path under the output directory, without extension) was not
- * drawn and why, and says so on stderr. */
+ * drawn and why, and says so on stderr; a figure already recorded (its PDF after its PNG) is
+ * not recorded again. */
 void ppb_figures_fail(ppb_figures *f, const char *figure, const char *why);
 
 /* The folder holding plots.sh and plot_style.gp (the style every gnuplot script loads). */
