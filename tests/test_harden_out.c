@@ -211,6 +211,172 @@ static void test_full_disk_never_commits_incomplete_files(void **state)
     tu_sh("umount '%s'", mnt);
 }
 
+/* Two finished runs, A and B, under one scratch directory, made once for the tests below. */
+static const char *finished_runs(void)
+{
+    static char dir[1200];
+    if (dir[0])
+        return dir;
+    snprintf(dir, sizeof dir, "%s", tu_scratch("harden_runs"));
+    char args[4096];
+    for (int i = 0; i < 2; i++) {
+        snprintf(args, sizeof args, "%s --out '%s/%c' configs/density_step.ini", small, dir,
+                 "AB"[i]);
+        cli_expect_env("PPBENCH_CACHE=", args, 0, "");
+    }
+    return dir;
+}
+
+/* score's --out is its own output set (docs/reference.md: Outputs, score): another finished
+ * run, a user's directory or a file is refused with exit 2, untouched; its own earlier set is
+ * replaced whole. Before: B's summary/rms/regions/totals were replaced (exit 0), a user's
+ * directory written into, and a file gave exit 1. */
+static void test_score_claims_only_its_own_set(void **state)
+{
+    (void)state;
+    const char *d = finished_runs();
+    char args[4096];
+    assert_int_equal(tu_sh("cd '%s' && rm -rf saved U F S && cp -r B saved && mkdir U && "
+                           "echo mine > U/notes.txt && touch F",
+                           d),
+                     0);
+    const char *outs[] = {"B", "U", "F"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(args, sizeof args, "score --quiet --ref '%s/A' --out '%s/%s' '%s/A/radiance.csv'",
+                 d, d, outs[i], d);
+        cli_expect(args, 2, "ppbench score: --out ");
+    }
+    assert_int_equal(tu_sh("cd '%s' && diff -r B saved && test \"$(ls U)\" = notes.txt", d), 0);
+    for (int i = 0; i < 2; i++) { /* new, then its own set replaced */
+        snprintf(args, sizeof args, "score --quiet --ref '%s/A' --out '%s/S' '%s/A/radiance.csv'",
+                 d, d, d);
+        cli_expect(args, 0, "");
+        assert_int_equal(tu_sh("cd '%s' && head -1 S/provenance.txt | grep -q '^# ppbench score "
+                               "provenance:' && test -s S/summary.csv && ! ls -d S.* 2>/dev/null",
+                               d),
+                         0);
+    }
+}
+
+/* Bad input is exit 2 everywhere (docs/reference.md: Exit codes): a report naming a case that
+ * is not there (was 1) and an mc-merge given a directory holding no shard (was 1; merge's
+ * equivalent was 2 already). */
+static void test_bad_input_exits_2(void **state)
+{
+    (void)state;
+    const char *d = finished_runs();
+    char args[4096];
+    snprintf(args, sizeof args, "report '%s' A nosuchcase", d);
+    cli_expect(args, 2, "nosuchcase");
+    assert_int_equal(tu_sh("test ! -e '%s/table2.csv'", d), 0);
+    snprintf(args, sizeof args, "mc-merge --out '%s/M' configs/density_step.ini '%s/A'", d, d);
+    cli_expect(args, 2, "mc_tallies.bin");
+}
+
+/* `ppbench scene` without --out writes into the config's [output] dir: there a finished run's
+ * set was (scene.json added into it, exit 0). Now refused, exit 2, the set untouched. */
+static void test_scene_never_writes_into_a_set(void **state)
+{
+    (void)state;
+    const char *d = finished_runs();
+    char args[4096];
+    snprintf(args, sizeof args, "scene --set output.dir='%s/A' configs/density_step.ini", d);
+    cli_expect(args, 2, "give --out DIR");
+    assert_int_equal(tu_sh("test ! -e '%s/A/scene.json'", d), 0);
+}
+
+/* A dangling symbolic link as --out was replaced by a directory, silently (exit 0): now
+ * refused before any work (exit 2), the link kept. */
+static void test_dangling_symlink_refused(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("harden_link");
+    char args[4096];
+    assert_int_equal(tu_sh("ln -s '%s/nowhere' '%s/L'", dir, dir), 0);
+    snprintf(args, sizeof args, "%s --out '%s/L' configs/density_step.ini", small, dir);
+    cli_expect_env("PPBENCH_CACHE=", args, 2, "a symbolic link to nothing");
+    assert_int_equal(tu_sh("test -L '%s/L' && test ! -e '%s/nowhere'", dir, dir), 0);
+}
+
+/* A scripts folder whose plots.sh first runs `pre` (shell text) and then the real script. */
+static void wrap_plots(const char *dir, const char *pre)
+{
+    char text[4096], path[1300];
+    char *here = realpath("scripts", NULL);
+    assert_non_null(here);
+    snprintf(text, sizeof text, "%s\nexec bash '%s/plots.sh' \"$@\"\n", pre, here);
+    free(here);
+    snprintf(path, sizeof path, "%s/scripts", dir);
+    assert_int_equal(tu_sh("mkdir -p '%s' && cp scripts/plot_style.gp '%s/'", path, path), 0);
+    snprintf(path, sizeof path, "%s/scripts/plots.sh", dir);
+    tu_write_file(path, text);
+}
+
+/* Two runs on one --out: both computed and the loser failed at its end. Now the second is
+ * refused at its start (exit 2), naming the lock, while the first holds it (here: kept in its
+ * plotting by a plots.sh that waits), and the first still succeeds. */
+static void test_second_run_on_one_out_refused(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("harden_lock");
+    char pre[1400], env[2400], args[4096];
+    snprintf(pre, sizeof pre, "touch '%s/plotting'; sleep 4", dir);
+    wrap_plots(dir, pre);
+    snprintf(env, sizeof env, "PPBENCH_CACHE= PPBENCH_SCRIPTS='%s/scripts'", dir);
+    assert_int_equal(tu_sh("(%s %s %s --out '%s/o' configs/density_step.ini > '%s/first.log' "
+                           "2>&1; echo $? > '%s/first.rc') &",
+                           env, tu_bin(), small, dir, dir, dir),
+                     0);
+    assert_int_equal(tu_sh("for i in $(seq 600); do test -e '%s/plotting' && exit 0; "
+                           "sleep 0.1; done; exit 1",
+                           dir),
+                     0);
+    snprintf(args, sizeof args, "%s --out '%s/o' configs/density_step.ini", small, dir);
+    cli_expect_env("PPBENCH_CACHE=", args, 2, "another ppbench is writing it");
+    assert_int_equal(tu_sh("for i in $(seq 600); do test -s '%s/first.rc' && exit 0; "
+                           "sleep 0.1; done; exit 1",
+                           dir),
+                     0);
+    assert_int_equal(tu_sh("test \"$(cat '%s/first.rc')\" = 0 && test -s '%s/o/rms.csv'", dir, dir),
+                     0);
+}
+
+/* SIGTERM while the set is being written (here: sent by plots.sh to ppbench, its parent)
+ * exited 0 though the command was stopped; an interrupt earlier exits 130 (docs/reference.md:
+ * Exit codes). Now 130 too; the set is whole. */
+static void test_sigterm_while_writing_exits_130(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("harden_term");
+    char env[2400], args[4096], path[1400];
+    wrap_plots(dir, "kill -TERM $PPID");
+    snprintf(env, sizeof env, "PPBENCH_CACHE= PPBENCH_SCRIPTS='%s/scripts'", dir);
+    snprintf(args, sizeof args, "%s --out '%s/o' configs/density_step.ini", small, dir);
+    cli_expect_env(env, args, 130, "");
+    snprintf(path, sizeof path, "%s/o/rms.csv", dir);
+    assert_true(file_ok(path));
+}
+
+/* The same run twice gives the same PDFs: cairo wrote the wall-clock /CreationDate into each,
+ * so two runs a second apart differed. Now the date is fixed (docs/reference.md: Outputs). */
+static void test_same_run_same_pdfs(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("harden_pdf");
+    char args[4096];
+    for (int i = 0; i < 2; i++) {
+        if (i)
+            sleep(1); /* cairo's date has whole seconds */
+        snprintf(args, sizeof args, "%s --out '%s/r%d' configs/density_step.ini", small, dir, i);
+        cli_expect_env("PPBENCH_CACHE=", args, 0, "");
+    }
+    assert_int_equal(tu_sh("cd '%s' && n=0 && for f in $(cd r0 && find . -name '*.pdf'); do "
+                           "cmp r0/$f r1/$f >&2 || exit 1; n=$((n + 1)); done; test $n -ge 6",
+                           /* rms_vs_x, angular_x0(_polar), all, error_pp, error_mc1 */
+                           dir),
+                     0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -220,6 +386,13 @@ int main(void)
         cmocka_unit_test(test_failed_figures_keep_the_run),
         cmocka_unit_test(test_albedo_zero_run_written),
         cmocka_unit_test(test_full_disk_never_commits_incomplete_files),
+        cmocka_unit_test(test_score_claims_only_its_own_set),
+        cmocka_unit_test(test_bad_input_exits_2),
+        cmocka_unit_test(test_scene_never_writes_into_a_set),
+        cmocka_unit_test(test_dangling_symlink_refused),
+        cmocka_unit_test(test_second_run_on_one_out_refused),
+        cmocka_unit_test(test_sigterm_while_writing_exits_130),
+        cmocka_unit_test(test_same_run_same_pdfs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,6 +2,7 @@
  * work (options, the device, every config, the output directories), dispatches to the
  * experiment runner, the sweep driver, the device list and the benchmarks, and maps failures to
  * the documented exit codes. Everything else lives in its module. */
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdio.h>
@@ -686,6 +687,29 @@ static int cmd_slurm(const cli *c)
     return EXIT_OK;
 }
 
+/* Whether scene may write DIR/scene.json: DIR is new, or holds nothing but scene.json (and
+ * temporaries). Without --out DIR is the config's [output] dir, where `run` puts its output
+ * set: a file added there would sit in a set it does not belong to, and go with the next run. */
+static int check_scene_dir(const char *dir, ppb_err *err)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0; /* new (mkdir -p makes it); another failure shows when it is written */
+    char other[256] = "";
+    struct dirent *de;
+    while (!other[0] && (de = readdir(d)))
+        if (strcmp(de->d_name, ".") && strcmp(de->d_name, "..") &&
+            strcmp(de->d_name, "scene.json") && !ppb_temp_pid(de->d_name, 0))
+            snprintf(other, sizeof other, "%s", de->d_name);
+    closedir(d);
+    if (!other[0])
+        return 0;
+    return ppb_fail(err,
+                    "%s: holds other files (%s; a run's output set?): scene writes scene.json "
+                    "only into a new directory or one holding nothing else; give --out DIR",
+                    dir, other);
+}
+
 /* `ppbench scene CONFIG --out DIR`: DIR/scene.json, what an external method reads
  * (io/scene_json.h; docs/external.md). */
 static int cmd_scene(const cli *c)
@@ -701,6 +725,8 @@ static int cmd_scene(const cli *c)
     int code = check_config_out(c, &cfg);
     if (code)
         return code;
+    if (check_scene_dir(cfg.out_dir, &err))
+        return usage_error(&err);
     char path[PPB_PATH_MAX + 16];
     snprintf(path, sizeof path, "%s/scene.json", cfg.out_dir);
     if (ppb_mkdirs(cfg.out_dir, &err) || ppb_scene_json_write(&cfg, path, &err)) {
