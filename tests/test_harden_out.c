@@ -242,8 +242,8 @@ static void test_score_claims_only_its_own_set(void **state)
                      0);
     const char *outs[] = {"B", "U", "F"};
     for (int i = 0; i < 3; i++) {
-        snprintf(args, sizeof args, "score --quiet --ref '%s/A' --out '%s/%s' '%s/A/radiance.csv'",
-                 d, d, outs[i], d);
+        snprintf(args, sizeof args, "score --ref '%s/A' --out '%s/%s' '%s/A/radiance.csv'", d, d,
+                 outs[i], d);
         cli_expect(args, 2, "ppbench score: --out ");
     }
     assert_int_equal(tu_sh("cd '%s' && diff -r B saved && test \"$(ls U)\" = notes.txt", d), 0);
