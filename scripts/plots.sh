@@ -11,8 +11,8 @@
 # it in provenance.txt and on stderr; reference: Outputs). Paths and names reach gnuplot only as
 # data, its ARG variables (set in render: OUT, NAME, TMP, DIR), never as script text.
 #   plots/rms_vs_x.{png,pdf}     (tube) RMS against the Monte Carlo per sample point of S1, S2,
-#                                S3, S4, every method, with the Monte Carlo's noise floor; S1, S2 on
-#                                one y range, S3 and S4 on one; dashed lines at step_x and at
+#                                S3, S4, every method, with the Monte Carlo's noise floor; the four
+#                                panels on one y range (compared at a glance); dashed lines at step_x and at
 #                                step_x +- 2 mfp (paper Fig. 8; the claim is about that band)
 #   plots/angular_x0.{png,pdf}   in-plane exit radiance at x = 0 on S1 and S2 against the signed
 #                                theta-bin centre (phi bin 0: +, along t; the last phi bin: -),
@@ -95,17 +95,17 @@ if has_rows "$dir/rms.csv" && [ "$(prov experiment.geometry)" != slab ]; then
         > "$tmp/rms_${m//+/_}_$s.dat"
     done
   done
-  # y ranges (%, log): S1 and S2 together, S3 and S4 together, over every curve and the floor
-  yr() { awk -F, -v a="$1" -v b="$2" 'NR > 1 && ($2 == a || $2 == b) {
-           for (i = 5; i <= 6; i++) if ($i > 0) { v = 100 * $i; if (!n++ || v < lo) lo = v;
+  # the y range (%, log) of all four panels, over every curve and the floor: panels on different
+  # ranges read alike while their errors differ tenfold
+  yr() { awk -F, 'NR > 1 && $2 ~ /^S[1-4]$/ {
+           for (i = 5; i <= 6; i++) if ($i ~ /^[-+]?[0-9.]+([eE][-+]?[0-9]+)?$/ && $i > 0) { v = 100 * $i; if (!n++ || v < lo) lo = v;
                                                   if (v > hi) hi = v } }
            END {if (!n) {lo = 0.1; hi = 100}
                 a = log(lo) / log(10); f = int(a); if (f > a) f--
                 b = log(hi) / log(10); c = int(b); if (c < b) c++
                 printf "[%g:%g]", 10 ^ f, 10 ^ c}' \
            "$dir/rms.csv"; }
-  yr12=$(yr S1 S2)
-  yr34=$(yr S3 S4)
+  yr_all=$(yr)
   {
     echo "set multiplot title NAME.': RMS error against Monte Carlo per sample point'"
     echo "set logscale y; set grid; set ylabel 'RMS (%)'"
@@ -125,10 +125,10 @@ if has_rows "$dir/rms.csv" && [ "$(prov experiment.geometry)" != slab ]; then
     i=0
     for s in "${surfs[@]}"; do
       case $s in
-        S1) t='S1 (top, reflectance)'; xl='x (mfp)'; r=$yr12 ;;
-        S2) t='S2 (bottom, transmittance)'; xl='x (mfp)'; r=$yr12 ;;
-        S3) t='S3 (left side)'; xl='y (mfp; S1 at 0)'; r=$yr34 ;;
-        S4) t='S4 (right side)'; xl='y (mfp; S1 at 0)'; r=$yr34 ;;
+        S1) t='S1 (top, reflectance)'; xl='x (mfp)'; r=$yr_all ;;
+        S2) t='S2 (bottom, transmittance)'; xl='x (mfp)'; r=$yr_all ;;
+        S3) t='S3 (left side)'; xl='y (mfp; S1 at 0)'; r=$yr_all ;;
+        S4) t='S4 (right side)'; xl='y (mfp; S1 at 0)'; r=$yr_all ;;
       esac
       col=$((i % 2)); row=$((i / 2))
       echo "set lmargin at screen $(awk -v c=$col 'BEGIN {print 0.07 + c * 0.41}')"

@@ -85,6 +85,15 @@ static void test_run_draws_every_figure(void **state)
     assert_int_equal(sscanf(strstr(a, "set yrange"), "set yrange %63s", ra), 1);
     assert_int_equal(sscanf(strstr(b, "set yrange"), "set yrange %63s", rb), 1);
     assert_string_equal(ra, rb);
+    /* ... and S3, S4 the same one: all four panels compared at a glance (S3 and S4 had their
+     * own range, so a tenfold larger error looked alike) */
+    char *c3 = strstr(gp, "S3 (left"), *c4 = strstr(gp, "S4 (right"), r3[64] = "", r4[64] = "";
+    assert_non_null(c3);
+    assert_non_null(c4);
+    assert_int_equal(sscanf(strstr(c3, "set yrange"), "set yrange %63s", r3), 1);
+    assert_int_equal(sscanf(strstr(c4, "set yrange"), "set yrange %63s", r4), 1);
+    assert_string_equal(ra, r3);
+    assert_string_equal(ra, r4);
 
     snprintf(path, sizeof path, "%s/angular_x0.gp", keep);
     gp = tu_read_text(path);
@@ -158,8 +167,23 @@ static void test_sweep_plots(void **state)
     snprintf(out, sizeof out, "%s/s3", dir);
     write_sweep(ini, "[medium]\ng = 0, 0.5\nalbedo = 0.5, 0.9\n[light]\ntheta_deg = 0, 30, 60\n",
                 out);
-    assert_int_equal(tu_sh("%s sweep --quiet '%s' > /dev/null 2>&1", tu_bin(), ini), 0);
+    assert_int_equal(
+        tu_sh("PPB_PLOTS_KEEP='%s' %s sweep --quiet '%s' > /dev/null 2>&1", dir, tu_bin(), ini), 0);
     assert_true(exists(out, "heatmap_ss.png"));
+    /* sweep.csv gains the noise floor and the RMS beyond it of every cell (model/metrics.h:
+     * noise_rel, rms_excess); the heat map is coloured by the excess, and a cell within the
+     * noise is grey and says so (an RMS alone read as the method's error where it was the
+     * reference's noise) */
+    snprintf(path, sizeof path, "%s/sweep.csv", out);
+    char *csv = tu_read_text(path);
+    assert_has(csv, ",noise_R_x0,noise_T_x0,noise_S1_all,noise_S2_all,noise_S3_all,noise_S4_all,"
+                    "excess_R_x0,excess_T_x0,excess_S1_all,");
+    snprintf(path, sizeof path, "%s/heatmap_ss.png.gp", dir);
+    char *hm = tu_read_text(path);
+    assert_has(hm, "RMS beyond the MC noise (%)");
+    assert_has(hm, "with boxxyerror fs solid noborder fc rgb '#BBBBBB'");
+    assert_has(hm, "'noise'");
+    assert_has(hm, "set output ARG1"); /* the path is data, not script text */
     assert_true(exists(out, "heatmap_ss.pdf"));
     assert_false(exists(out, "heatmap_mc.png"));
     snprintf(path, sizeof path, "%s/heatmap_ss.png", out);
@@ -170,8 +194,16 @@ static void test_sweep_plots(void **state)
     snprintf(ini, sizeof ini, "%s/s1.ini", dir);
     snprintf(out, sizeof out, "%s/s1", dir);
     write_sweep(ini, "[medium]\ng = 0, 0.5, 0.8\n", out);
-    assert_int_equal(tu_sh("%s sweep --quiet '%s' > /dev/null 2>&1", tu_bin(), ini), 0);
+    assert_int_equal(
+        tu_sh("PPB_PLOTS_KEEP='%s' %s sweep --quiet '%s' > /dev/null 2>&1", dir, tu_bin(), ini), 0);
     assert_true(exists(out, "sweep_rms.png"));
+    /* the excess with the noise floor dashed; padded so the first and last values' markers
+     * are not drawn on the frame (a sweep of two values had both there) */
+    snprintf(path, sizeof path, "%s/sweep_rms.png.gp", dir);
+    char *lp = tu_read_text(path);
+    assert_has(lp, "set offsets graph 0.06, graph 0.06");
+    assert_has(lp, "title 'MC noise floor'");
+    assert_has(lp, "RMS beyond the MC noise (%)");
     assert_true(exists(out, "sweep_rms.pdf"));
     assert_false(exists(out, "heatmap_ss.png"));
 }

@@ -129,6 +129,22 @@ int ppb_gnuplot_run(const char *script, size_t len, const char *const *args, int
     return rc;
 }
 
+/* PPB_PLOTS_KEEP=DIR keeps each figure's script as DIR/<file name>.gp, as plots.sh keeps its
+ * bodies (the tests read them). */
+static void keep_script(const char *path, const char *script, size_t len)
+{
+    const char *keep = getenv("PPB_PLOTS_KEEP"), *base = strrchr(path, '/');
+    if (!keep || !*keep)
+        return;
+    char kept[4200];
+    snprintf(kept, sizeof kept, "%s/%s.gp", keep, base ? base + 1 : path);
+    FILE *f = fopen(kept, "w");
+    if (f) {
+        fwrite(script, 1, len, f);
+        fclose(f);
+    }
+}
+
 int ppb_gnuplot_figure(const char *path, const char *script, size_t len, const char *name,
                        char *why, size_t cap)
 {
@@ -137,6 +153,7 @@ int ppb_gnuplot_figure(const char *path, const char *script, size_t len, const c
     char style[4200];
     snprintf(style, sizeof style, "%s/plot_style.gp", ppb_plots_script_dir());
     const char *args[3] = {ap.tmp, style, name ? name : ""};
+    keep_script(path, script, len);
     if (ppb_apath_begin(&ap, path, &err)) {
         snprintf(why, cap, "%s", err.msg);
         return -1;
