@@ -104,6 +104,11 @@ static void test_run_draws_every_figure(void **state)
         snprintf(t, sizeof t, "set title '%s' font", ids[i]);
         assert_has(gp, t);
     }
+    /* a colour bar of the pictures' grey levels: images.c's tone curve (shoulder above 0.75,
+     * sRGB-encoded) over radiance / L_white (all.png had none: a grey read as nothing) */
+    assert_has(gp, "set palette functions enc(sh(2 * gray))");
+    assert_has(gp, "set colorbox horizontal");
+    assert_has(gp, "set cblabel 'radiance / L_white");
     snprintf(path, sizeof path, "%s/error_pp.gp", keep);
     gp = tu_read_text(path);
     assert_has(gp, "pp vs mc");
