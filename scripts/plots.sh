@@ -266,6 +266,10 @@ if [ -d "$img" ] && has_rows "$dir/angular.csv"; then
       echo "set colorbox vertical user origin screen 0.74, screen 0.12 size screen 0.04, screen 0.62"
       echo "set lmargin at screen 0.04; set rmargin at screen 0.70; set tmargin at screen 0.82; set bmargin at screen 0.02"
       echo "set cblabel 'relative error, clamped at +-50%' offset 1.5, 0"
+      # the map alone: errmap's strip at the right carries its own bar (src/io/images.c), drawn
+      # here by gnuplot instead; the map is the size of $m.png (its IHDR: width, height)
+      read -r wm hm < <(od -An -tu1 -j16 -N8 "$img/$m.png" | awk '{print $1 * 16777216 + $2 * 65536 + $3 * 256 + $4, $5 * 16777216 + $6 * 65536 + $7 * 256 + $8}')
+      echo "set xrange [-0.5:$wm - 0.5]; set yrange [-0.5:$hm - 0.5]"
       echo "plot DIR.'/images/errmap_$m.png' binary filetype=png with rgbimage, '+' using (NaN):(NaN):(0) with points lc palette"
     } > "$tmp/body.gp"
     render "$img/error_$m" 560 640
