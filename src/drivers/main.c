@@ -477,7 +477,7 @@ static int cmd_run(const cli *c)
         const ppb_config *cfg = &cfgs[i];
         ppb_experiment ex = {0};
         ppb_run_ctx ctx = {.device_selector = c->device,
-                           .quiet = c->quiet,
+                           .quiet = c->quiet ? 2 : 0, /* 2: silent (method.h) */
                            .ref_cache = cache,
                            .rte2d_study = &ex.rte2d_study};
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);

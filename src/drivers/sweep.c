@@ -384,7 +384,7 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t
     ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
     /* Points that share a medium share the marcher's tables: built once per process. */
     ppb_run_ctx ctx = {.device_selector = o->device,
-                       .quiet = 1,
+                       .quiet = o->quiet ? 2 : 1, /* a point's progress: never */
                        .march_cache = ppb_march_cache_new(),
                        .ref_cache = o->ref_cache};
     long long done = 0;

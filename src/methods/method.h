@@ -23,7 +23,7 @@ typedef struct ppb_run_ctx {
     const char *device_selector; /* --device, or NULL */
     ppb_ocl ocl;
     int ocl_open;
-    int quiet;                           /* no progress lines */
+    int quiet; /* 1: no progress lines; 2 (--quiet): nor the reference cache's line */
     struct ppb_march_cache *march_cache; /* owned by the caller; NULL = build afresh */
     /* The experiment's results so far, set by the runner before each method (NULL, 0: none).
      * A method that combines others' results (mp+ss) takes them from here when they ran,

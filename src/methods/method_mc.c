@@ -461,7 +461,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     int status = 0;
     if (ctx->ref_cache && ppb_mc_cache_get(ctx, &t)) {
         /* The same reference was traced before (docs/external.md): no photon is traced now. */
-        if (!ctx->quiet)
+        if (ctx->quiet < 2)
             fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n",
                     cfg->name, (unsigned long long)t.count, ctx->ref_cache);
     } else {
