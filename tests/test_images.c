@@ -497,11 +497,23 @@ static void test_error_image(void **state)
     int w, h, ew, eh;
     float *exr = read_exr(f, "pp.exr", &w, &h);
     unsigned char *e = read_png(f, "errmap_pp.png", &ew, &eh);
-    assert_int_equal(ew, w);
-    assert_int_equal(eh, h); /* bare: plots.sh adds the numbered colour bar */
-    for (long k = 0; k < (long)w * h; k++)
+    /* the map, then a 64-pixel strip at its right with the colour bar (images.c: BAR_STRIP),
+     * which the bare map lacked: +50% (warm, 180 4 38) at row 40, 0 (neutral, 221) at the
+     * middle, -50% (cool, 59 76 192) at row h - 40, in the bar's columns (the map's width + 6
+     * on); the colours are the map's own stops (images.c, Moreland's cool-warm) */
+    assert_int_equal(ew, w + 64);
+    assert_int_equal(eh, h);
+    for (long k = 0; k < (long)w * h; k++) {
+        const unsigned char *px = e + 3 * (k / w * ew + k % w);
         if (exr[3 * k] > 0)
-            assert_true(e[3 * k] == 221 && e[3 * k + 1] == 221 && e[3 * k + 2] == 221);
+            assert_true(px[0] == 221 && px[1] == 221 && px[2] == 221);
+    }
+    const int rows[3] = {40, h / 2, h - 40};
+    const unsigned char want[3][3] = {{180, 4, 38}, {221, 221, 221}, {59, 76, 192}};
+    for (int i = 0; i < 3; i++) {
+        const unsigned char *px = e + 3 * ((long)rows[i] * ew + w + 10);
+        assert_memory_equal(px, want[i], 3);
+    }
     free(exr);
     free(e);
     fake_free(f);

@@ -3,7 +3,8 @@
  * output set; every figure is there as PNG and PDF with the panels, labels and markers issue 16
  * asks for, read from the gnuplot scripts plots.sh keeps under PPB_PLOTS_KEEP; without mc the
  * run still succeeds and draws what exists; a sweep's heat map has a row of panels per value of
- * its third key and a 1-D sweep gets a line plot. */
+ * its third key and a 1-D sweep gets a line plot; rms_vs_x's four panels share one y range;
+ * sweeps plot the RMS beyond the noise floor (docs/reference.md: Sweeps). */
 #include "testutil.h"
 
 #include <sys/stat.h>
@@ -103,6 +104,11 @@ static void test_run_draws_every_figure(void **state)
         snprintf(t, sizeof t, "set title '%s' font", ids[i]);
         assert_has(gp, t);
     }
+    /* a colour bar of the pictures' grey levels: images.c's tone curve (shoulder above 0.75,
+     * sRGB-encoded) over radiance / L_white (all.png had none: a grey read as nothing) */
+    assert_has(gp, "set palette functions enc(sh(2 * gray))");
+    assert_has(gp, "set colorbox horizontal");
+    assert_has(gp, "set cblabel 'radiance / L_white");
     snprintf(path, sizeof path, "%s/error_pp.gp", keep);
     gp = tu_read_text(path);
     assert_has(gp, "pp vs mc");
@@ -137,6 +143,38 @@ static void test_without_mc(void **state)
     assert_int_equal(w, 2 * 250 + 20);
 }
 
+/* rms_vs_x's four panels share one y range: a set whose side errors (S3, S4) are a hundred
+ * times its top and bottom errors (a synthetic rms.csv: 1 % on S1, S2, 100 % on S3, S4; the
+ * Monte Carlo floor 0.5 %) gave S1, S2 the range [0.1:1] and S3, S4 [0.1:100], so the sides
+ * looked as good as the top. Now every panel has [0.1:100] (the decades around 0.5 % .. 100 %). */
+static void test_rms_panels_share_one_range(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("plots_range");
+    char path[2048];
+    snprintf(path, sizeof path, "%s/case/provenance.txt", dir);
+    assert_int_equal(tu_sh("mkdir -p '%s/case' '%s/gp'", dir, dir), 0);
+    tu_write_file(path, "# ppbench provenance: test\nexperiment.name = r\n"
+                        "experiment.geometry = tube\nmedium.step = none\n");
+    snprintf(path, sizeof path, "%s/case/rms.csv", dir);
+    tu_write_file(path, "method,surface,segment,s,rms_rel,noise_rel,rms_excess\n"
+                        "pp,S1,0,-1,0.01,0.005,0.0087\npp,S1,1,1,0.01,0.005,0.0087\n"
+                        "pp,S2,0,-1,0.01,0.005,0.0087\npp,S2,1,1,0.01,0.005,0.0087\n"
+                        "pp,S3,0,-1,1,0.005,1\npp,S3,1,-0.5,1,0.005,1\n"
+                        "pp,S4,0,-1,1,0.005,1\npp,S4,1,-0.5,1,0.005,1\n");
+    assert_int_equal(
+        tu_sh("PPB_PLOTS_KEEP='%s/gp' bash scripts/plots.sh '%s/case' > /dev/null", dir, dir), 0);
+    snprintf(path, sizeof path, "%s/gp/rms_vs_x.gp", dir);
+    char *gp = tu_read_text(path);
+    const char *panels[] = {"S1 (top", "S2 (bottom", "S3 (left", "S4 (right"};
+    for (int i = 0; i < 4; i++) {
+        char *at = strstr(gp, panels[i]), r[64] = "";
+        assert_non_null(at);
+        assert_int_equal(sscanf(strstr(at, "set yrange"), "set yrange %63s", r), 1);
+        assert_string_equal(r, "[0.1:100]");
+    }
+}
+
 static void write_sweep(const char *path, const char *lists, const char *out)
 {
     char text[2048];
@@ -158,8 +196,23 @@ static void test_sweep_plots(void **state)
     snprintf(out, sizeof out, "%s/s3", dir);
     write_sweep(ini, "[medium]\ng = 0, 0.5\nalbedo = 0.5, 0.9\n[light]\ntheta_deg = 0, 30, 60\n",
                 out);
-    assert_int_equal(tu_sh("%s sweep --quiet '%s' > /dev/null 2>&1", tu_bin(), ini), 0);
+    assert_int_equal(
+        tu_sh("PPB_PLOTS_KEEP='%s' %s sweep --quiet '%s' > /dev/null 2>&1", dir, tu_bin(), ini), 0);
     assert_true(exists(out, "heatmap_ss.png"));
+    /* sweep.csv gains the noise floor and the RMS beyond it of every cell (model/metrics.h:
+     * noise_rel, rms_excess); the heat map is coloured by the excess, and a cell within the
+     * noise is grey and says so (an RMS alone read as the method's error where it was the
+     * reference's noise) */
+    snprintf(path, sizeof path, "%s/sweep.csv", out);
+    char *csv = tu_read_text(path);
+    assert_has(csv, ",noise_R_x0,noise_T_x0,noise_S1_all,noise_S2_all,noise_S3_all,noise_S4_all,"
+                    "excess_R_x0,excess_T_x0,excess_S1_all,");
+    snprintf(path, sizeof path, "%s/heatmap_ss.png.gp", dir);
+    char *hm = tu_read_text(path);
+    assert_has(hm, "RMS beyond the MC noise (%)");
+    assert_has(hm, "with boxxyerror fs solid noborder fc rgb '#BBBBBB'");
+    assert_has(hm, "'noise'");
+    assert_has(hm, "set output ARG1"); /* the path is data, not script text */
     assert_true(exists(out, "heatmap_ss.pdf"));
     assert_false(exists(out, "heatmap_mc.png"));
     snprintf(path, sizeof path, "%s/heatmap_ss.png", out);
@@ -170,8 +223,16 @@ static void test_sweep_plots(void **state)
     snprintf(ini, sizeof ini, "%s/s1.ini", dir);
     snprintf(out, sizeof out, "%s/s1", dir);
     write_sweep(ini, "[medium]\ng = 0, 0.5, 0.8\n", out);
-    assert_int_equal(tu_sh("%s sweep --quiet '%s' > /dev/null 2>&1", tu_bin(), ini), 0);
+    assert_int_equal(
+        tu_sh("PPB_PLOTS_KEEP='%s' %s sweep --quiet '%s' > /dev/null 2>&1", dir, tu_bin(), ini), 0);
     assert_true(exists(out, "sweep_rms.png"));
+    /* the excess with the noise floor dashed; padded so the first and last values' markers
+     * are not drawn on the frame (a sweep of two values had both there) */
+    snprintf(path, sizeof path, "%s/sweep_rms.png.gp", dir);
+    char *lp = tu_read_text(path);
+    assert_has(lp, "set offsets graph 0.06, graph 0.06");
+    assert_has(lp, "title 'MC noise floor'");
+    assert_has(lp, "RMS beyond the MC noise (%)");
     assert_true(exists(out, "sweep_rms.pdf"));
     assert_false(exists(out, "heatmap_ss.png"));
 }
@@ -181,6 +242,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_run_draws_every_figure),
         cmocka_unit_test(test_without_mc),
+        cmocka_unit_test(test_rms_panels_share_one_range),
         cmocka_unit_test(test_sweep_plots),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

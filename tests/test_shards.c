@@ -7,7 +7,7 @@
  *   fresh run of the grown grid (expected: that run's bytes; the point column was wrong and the
  *   rows ragged);
  * - merge refuses shards of another grid (value order, settings, keys), exit 2 naming the shard;
- * - mc-merge refuses duplicated, overlapping and missing photon ranges naming the files, a
+ * - mc-merge refuses (exit 2) duplicated, overlapping and missing photon ranges naming the files, a
  *   tally file with one flipped bit, and names the shard of another scene in an exact message;
  *   an interrupted mc-shard exits 130 and leaves no file;
  * - ppb_mc_tallies_totals gives the true statistics when memory is exhausted (it gave zeros).
@@ -269,27 +269,27 @@ static void test_mc_merge_checks_shards(void **state)
     snprintf(args, sizeof args, "mc-merge --out %s/dup %s %s/p1 %s/p1 %s/p3", d, cfg, d, d, d);
     snprintf(needle, sizeof needle,
              "%s/p1/mc_tallies.bin and %s/p1/mc_tallies.bin hold the same photons [0, 1332)", d, d);
-    expect(args, 1, needle);
+    expect(args, 2, needle); /* bad input: docs/reference.md, Exit codes */
     /* Overlapping shards of different N: 1/2 + 2/4 + 4/4 also counts 3996 photons. */
     snprintf(args, sizeof args, "mc-merge --out %s/ovl %s %s/h1 %s/q2 %s/q4", d, cfg, d, d, d);
     snprintf(needle, sizeof needle,
              "%s/h1/mc_tallies.bin (photons [0, 1998)) and %s/q2/mc_tallies.bin (photons [999, "
              "1998)) overlap",
              d, d);
-    expect(args, 1, needle);
+    expect(args, 2, needle); /* bad input: docs/reference.md, Exit codes */
     /* A gap: 1/4 + 2/4 + 4/4 misses [1998, 2997). */
     snprintf(args, sizeof args, "mc-merge --out %s/gap %s %s/q1 %s/q2 %s/q4", d, cfg, d, d, d);
     snprintf(needle, sizeof needle,
              "photons [1998, 2997) are in none of the shards (the next is %s/q4/mc_tallies.bin)",
              d);
-    expect(args, 1, needle);
+    expect(args, 2, needle); /* bad input: docs/reference.md, Exit codes */
     /* A shard of another scene: the message names it once, unmangled. */
     snprintf(args, sizeof args, "mc-merge --out %s/scene %s %s/p1 %s/p2 %s/x3", d, cfg, d, d, d);
     snprintf(needle, sizeof needle,
              "%s: %s/x3/mc_tallies.bin: mc merge: tallies come from different scenes or bin "
              "settings\n",
              cfg, d);
-    expect(args, 1, needle);
+    expect(args, 2, needle); /* bad input: docs/reference.md, Exit codes */
     /* One flipped bit in the middle of p2's file (a tally): refused, the file named. */
     char p2[1300];
     snprintf(p2, sizeof p2, "%s/p2/mc_tallies.bin", d);
@@ -298,7 +298,7 @@ static void test_mc_merge_checks_shards(void **state)
     flip_bit(p2, (long)st.st_size / 2);
     snprintf(args, sizeof args, "mc-merge --out %s/flip %s %s/p1 %s/p2 %s/p3", d, cfg, d, d, d);
     snprintf(needle, sizeof needle, "%s: corrupt or truncated tally file", p2);
-    expect(args, 1, needle);
+    expect(args, 2, needle); /* bad input: docs/reference.md, Exit codes */
     for (const char *o = "dup\0ovl\0gap\0scene\0flip\0"; *o; o += strlen(o) + 1)
         expect_sh(tu_sh("test ! -e %s/%s/radiance.csv", d, o) == 0,
                   "no radiance.csv from a refused merge");

@@ -64,6 +64,13 @@ static int write_errno(FILE *f)
 
 int ppb_afile_commit(ppb_afile *af, ppb_err *err)
 {
+    if (ppb_afile_close(af, err))
+        return -1;
+    return ppb_apath_commit(&af->name, err);
+}
+
+int ppb_afile_close(ppb_afile *af, ppb_err *err)
+{
     int bad = ferror(af->f) != 0, e = bad ? write_errno(af->f) : 0;
     errno = 0;
     if (!bad && fflush(af->f) != 0)
@@ -76,7 +83,24 @@ int ppb_afile_commit(ppb_afile *af, ppb_err *err)
         return ppb_fail(err, "%s: write failed: %s", af->name.path,
                         e ? strerror(e) : "an earlier write failed (the cause has passed)");
     }
-    return ppb_apath_commit(&af->name, err);
+    return 0;
+}
+
+int ppb_apaths_commit(ppb_apath *const *aps, int n, ppb_err *err)
+{
+    sigset_t hold, old;
+    sigemptyset(&hold);
+    sigaddset(&hold, SIGINT);
+    sigaddset(&hold, SIGTERM);
+    sigprocmask(SIG_BLOCK, &hold, &old);
+    int rc = 0;
+    for (int i = 0; i < n; i++)
+        if (rc)
+            ppb_apath_abort(aps[i]);
+        else
+            rc = ppb_apath_commit(aps[i], err);
+    sigprocmask(SIG_SETMASK, &old, NULL); /* a signal held off arrives now */
+    return rc;
 }
 
 void ppb_afile_abort(ppb_afile *af)
@@ -407,4 +431,119 @@ void ppb_adir_abort(ppb_adir *ad)
     ppb_err ignored;
     ppb_remove_tree(ad->tmp, &ignored);
     ad->made = 0;
+}
+
+/* Whether s ends with suffix. */
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), k = strlen(suffix);
+    return n >= k && !strcmp(s + n - k, suffix);
+}
+
+/* The last n bytes of the file at fd (size bytes long) into buf; 0 on success. */
+static int read_tail(int fd, off_t size, unsigned char *buf, size_t n)
+{
+    if (size < (off_t)n)
+        return -1;
+    return pread(fd, buf, n, size - (off_t)n) == (ssize_t)n ? 0 : -1;
+}
+
+int ppb_file_complete(const char *path, ppb_err *err)
+{
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
+    int fd = open(path, O_RDONLY | O_NOFOLLOW);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        int e = errno;
+        if (fd >= 0)
+            close(fd);
+        return ppb_fail(err, "%s: cannot read it back: %s", path, strerror(e));
+    }
+    const char *bad = NULL;
+    unsigned char tail[64];
+    if (!S_ISREG(st.st_mode))
+        bad = "not a regular file";
+    else if (st.st_size == 0)
+        bad = "0 bytes (a full disk?)";
+    else if (ends_with(path, ".png") &&
+             (read_tail(fd, st.st_size, tail, 12) || memcmp(tail, iend, 12)))
+        bad = "a PNG cut short (no IEND chunk at its end; a full disk?)";
+    else if (ends_with(path, ".pdf")) {
+        size_t n = st.st_size < 64 ? (size_t)st.st_size : 64;
+        if (read_tail(fd, st.st_size, tail, n) || !memmem(tail, n, "%%EOF", 5))
+            bad = "a PDF cut short (no %%EOF at its end; a full disk?)";
+    }
+    close(fd);
+    return bad ? ppb_fail(err, "%s: incomplete: %s", path, bad) : 0;
+}
+
+int ppb_pdf_fix_date(const char *path, ppb_err *err)
+{
+    static const char key[] = "/CreationDate (D:", fixed[] = "19700101000000";
+    FILE *f = fopen(path, "r+b");
+    if (!f)
+        return ppb_fail(err, "%s: cannot open: %s", path, strerror(errno));
+    /* cairo writes the date in the Info dictionary near the end; a PDF here is small (a
+     * figure), so the whole file is read. */
+    char *buf = NULL;
+    size_t cap = 0, len = 0, got;
+    int rc = 0;
+    do {
+        if (len + 65536 > cap) {
+            char *grown = realloc(buf, cap = 2 * cap + 65536);
+            if (!grown) {
+                rc = ppb_fail(err, "%s: out of memory", path);
+                break;
+            }
+            buf = grown;
+        }
+        got = fread(buf + len, 1, cap - len, f);
+        len += got;
+    } while (got > 0);
+    char *at = rc ? NULL : memmem(buf, len, key, sizeof key - 1);
+    if (at && (size_t)(at - buf) + sizeof key - 1 + 14 <= len) {
+        long off = (long)(at - buf) + (long)sizeof key - 1;
+        if (fseek(f, off, SEEK_SET) != 0 || fwrite(fixed, 1, 14, f) != 14)
+            rc = ppb_fail(err, "%s: cannot fix its date: %s", path, strerror(errno));
+    }
+    free(buf);
+    if (fclose(f) != 0 && rc == 0)
+        rc = ppb_fail(err, "%s: cannot fix its date: %s", path, strerror(errno));
+    return rc;
+}
+
+/* ppb_dir_verify below dir/rel (rel "" at the top). */
+static int verify_at(const char *dir, const char *rel, ppb_bad_file_fn bad, void *ctx, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 512];
+    snprintf(path, sizeof path, "%s%s%s", dir, rel[0] ? "/" : "", rel);
+    DIR *d = opendir(path);
+    if (!d)
+        return ppb_fail(err, "%s: cannot read: %s", path, strerror(errno));
+    int rc = 0;
+    struct dirent *de;
+    while (rc == 0 && (de = readdir(d))) {
+        if (!strcmp(de->d_name, ".") || !strcmp(de->d_name, ".."))
+            continue;
+        char sub[512], full[PPB_PATH_MAX + 1024];
+        snprintf(sub, sizeof sub, "%s%s%s", rel, rel[0] ? "/" : "", de->d_name);
+        snprintf(full, sizeof full, "%s/%s", dir, sub);
+        struct stat st;
+        if (lstat(full, &st) == 0 && S_ISDIR(st.st_mode)) {
+            rc = verify_at(dir, sub, bad, ctx, err);
+            continue;
+        }
+        ppb_err why;
+        if (ppb_file_complete(full, &why) == 0 &&
+            (!ends_with(full, ".pdf") || ppb_pdf_fix_date(full, &why) == 0))
+            continue;
+        rc = bad(sub, why.msg, ctx, err);
+    }
+    closedir(d);
+    return rc;
+}
+
+int ppb_dir_verify(const char *dir, ppb_bad_file_fn bad, void *ctx, ppb_err *err)
+{
+    return verify_at(dir, "", bad, ctx, err);
 }

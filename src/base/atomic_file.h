@@ -39,6 +39,14 @@ int ppb_afile_open(ppb_afile *af, const char *path, ppb_err *err);
 /* Flushes, checks for write errors, renames; on any failure removes the temporary. */
 int ppb_afile_commit(ppb_afile *af, ppb_err *err);
 void ppb_afile_abort(ppb_afile *af);
+/* The first half of ppb_afile_commit: flushes, checks for write errors and closes, leaving the
+ * complete temporary af->name.tmp for ppb_apath_commit (several files put in place together:
+ * ppb_apaths_commit); on failure removes it. */
+int ppb_afile_close(ppb_afile *af, ppb_err *err);
+/* Renames n closed temporaries into place with SIGINT and SIGTERM held off meanwhile, so an
+ * interrupt never leaves some files new and the others old; on a failure the rest are
+ * removed. */
+int ppb_apaths_commit(ppb_apath *const *aps, int n, ppb_err *err);
 
 /* mkdir -p. */
 int ppb_mkdirs(const char *dir, ppb_err *err);
@@ -67,6 +75,22 @@ int ppb_adir_begin(ppb_adir *ad, ppb_err *err);
 int ppb_adir_commit(ppb_adir *ad, ppb_err *err);
 /* Removes the staging directory and all in it. */
 void ppb_adir_abort(ppb_adir *ad);
+
+/* Whether the file at path is complete, as far as its kind shows: a regular file of non-zero
+ * size; a PNG ending with its IEND chunk; a PDF ending with %%EOF. A writer that ignores a
+ * full disk (gnuplot's cairo) leaves a 0-byte or cut file with a success status: this finds
+ * it (docs/reference.md: Outputs). Fails naming the path and what is wrong. */
+int ppb_file_complete(const char *path, ppb_err *err);
+/* A PDF made the same bytes by the same run: its /CreationDate (the one thing cairo writes
+ * that changes from run to run) set to D:19700101000000Z, in place and of the same length, so
+ * the cross-reference offsets stay true. A PDF without one is left as it is. */
+int ppb_pdf_fix_date(const char *path, ppb_err *err);
+/* Checks every file under dir (at any depth, never following a link) with ppb_file_complete
+ * and fixes every PDF's date (ppb_pdf_fix_date). A bad file is handed to bad(rel, why, ctx)
+ * (rel: its path under dir): it returns 0 when the file may be left out (it has then removed
+ * it) and -1 to fail the whole check with its own message in err. */
+typedef int (*ppb_bad_file_fn)(const char *rel, const char *why, void *ctx, ppb_err *err);
+int ppb_dir_verify(const char *dir, ppb_bad_file_fn bad, void *ctx, ppb_err *err);
 
 /* The pid in a temporary's name ("<name>.tmp.<pid>", or ".old.<pid>" when old is set), or 0
  * when name is no such temporary. */

@@ -2,6 +2,10 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -172,7 +176,8 @@ static const char *skip_for(const ppb_result *ref)
 }
 
 /* The first line of provenance.txt: what marks a directory as a ppbench output set. */
-static const char provenance_mark[] = "# ppbench provenance";
+const char ppb_provenance_mark[] = "# ppbench provenance";
+#define provenance_mark ppb_provenance_mark
 
 static void out_path(const char *dir, const char *file, char *buf, size_t n)
 {
@@ -192,7 +197,9 @@ static int write_timings(const ppb_experiment *ex, const char *dir, ppb_err *err
     return ppb_afile_commit(&af, err);
 }
 
-static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *err)
+/* provenance.txt; fig: the figures left out (NULL before they are drawn). */
+static int write_provenance(const ppb_experiment *ex, const char *dir, const ppb_figures *fig,
+                            ppb_err *err)
 {
     char path[PPB_PATH_MAX + 256], when[64];
     out_path(dir, "provenance.txt", path, sizeof path);
@@ -217,6 +224,8 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, ppb_err *
     for (int i = 0; i < ex->nincomplete; i++)
         fprintf(af.f, "%s.incomplete = interrupted before it finished: no rows written\n",
                 ex->incomplete[i]);
+    if (fig) /* before the config: `ppbench score` reads the lines from experiment.name on */
+        fputs(fig->text, af.f);
     ppb_config_write_readable(ex->cfg, af.f);
     return ppb_afile_commit(&af, err);
 }
@@ -263,8 +272,9 @@ static int write_comparisons(const ppb_experiment *ex, const char *dir, ppb_err 
 }
 
 /* Whether the existing directory ad->path may be replaced: it is empty (but for temporaries,
- * which ppb_adir_clean sorts out) or its provenance.txt says ppbench wrote it. */
-static int check_owned(const ppb_adir *ad, const char *dir, ppb_err *err)
+ * which ppb_adir_clean sorts out) or its provenance.txt starts with mark (the kind of set
+ * this command writes). */
+static int check_owned(const ppb_adir *ad, const char *dir, const char *mark, ppb_err *err)
 {
     DIR *d = opendir(ad->path);
     if (!d)
@@ -285,21 +295,86 @@ static int check_owned(const ppb_adir *ad, const char *dir, ppb_err *err)
             line[0] = '\0';
         fclose(f);
     }
-    if (!strncmp(line, provenance_mark, sizeof provenance_mark - 1))
+    if (!strncmp(line, mark, strlen(mark)) && line[strlen(mark)] == ':')
         return 0;
     return ppb_fail(err,
-                    "%s: holds files ppbench did not write (%s; no ppbench provenance.txt): a run "
-                    "replaces its whole output directory, so it will not take this one; give "
-                    "an empty or new directory",
-                    dir, other);
+                    "%s: holds files ppbench did not write as this command's output (%s; no "
+                    "provenance.txt starting \"%s:\"): it replaces its whole output directory, "
+                    "so it will not take this one; give an empty or new directory",
+                    dir, other, mark);
+}
+
+/* The output directories this process holds the lock of (claim_out: at most one a config). */
+static char locked[64][PPB_PATH_MAX];
+static int nlocked;
+
+/* An exclusive lock on .<name>.lock beside the directory (hidden: a listing of the parent shows
+ * the output directories alone), held until the process exits: a
+ * second process claiming the same directory is refused at its start, before any work, instead
+ * of computing and then losing the swap (docs/reference.md: Outputs). */
+static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
+{
+    for (int i = 0; i < nlocked; i++)
+        if (!strcmp(locked[i], ad->path))
+            return 0;
+    char path[PPB_PATH_MAX + 16], parent[PPB_PATH_MAX + 16];
+    snprintf(parent, sizeof parent, "%s", ad->path);
+    char *slash = strrchr(parent, '/');
+    const char *base = slash ? slash + 1 : parent;
+    if (slash)
+        *slash = '\0';
+    if ((size_t)snprintf(path, sizeof path, "%s/.%s.lock",
+                         slash ? (slash == parent ? "" : parent) : ".", base) >= sizeof path)
+        return ppb_fail(err, "%s: path too long", dir);
+    if (slash && slash != parent && ppb_mkdirs(parent, err))
+        return -1;
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0)
+        return ppb_fail(err, "%s: cannot take its lock %s: %s", dir, path, strerror(errno));
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        int e = errno;
+        close(fd);
+        if (e == EWOULDBLOCK)
+            return ppb_fail(err,
+                            "%s: another ppbench is writing it (it holds %s); wait for it or "
+                            "give another directory",
+                            dir, path);
+        return ppb_fail(err, "%s: cannot lock %s: %s", dir, path, strerror(e));
+    }
+    if (nlocked < 64) /* the descriptor stays open: the lock lasts as long as the process */
+        snprintf(locked[nlocked++], sizeof locked[0], "%s", ad->path);
+    return 0;
+}
+
+/* A symbolic link whose target does not exist: refused, rather than replaced by a directory
+ * (the link silently gone, its target never written). */
+static int check_not_dangling(const char *dir, ppb_err *err)
+{
+    struct stat st;
+    char buf[PPB_PATH_MAX];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (size_t n = strlen(buf); n > 1 && buf[n - 1] == '/'; n--)
+        buf[n - 1] = '\0';
+    if (lstat(buf, &st) == 0 && S_ISLNK(st.st_mode) && stat(buf, &st) != 0)
+        return ppb_fail(err,
+                        "%s: a symbolic link to nothing (%s): give the directory it should "
+                        "name, or remove the link",
+                        dir, strerror(errno));
+    return 0;
+}
+
+int ppb_out_claim(const char *dir, const char *mark, ppb_adir *ad, ppb_err *err)
+{
+    if (check_not_dangling(dir, err) || ppb_adir_name(ad, dir, err) ||
+        check_owned(ad, dir, mark, err) || lock_out(ad, dir, err))
+        return -1;
+    return ppb_adir_clean(ad, err);
 }
 
 /* The output directory named and claimed: see experiment.h. */
 static int claim_out(const char *dir, ppb_adir *ad, ppb_err *err)
 {
-    if (ppb_adir_name(ad, dir, err) || check_owned(ad, dir, err))
-        return -1;
-    return ppb_adir_clean(ad, err);
+    return ppb_out_claim(dir, provenance_mark, ad, err);
 }
 
 int ppb_experiment_claim_out(const char *dir, ppb_err *err)
@@ -308,9 +383,32 @@ int ppb_experiment_claim_out(const char *dir, ppb_err *err)
     return claim_out(dir, &ad, err);
 }
 
-/* Every file of the output set, under dir. */
-static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
+/* A file of the staged set found incomplete (ppb_dir_verify): a figure's is left out, as a
+ * figure that failed; any other fails the write (the previous set stays). */
+static int bad_file(const char *rel, const char *why, void *ctx, ppb_err *err)
 {
+    const ppb_adir *ad = ((void **)ctx)[0];
+    ppb_figures *fig = ((void **)ctx)[1];
+    size_t n = strlen(rel);
+    int figure = (!strncmp(rel, "plots/", 6) || !strncmp(rel, "images/", 7)) && n > 4 &&
+                 (!strcmp(rel + n - 4, ".png") || !strcmp(rel + n - 4, ".pdf"));
+    if (!figure)
+        return ppb_fail(err, "%s", why);
+    char path[PPB_PATH_MAX + 600], name[600];
+    snprintf(path, sizeof path, "%s/%s", ad->tmp, rel);
+    remove(path);
+    snprintf(name, sizeof name, "%.*s", (int)n - 4, rel);
+    ppb_figures_fail(fig, name, why);
+    return 0;
+}
+
+/* Every file of the output set, under ad->tmp: the data first (any failure fails the write),
+ * then the images and figures (one that fails is said, recorded in provenance.txt and left
+ * out; reference: Outputs), then every file is checked complete before the set may be put in
+ * place. */
+static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
+{
+    const char *dir = ad->tmp;
     char path[PPB_PATH_MAX + 256];
     out_path(dir, "radiance.csv", path, sizeof path);
     if (ppb_write_radiance_csv(path, &ex->cfg->scene, ex->res, ex->n, err))
@@ -326,14 +424,27 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
     for (int i = 0; i < ex->n; i++) /* a method's own outputs (rte2d_refinements.csv) */
         if (ppb_result_write_extra(&ex->res[i], dir, err))
             return -1;
-    if (write_provenance(ex, dir, err) || write_config_ini(ex, dir, err))
+    if (write_provenance(ex, dir, NULL, err) || write_config_ini(ex, dir, err))
         return -1;
+    ppb_figures fig = {.who = ex->cfg->name, .staged = ad->tmp, .final = ad->path};
     const ppb_result *ref = ppb_experiment_reference(ex);
     const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
+    ppb_err why;
     if (ppb_images_write(dir, &ex->cfg->scene, &meta, ex->res, ex->n,
-                         ref ? (int)(ref - ex->res) : -1, err))
+                         ref ? (int)(ref - ex->res) : -1, &why)) {
+        /* a part of the images would be drawn into figures as if whole: none are kept */
+        out_path(dir, "images", path, sizeof path);
+        ppb_err ignored;
+        ppb_remove_tree(path, &ignored);
+        ppb_figures_fail(&fig, "images", why.msg);
+    }
+    ppb_plots_write(dir, ex->cfg->name, &fig); /* last: the figures read the files above */
+    void *ctx[2] = {(void *)ad, &fig};
+    if (ppb_dir_verify(dir, bad_file, ctx, err))
         return -1;
-    return ppb_plots_write(dir, ex->cfg->name, err); /* last: the figures read the files above */
+    if (fig.nfailed && write_provenance(ex, dir, &fig, err))
+        return -1;
+    return 0;
 }
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
@@ -344,7 +455,7 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
     ppb_adir ad;
     if (claim_out(ex->cfg->out_dir, &ad, err) || ppb_adir_begin(&ad, err))
         return -1;
-    if (write_set(ex, ad.tmp, err)) {
+    if (write_set(ex, &ad, err)) {
         ppb_adir_abort(&ad);
         return -1;
     }

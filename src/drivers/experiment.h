@@ -9,6 +9,7 @@
 #ifndef PPB_EXPERIMENT_H
 #define PPB_EXPERIMENT_H
 
+#include "base/atomic_file.h"
 #include "model/config.h"
 #include "methods/method.h"
 #include "model/result.h"
@@ -45,6 +46,14 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
  * live process is writing. Callers check it before any work; ppb_experiment_write checks it
  * again. */
 int ppb_experiment_claim_out(const char *dir, ppb_err *err);
+/* The first line's start of a run's provenance.txt, the mark of its output set. */
+extern const char ppb_provenance_mark[];
+/* The claim of any command that writes a whole output set (run, mc-merge, score): dir must be
+ * new, empty, or hold a set whose provenance.txt starts with "<mark>:"; never a dangling
+ * symbolic link; and no other live process may hold it (an exclusive flock on .<name>.lock
+ * beside it, kept until this process exits). Names its staging in ad and cleans dead
+ * processes' leftovers. Fails, having touched nothing but the lock file. */
+int ppb_out_claim(const char *dir, const char *mark, ppb_adir *ad, ppb_err *err);
 /* Writes the outputs of the methods that ran as one set: into a staging directory beside
  * cfg->out_dir, swapped into its place when every file is written (a failure leaves the
  * previous directory as it was); then fails, naming them, if any method failed. */

@@ -2,6 +2,7 @@
  * work (options, the device, every config, the output directories), dispatches to the
  * experiment runner, the sweep driver, the device list and the benchmarks, and maps failures to
  * the documented exit codes. Everything else lives in its module. */
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
 #include <stdio.h>
@@ -475,8 +476,10 @@ static int cmd_run(const cli *c)
     for (int i = 0; i < c->nargs && code == EXIT_OK; i++) {
         const ppb_config *cfg = &cfgs[i];
         ppb_experiment ex = {0};
-        ppb_run_ctx ctx = {
-            .device_selector = c->device, .quiet = c->quiet, .ref_cache = cache, .extras = 1};
+        ppb_run_ctx ctx = {.device_selector = c->device,
+                           .quiet = c->quiet ? 2 : 0, /* 2: silent (method.h) */
+                           .ref_cache = cache,
+                           .extras = 1};
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
@@ -485,12 +488,17 @@ static int cmd_run(const cli *c)
         ppb_ctx_close(&ctx);
         if (rc) {
             fprintf(stderr, "ppbench: %s: %s\n", cfg->path, err.msg);
-            code = EXIT_RUN;
+            code = ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_RUN;
         } else {
-            /* Said under --quiet too (issue 16): where the results went is its one line. */
-            fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
-                    partial ? " (partial: interrupted)" : "");
-            if (partial)
+            /* A signal while writing (after the last check) exits 130 as one earlier does,
+             * though the set is whole (docs/reference.md: Exit codes). */
+            int late = !partial && ppb_interrupted();
+            if (!c->quiet)
+                fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
+                        partial ? " (partial: interrupted)"
+                        : late  ? " (interrupted while writing: the set is whole)"
+                                : "");
+            if (partial || late)
                 code = EXIT_INTERRUPTED;
         }
     }
@@ -628,9 +636,13 @@ static int mc_shard_or_merge(const cli *c, int merge)
                    : ppb_mc_shard_run(&cfg, c->device, c->quiet, c->shard_i, c->shard_n, &err);
     if (rc) {
         fprintf(stderr, "ppbench: %s: %s\n", cfg.path, err.msg);
-        return ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_RUN;
+        return ppb_interrupted()               ? EXIT_INTERRUPTED
+               : rc == PPB_MC_MERGE_BAD_SHARDS ? EXIT_USAGE
+                                               : EXIT_RUN;
     }
-    return EXIT_OK;
+    /* A signal after the last check (while writing): the outputs are whole, but the command
+     * was stopped, as an interrupt earlier says (docs/reference.md: Exit codes). */
+    return ppb_interrupted() ? EXIT_INTERRUPTED : EXIT_OK;
 }
 
 static int cmd_mc_shard(const cli *c)
@@ -675,6 +687,29 @@ static int cmd_slurm(const cli *c)
     return EXIT_OK;
 }
 
+/* Whether scene may write DIR/scene.json: DIR is new, or holds nothing but scene.json (and
+ * temporaries). Without --out DIR is the config's [output] dir, where `run` puts its output
+ * set: a file added there would sit in a set it does not belong to, and go with the next run. */
+static int check_scene_dir(const char *dir, ppb_err *err)
+{
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0; /* new (mkdir -p makes it); another failure shows when it is written */
+    char other[256] = "";
+    struct dirent *de;
+    while (!other[0] && (de = readdir(d)))
+        if (strcmp(de->d_name, ".") && strcmp(de->d_name, "..") &&
+            strcmp(de->d_name, "scene.json") && !ppb_temp_pid(de->d_name, 0))
+            snprintf(other, sizeof other, "%s", de->d_name);
+    closedir(d);
+    if (!other[0])
+        return 0;
+    return ppb_fail(err,
+                    "%s: holds other files (%s; a run's output set?): scene writes scene.json "
+                    "only into a new directory or one holding nothing else; give --out DIR",
+                    dir, other);
+}
+
 /* `ppbench scene CONFIG --out DIR`: DIR/scene.json, what an external method reads
  * (io/scene_json.h; docs/external.md). */
 static int cmd_scene(const cli *c)
@@ -690,6 +725,8 @@ static int cmd_scene(const cli *c)
     int code = check_config_out(c, &cfg);
     if (code)
         return code;
+    if (check_scene_dir(cfg.out_dir, &err))
+        return usage_error(&err);
     char path[PPB_PATH_MAX + 16];
     snprintf(path, sizeof path, "%s/scene.json", cfg.out_dir);
     if (ppb_mkdirs(cfg.out_dir, &err) || ppb_scene_json_write(&cfg, path, &err)) {
@@ -702,7 +739,7 @@ static int cmd_scene(const cli *c)
 /* `ppbench score RADIANCE.csv --ref DIR [--out DIR2]` (drivers/score.h). */
 static int cmd_score(const cli *c)
 {
-    return ppb_score_main(c->nargs ? c->args[0] : NULL, c->nargs, c->ref, c->out);
+    return ppb_score_main(c->nargs ? c->args[0] : NULL, c->nargs, c->ref, c->out, c->quiet);
 }
 
 static int cmd_report(const cli *c)
@@ -716,7 +753,7 @@ static int cmd_report(const cli *c)
     int rc = ppb_report_write(c->args[0], c->args + 1, c->nargs - 1, &err);
     if (rc) {
         fprintf(stderr, "ppbench report: %s\n", err.msg);
-        return rc == PPB_REPORT_REFUSED ? EXIT_USAGE : EXIT_RUN;
+        return rc == PPB_REPORT_REFUSED || rc == PPB_REPORT_BAD_INPUT ? EXIT_USAGE : EXIT_RUN;
     }
     return EXIT_OK;
 }
@@ -750,8 +787,8 @@ static const command commands[] = {
     {"score", "RADIANCE.csv", OPT_REF,
      "score a radiance.csv against the finished experiment\n--ref DIR: its summary, rms and "
      "totals rows into --out\n(default DIR-score, -score-2, ...; DIR is never written)",
-     "ppbench score --ref results/uniform_g0_normal mine/radiance.csv", OPT_REF | OPT_OUT, 1,
-     cmd_score},
+     "ppbench score --ref results/uniform_g0_normal mine/radiance.csv",
+     OPT_REF | OPT_OUT | OPT_QUIET, 1, cmd_score},
     {"slurm", "CONFIG", OPT_SHARDS | OPT_OUT,
      "write a Slurm job array into --out DIR (job.sh: shard I\nof a sweep, or of one config's "
      "Monte Carlo; merge.sh:\nits merge into DIR/result) and print the sbatch lines;\n--submit "

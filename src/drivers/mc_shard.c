@@ -156,7 +156,11 @@ int ppb_mc_shard_merge(const ppb_config *cfg, const char *const *dirs, int ndirs
 {
     ppb_experiment ex = {0};
     ppb_mc_tallies sum = {0};
-    int rc = load_sum(cfg, dirs, ndirs, &sum, err);
+    if (load_sum(cfg, dirs, ndirs, &sum, err)) {
+        ppb_mc_tallies_free(&sum);
+        return PPB_MC_MERGE_BAD_SHARDS;
+    }
+    int rc = 0;
     ppb_layout lo = ppb_scene_layout(&cfg->scene);
     ex.cfg = cfg;
     ex.n = 0;

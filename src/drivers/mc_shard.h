@@ -13,7 +13,12 @@
 int ppb_mc_shard_run(const ppb_config *cfg, const char *device, int quiet, int i, int n,
                      ppb_err *err);
 
-/* Adds the tallies found in dirs and writes cfg's outputs (mc, mc1) under cfg->out_dir. */
+/* What ppb_mc_shard_merge returns when the shards will not do (a directory without tallies, a
+ * shard of another config, photons missing or twice): bad input, exit code 2. */
+enum { PPB_MC_MERGE_BAD_SHARDS = -2 };
+
+/* Adds the tallies found in dirs and writes cfg's outputs (mc, mc1) under cfg->out_dir: 0, -1
+ * (writing failed) or PPB_MC_MERGE_BAD_SHARDS. */
 int ppb_mc_shard_merge(const ppb_config *cfg, const char *const *dirs, int ndirs, ppb_err *err);
 
 #endif

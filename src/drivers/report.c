@@ -206,56 +206,50 @@ static int check_own(const char *path, const char *const *marks, ppb_err *err)
                     path, marks[0]);
 }
 
-/* Commits af, saying so. */
-static int commit_said(ppb_afile *af, ppb_err *err)
-{
-    if (ppb_afile_commit(af, err))
-        return -1;
-    fprintf(stderr, "ppbench report: wrote %s\n", af->name.path);
-    return 0;
-}
+/* The files of one report, each written and closed under its temporary name, then put in
+ * place together (ppb_apaths_commit): an interrupt or a failure never leaves new tables beside
+ * an old README. */
+enum { REPORT_FILES = 3 };
+typedef struct report_files {
+    ppb_afile f[REPORT_FILES]; /* table2.csv, table2.md, README.md; zeroed: none begun */
+} report_files;
 
 static void md_cell(FILE *f, double v)
 {
     fprintf(f, isnan(v) ? " - |" : " %.1f |", v);
 }
 
+/* table2.csv and table2.md into rf->f[0], rf->f[1], closed (not yet in place). */
 static int write_tables(const char *dir, const char *const *cases, const case_data *cd, int ncases,
-                        ppb_err *err)
+                        report_files *rf, ppb_err *err)
 {
     char path[1200];
-    ppb_afile csv, md;
+    ppb_afile *csvf = &rf->f[0], *mdf = &rf->f[1];
     snprintf(path, sizeof path, "%s/table2.csv", dir);
-    if (ppb_afile_open(&csv, path, err))
+    if (ppb_afile_open(csvf, path, err))
         return -1;
     snprintf(path, sizeof path, "%s/table2.md", dir);
-    if (ppb_afile_open(&md, path, err)) {
-        ppb_afile_abort(&csv);
+    if (ppb_afile_open(mdf, path, err))
         return -1;
-    }
-    fprintf(csv.f, "%s\n", csv_header);
-    fprintf(md.f, "%s\n", md_header);
-    fprintf(md.f, "|---|---|---|---|---|---|---|\n");
+    fprintf(csvf->f, "%s\n", csv_header);
+    fprintf(mdf->f, "%s\n", md_header);
+    fprintf(mdf->f, "|---|---|---|---|---|---|---|\n");
     for (int c = 0; c < ncases; c++)
         for (int i = 0; i < cd[c].n; i++) {
             const summary_row *r = &cd[c].rows[i];
             if (!is_table2_cell(r->cell))
                 continue;
             double pv = paper_value(cases[c], r->cell, r->method);
-            fprintf(csv.f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g\n", cases[c], r->cell, r->method, r->rms,
+            fprintf(csvf->f, "%s,%s,%s,%.6g,%.6g,%.6g,%.6g\n", cases[c], r->cell, r->method, r->rms,
                     r->noise, r->excess, pv / 100);
-            fprintf(md.f, "| %s | %c | %s |", cases[c], r->cell[0], r->method);
-            md_cell(md.f, 100 * r->rms);
-            md_cell(md.f, 100 * r->noise);
-            md_cell(md.f, 100 * r->excess);
-            md_cell(md.f, pv);
-            fputc('\n', md.f);
+            fprintf(mdf->f, "| %s | %c | %s |", cases[c], r->cell[0], r->method);
+            md_cell(mdf->f, 100 * r->rms);
+            md_cell(mdf->f, 100 * r->noise);
+            md_cell(mdf->f, 100 * r->excess);
+            md_cell(mdf->f, pv);
+            fputc('\n', mdf->f);
         }
-    if (commit_said(&csv, err)) {
-        ppb_afile_abort(&md);
-        return -1;
-    }
-    return commit_said(&md, err);
+    return ppb_afile_close(csvf, err) || ppb_afile_close(mdf, err) ? -1 : 0;
 }
 
 static void copy_file(FILE *dst, const char *path)
@@ -557,15 +551,16 @@ static void write_footer(FILE *f, const char *dir, const char *const *cases, int
     fprintf(f, "\n");
 }
 
+/* README.md into rf->f[2], closed (not yet in place). */
 static int write_readme(const char *dir, const char *const *cases, const case_data *cd, int ncases,
-                        ppb_err *err)
+                        report_files *rf, ppb_err *err)
 {
     char path[1200];
-    ppb_afile af;
+    ppb_afile *af = &rf->f[2];
     snprintf(path, sizeof path, "%s/README.md", dir);
-    if (ppb_afile_open(&af, path, err))
+    if (ppb_afile_open(af, path, err))
         return -1;
-    FILE *f = af.f;
+    FILE *f = af->f;
     fprintf(f, "%s\n%s\n\n", readme_mark, readme_mark_v1);
     write_budget(f, cases, cd, ncases);
     fprintf(f, "## Table 2\n\n");
@@ -592,7 +587,7 @@ static int write_readme(const char *dir, const char *const *cases, const case_da
         link_error_images(f, dir, cases[c]);
     }
     write_footer(f, dir, cases, ncases);
-    return commit_said(&af, err);
+    return ppb_afile_close(af, err);
 }
 
 int ppb_report_write(const char *dir, const char *const *cases, int ncases, ppb_err *err)
@@ -612,14 +607,24 @@ int ppb_report_write(const char *dir, const char *const *cases, int ncases, ppb_
             return PPB_REPORT_REFUSED;
     }
     case_data *cd = load_cases(dir, cases, ncases, err);
-    if (!cd)
-        return -1;
-    int rc = write_tables(dir, cases, cd, ncases, err);
+    if (!cd) /* a case missing or unreadable: bad input, nothing written */
+        return PPB_REPORT_BAD_INPUT;
+    report_files rf = {0};
+    int rc = write_tables(dir, cases, cd, ncases, &rf, err);
     if (rc == 0)
-        rc = write_readme(dir, cases, cd, ncases, err);
+        rc = write_readme(dir, cases, cd, ncases, &rf, err);
     free_cases(cd, ncases);
-    if (rc == 0) /* issue 16: the last line says where the results went, as `run` does */
-        fprintf(stderr, "ppbench report: wrote %s (%d files)\n", dir,
-                (int)(sizeof outs / sizeof outs[0]));
-    return rc;
+    ppb_apath *names[REPORT_FILES] = {&rf.f[0].name, &rf.f[1].name, &rf.f[2].name};
+    if (rc) {
+        for (int i = 0; i < REPORT_FILES; i++) /* open or closed, its temporary goes */
+            ppb_afile_abort(&rf.f[i]);
+        return -1;
+    }
+    if (ppb_apaths_commit(names, REPORT_FILES, err))
+        return -1;
+    for (int i = 0; i < REPORT_FILES; i++)
+        fprintf(stderr, "ppbench report: wrote %s\n", names[i]->path);
+    /* issue 16: the last line says where the results went, as `run` does */
+    fprintf(stderr, "ppbench report: wrote %s (%d files)\n", dir, REPORT_FILES);
+    return 0;
 }

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/progress.h"
 #include "base/csv_read.h"
 #include "drivers/experiment.h"
 #include "io/csv.h"
@@ -15,7 +16,11 @@
 #include "methods/registry.h"
 #include "model/config.h"
 
-enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2 };
+enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
+
+/* The start of the first line of provenance.txt in score's output set: what marks a directory
+ * as one (ppb_out_claim). */
+static const char score_mark[] = "# ppbench score provenance";
 
 /* The experiment's config from DIR/provenance.txt: its "section.key = value" lines from
  * experiment.name on (the resolved config, model/config.h) applied as --set options would be
@@ -134,7 +139,50 @@ static int same_file(const char *a, const char *b)
            sa.st_ino == sb.st_ino;
 }
 
-int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir)
+/* Score's files, under dir: provenance.txt (what was scored against what) and the CSVs. */
+static int write_set(const char *dir, const char *ref_dir, const char *radiance,
+                     const ppb_config *cfg, const ppb_result *res, int n, const ppb_method *refm,
+                     ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/provenance.txt", dir);
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    fprintf(af.f, "%s: what produced the files beside this one\n", score_mark);
+    fprintf(af.f, "score.ref = %s\nscore.radiance = %s\n", ref_dir, radiance);
+    if (ppb_afile_commit(&af, err))
+        return -1;
+    static const char *const files[] = {"summary.csv", "rms.csv", "regions.csv", "totals.csv"};
+    for (int f = 0; f < 4; f++) {
+        snprintf(path, sizeof path, "%s/%s", dir, files[f]);
+        int rc = f == 0   ? ppb_write_summary_csv(path, res, n, &res[0], refm->also, err)
+                 : f == 1 ? ppb_write_rms_csv(path, &cfg->scene, res, n, &res[0], refm->also, err)
+                 : f == 2
+                     ? ppb_write_regions_csv(path, &cfg->scene, res, n, &res[0], refm->also, err)
+                     : ppb_write_totals_csv(path, res + 1, n - 1, err);
+        if (rc)
+            return -1;
+    }
+    return 0;
+}
+
+/* Any incomplete file fails the set (score draws no figures). */
+static int any_bad(const char *rel, const char *why, void *ctx, ppb_err *err)
+{
+    (void)rel;
+    (void)ctx;
+    return ppb_fail(err, "%s", why);
+}
+
+/* An interrupt before the swap: nothing is put in place (the exit code is 130). */
+static int interrupted(ppb_err *err)
+{
+    return ppb_interrupted() ? ppb_fail(err, "interrupted: nothing written") : 0;
+}
+
+int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir,
+                   int quiet)
 {
     if (nargs != 1 || !ref_dir) {
         fprintf(stderr, "ppbench score: usage: ppbench score --ref DIR [--out DIR2] RADIANCE.csv "
@@ -163,9 +211,16 @@ int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const c
                 "ppbench score: --out %s is the experiment's own directory: never written\n", out);
         return EXIT_USAGE;
     }
+    /* Score's output set is its own, replaced whole as run's is (ppb_out_claim): never a
+     * finished run or a user's directory. */
+    ppb_adir ad;
+    if (ppb_out_claim(out, score_mark, &ad, &err)) {
+        fprintf(stderr, "ppbench score: --out %s\n", err.msg);
+        return EXIT_USAGE;
+    }
     static ppb_result res[PPB_MAX_RESULTS];
     char ids[PPB_MAX_RESULTS][32];
-    int nids = 0, n = 0, code = EXIT_RUN;
+    int nids = 0, n = 0, code = EXIT_USAGE; /* a file read below that will not do is bad input */
     ppb_layout lo = ppb_scene_layout(&cfg.scene);
     char path[PPB_PATH_MAX + 64], beside[PPB_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/radiance.csv", ref_dir);
@@ -192,24 +247,24 @@ int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const c
         ppb_fail(&err, "%s: no rows of a method to score (only the reference's)", radiance);
         goto done;
     }
-    if (ppb_mkdirs(out, &err))
+    code = EXIT_RUN;
+    if (ppb_adir_begin(&ad, &err))
         goto done;
-    static const char *const files[] = {"summary.csv", "rms.csv", "regions.csv", "totals.csv"};
-    for (int f = 0; f < 4; f++) {
-        snprintf(path, sizeof path, "%s/%s", out, files[f]);
-        int rc = f == 0   ? ppb_write_summary_csv(path, res, n, &res[0], refm->also, &err)
-                 : f == 1 ? ppb_write_rms_csv(path, &cfg.scene, res, n, &res[0], refm->also, &err)
-                 : f == 2
-                     ? ppb_write_regions_csv(path, &cfg.scene, res, n, &res[0], refm->also, &err)
-                     : ppb_write_totals_csv(path, res + 1, n - 1, &err);
-        if (rc)
-            goto done;
+    if (write_set(ad.tmp, ref_dir, radiance, &cfg, res, n, refm, &err) ||
+        ppb_dir_verify(ad.tmp, any_bad, NULL, &err) || interrupted(&err)) {
+        ppb_adir_abort(&ad);
+        goto done;
     }
-    fprintf(stderr, "score: wrote %s\n", out);
+    if (ppb_adir_commit(&ad, &err))
+        goto done;
+    if (!quiet)
+        fprintf(stderr, "score: wrote %s\n", out);
     code = EXIT_OK;
 done:
     if (code)
         fprintf(stderr, "ppbench score: %s\n", err.msg);
+    if (code && ppb_interrupted())
+        code = EXIT_INTERRUPTED;
     for (int i = 0; i < n; i++)
         ppb_result_free(&res[i]);
     return code;

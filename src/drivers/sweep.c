@@ -39,13 +39,14 @@ static uint64_t point_hash(const ppb_config *pt)
     return h;
 }
 
-/* A point's files hold only what the point's settings determine: points/<hash>.rows.csv its
+/* A point's files hold only what the point's settings determine: points/<hash>.rows2.csv its
  * rows from the method on (method, RMS, noise, totals), points/<hash>.seconds its wall time.
  * The point index and the swept values are the grid's, not the point's: they are prefixed when
  * sweep.csv is assembled, from the grid of that run (grid.txt), so a grid grown by a value or an
  * axis reuses its finished points under their new index and columns. (Files of the earlier
- * form, points/<hash>.csv, carried both and are not read: such points are computed again.) */
-#define ROWS_EXT    "rows.csv"
+ * forms are not read: points/<hash>.csv carried both; points/<hash>.rows.csv lacked the noise
+ * and excess of every cell. Such points are computed again.) */
+#define ROWS_EXT    "rows2.csv"
 #define SECONDS_EXT "seconds"
 
 static void point_file(const char *dir, uint64_t h, const char *ext, char *buf, size_t n)
@@ -68,9 +69,13 @@ static void write_header(const ppb_grid *grid, FILE *f)
         fprintf(f, ",%s", name);
     }
     fprintf(f, ",method");
-    for (int c = 0; c < PPB_NCELLS; c++)
-        fprintf(f, ",rms_%s", ppb_cell_name(c));
-    fprintf(f, ",noise_R_x0,noise_T_x0,R,T,sides,absorbed,ballistic,specular\n");
+    /* rms_rel, noise_rel and rms_excess of every summary cell (model/metrics.h), each kind
+     * in the cells' order; the noise of R_x0 and T_x0 first, where it always was */
+    static const char *const kinds[3] = {"rms", "noise", "excess"};
+    for (int k = 0; k < 3; k++)
+        for (int c = 0; c < PPB_NCELLS; c++)
+            fprintf(f, ",%s_%s", kinds[k], ppb_cell_name(c));
+    fprintf(f, ",R,T,sides,absorbed,ballistic,specular\n");
 }
 
 /* One row per method of a point, from the method on: the RMS per summary cell against the
@@ -87,20 +92,23 @@ static int write_rows(const ppb_experiment *ex, FILE *f, ppb_err *err)
         return ppb_fail(err, "sweep: out of memory for %d cell points", cap);
     for (int m = 0; m < ex->n; m++) {
         fprintf(f, "%s", ex->res[m].method);
-        ppb_rms x0[2] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
+        ppb_rms e[PPB_NCELLS];
         for (int c = 0; c < PPB_NCELLS; c++) {
             int np = ref ? ppb_cell_points(lo, c, pts, cap) : 0;
-            ppb_rms e = {NAN, NAN, NAN};
+            e[c] = (ppb_rms){NAN, NAN, NAN};
             if (np > 0 && &ex->res[m] != ref)
-                e = ppb_rms_points(&ex->res[m], ref, pts, np);
-            if (c < 2)
-                x0[c] = e;
-            fprintf(f, ",%.6g", e.rms_rel);
+                e[c] = ppb_rms_points(&ex->res[m], ref, pts, np);
         }
+        for (int c = 0; c < PPB_NCELLS; c++)
+            fprintf(f, ",%.6g", e[c].rms_rel);
+        for (int c = 0; c < PPB_NCELLS; c++)
+            fprintf(f, ",%.6g", e[c].noise_rel);
+        for (int c = 0; c < PPB_NCELLS; c++)
+            fprintf(f, ",%.6g", e[c].rms_excess);
         ppb_totals t = ex->res[m].totals;
         ppb_totals_complete(&t);
-        fprintf(f, ",%.6g,%.6g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", x0[0].noise_rel,
-                x0[1].noise_rel, t.R, t.T, t.sides, t.absorbed, t.ballistic, t.specular);
+        fprintf(f, ",%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", t.R, t.T, t.sides, t.absorbed,
+                t.ballistic, t.specular);
     }
     free(pts);
     return 0;
@@ -375,7 +383,9 @@ static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t
     ppb_progress_begin(&pr, cfg->name, "points", (double)n, quiet);
     /* One context for every point: what methods keep in it (the marcher's tables, shared by
      * the points of one medium) is built once per process. */
-    ppb_run_ctx ctx = {.device_selector = o->device, .quiet = 1, .ref_cache = o->ref_cache};
+    ppb_run_ctx ctx = {.device_selector = o->device,
+                       .quiet = o->quiet ? 2 : 1, /* a point's progress: never */
+                       .ref_cache = o->ref_cache};
     long long done = 0;
     int rc = 0;
     for (long long i = part; i < n && rc == 0 && !ppb_interrupted(); i += parts) {
@@ -522,8 +532,9 @@ int ppb_sweep_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_sweep_o
     long long missing = assemble(dirs, 1, cfg->out_dir, err);
     if (missing < 0)
         return -1;
-    if (missing == 0 && ppb_sweep_heatmaps(cfg, grid, cfg->out_dir, err))
-        return -1;
+    ppb_figures fig = {.who = cfg->name};
+    if (missing == 0)
+        ppb_sweep_heatmaps(cfg, grid, cfg->out_dir, &fig); /* a figure left out is said there */
     if (!o->quiet && missing)
         fprintf(stderr, "%s: %lld points left to other shards; merge when done\n", cfg->name,
                 missing);

@@ -2,7 +2,7 @@
  *
  * A config whose numeric keys hold lists expands into the Cartesian product of its values.
  * Every grid point runs every method; its rows of sweep.csv from the method on (RMS at x = 0
- * and per surface, noise floor, totals) are written atomically to points/<hash>.rows.csv, the
+ * and per surface, noise floor, totals) are written atomically to points/<hash>.rows2.csv, the
  * hash being that of the point's resolved settings, so a re-run skips finished points and
  * recomputes changed ones; the point index and swept values are prefixed from the current grid
  * (grid.txt) when sweep.csv is assembled, so a grown grid reuses its finished points.

@@ -15,10 +15,11 @@
 #define MAX_ROWS_PANELS 6 /* panels of the third axis drawn; more are said in the title */
 
 /* One row of sweep.csv reduced to what is plotted: the grid indices of the first three axes
- * and the RMS (%) of R_x0 and T_x0. */
+ * and, in %, the RMS, the Monte Carlo's noise floor and the RMS beyond it (rms_excess,
+ * model/metrics.h) of R_x0 and T_x0. */
 typedef struct cell_row {
     int ix[3];
-    double rms[2];
+    double rms[2], noise[2], excess[2];
 } cell_row;
 
 static int value_index(const ppb_axis *a, double v)
@@ -38,24 +39,27 @@ static int read_rows(const ppb_grid *grid, const char *csv, const char *method, 
     ppb_csv c;
     if (ppb_csv_open(&c, csv, err))
         return -1;
-    int axis[PPB_MAX_AXES], col_method = -1, col_rms[2] = {-1, -1}, rc = 0, n = 0, cap = 0;
+    int axis[PPB_MAX_AXES], col_method = -1, col[3][2] = {{-1, -1}, {-1, -1}, {-1, -1}}, rc = 0,
+                            n = 0, cap = 0;
+    static const char *const kinds[3] = {"rms", "noise", "excess"};
     cell_row *rows = NULL;
     char name[80];
     for (int a = 0; a < grid->naxes && rc == 0; a++) {
         ppb_config_key_name(grid->axes[a].key, name, sizeof name);
         rc = (axis[a] = ppb_csv_need(&c, name, err)) < 0;
     }
-    for (int k = 0; k < 2 && rc == 0; k++) {
-        snprintf(name, sizeof name, "rms_%s", ppb_cell_name(k));
-        rc = (col_rms[k] = ppb_csv_need(&c, name, err)) < 0;
-    }
+    for (int q = 0; q < 3; q++)
+        for (int k = 0; k < 2 && rc == 0; k++) {
+            snprintf(name, sizeof name, "%s_%s", kinds[q], ppb_cell_name(k));
+            rc = (col[q][k] = ppb_csv_need(&c, name, err)) < 0;
+        }
     if (rc == 0)
         rc = (col_method = ppb_csv_need(&c, "method", err)) < 0;
     while (rc == 0 && (rc = ppb_csv_next(&c, err)) == 1) {
         rc = 0;
         if (strcmp(ppb_csv_get(&c, col_method), method))
             continue;
-        cell_row r = {{0, 0, 0}, {0, 0}};
+        cell_row r = {{0, 0, 0}, {0, 0}, {0, 0}, {0, 0}};
         int keep = 1;
         for (int a = 0; a < grid->naxes && keep; a++) {
             int k = value_index(&grid->axes[a], strtod(ppb_csv_get(&c, axis[a]), NULL));
@@ -65,8 +69,11 @@ static int read_rows(const ppb_grid *grid, const char *csv, const char *method, 
         }
         if (!keep)
             continue;
-        for (int k = 0; k < 2; k++)
-            r.rms[k] = 100 * strtod(ppb_csv_get(&c, col_rms[k]), NULL);
+        for (int k = 0; k < 2; k++) {
+            r.rms[k] = 100 * strtod(ppb_csv_get(&c, col[0][k]), NULL);
+            r.noise[k] = 100 * strtod(ppb_csv_get(&c, col[1][k]), NULL);
+            r.excess[k] = 100 * strtod(ppb_csv_get(&c, col[2][k]), NULL);
+        }
         if (n == cap) {
             cap = cap ? 2 * cap : 64;
             cell_row *grown = realloc(rows, (size_t)cap * sizeof *rows);
@@ -98,9 +105,12 @@ static void emit_tics(FILE *gp, const char *which, const ppb_axis *a)
     fprintf(gp, ")\n");
 }
 
-/* The heat map script of one method: a row of panels (R, T) per value of the third axis. */
-static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, const cell_row *rows,
-                         int n)
+/* The heat map script of one method (its id is ARG3, data to gnuplot): a row of panels (R, T)
+ * per value of the third axis. The colour and the number in a cell are the RMS beyond the Monte
+ * Carlo's noise (rms_excess): an RMS within the noise is no measured error, so such a cell is
+ * grey and says "noise" (the RMS alone read as an error of the method where it is the
+ * reference's own noise). */
+static void emit_heatmap(FILE *gp, const ppb_grid *grid, const cell_row *rows, int n)
 {
     char xname[64], yname[64], zname[64] = "", rest[512] = "";
     ppb_config_key_name(grid->axes[0].key, xname, sizeof xname);
@@ -119,9 +129,9 @@ static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, con
     double lo = INFINITY, hi = -INFINITY;
     for (int i = 0; i < n; i++)
         for (int k = 0; k < 2; k++)
-            if (isfinite(rows[i].rms[k]) && rows[i].ix[2] < shown) {
-                lo = fmin(lo, rows[i].rms[k]);
-                hi = fmax(hi, rows[i].rms[k]);
+            if (rows[i].excess[k] > 0 && isfinite(rows[i].excess[k]) && rows[i].ix[2] < shown) {
+                lo = fmin(lo, rows[i].excess[k]);
+                hi = fmax(hi, rows[i].excess[k]);
             }
     if (!(hi >= lo))
         lo = 0, hi = 1;
@@ -132,15 +142,19 @@ static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, con
             fprintf(gp, "$d%d_%d << EOD\n", z, k);
             for (int i = 0; i < n; i++)
                 if (rows[i].ix[2] == z)
-                    fprintf(gp, "%d %d %.6g\n", rows[i].ix[0], rows[i].ix[1], rows[i].rms[k]);
+                    fprintf(gp, "%d %d %.6g %d\n", rows[i].ix[0], rows[i].ix[1], rows[i].excess[k],
+                            isfinite(rows[i].rms[k]) && rows[i].excess[k] == 0);
             fprintf(gp, "EOD\n");
         }
-    fprintf(gp, "@viridis\nset cbrange [%.6g:%.6g]\nset cblabel 'RMS (%%)' offset 1.5, 0\n", lo,
-            hi);
     fprintf(gp,
-            "set multiplot layout %d,2 title '%s: RMS against mc at x = 0 (%%), values in the "
-            "cells%s%s'\n",
-            shown, method, rest, nz > shown ? "; the third key's first values only" : "");
+            "@viridis\nset cbrange [%.6g:%.6g]\nset cblabel 'RMS beyond the MC noise (%%)' "
+            "offset 1.5, 0\n",
+            lo, hi);
+    fprintf(gp,
+            "set multiplot layout %d,2 title ARG3.': RMS against mc at x = 0 beyond the Monte "
+            "Carlo noise (rms_excess, %%), values in the cells; grey: within the noise "
+            "floor%s%s'\n",
+            shown, rest, nz > shown ? "; the third key's first values only" : "");
     fprintf(gp, "set xrange [-0.5:%d.5]\nset yrange [-0.5:%d.5]\n", grid->axes[0].n - 1,
             grid->axes[1].n - 1);
     emit_tics(gp, "xtics", &grid->axes[0]);
@@ -156,14 +170,20 @@ static void emit_heatmap(FILE *gp, const ppb_grid *grid, const char *method, con
                 snprintf(zt, sizeof zt, ", %s = %g", zname, grid->axes[2].values[z]);
             fprintf(gp, "set title '%s%s'\n", k == 0 ? "R (S1)" : "T (S2)", zt);
             fprintf(gp,
-                    "plot $d%d_%d using 1:2:3 with image, $d%d_%d using 1:2:(sprintf('%%.1f', "
-                    "$3)):($3 > %.6g ? 0 : 0xffffff) with labels tc rgb variable\n",
-                    z, k, z, k, mid);
+                    "plot $d%d_%d using 1:2:3 with image, "
+                    "$d%d_%d using ($4 != 0 ? $1 : NaN):2:(0.5):(0.5) with boxxyerror fs solid "
+                    "noborder fc rgb '#BBBBBB', "
+                    "$d%d_%d using 1:2:($4 != 0 ? 'noise' : sprintf('%%.1f', $3)):"
+                    "($4 != 0 || $3 > %.6g ? 0 : 0xffffff) with labels tc rgb variable\n",
+                    z, k, z, k, z, k, mid);
         }
     fprintf(gp, "unset multiplot\n");
 }
 
-/* The 1-D sweep's script: RMS of R and T against the swept value, a line per method. */
+/* The 1-D sweep's script: the RMS of R and T beyond the Monte Carlo's noise (rms_excess)
+ * against the swept value, a line per method, and the noise floor itself dashed ($floor_k:
+ * the noise is the reference's, the same in every method's row). The x range is padded so a
+ * point at the first or last value is not drawn on the frame. */
 static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, const char *csv,
                       ppb_err *err)
 {
@@ -181,15 +201,24 @@ static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, con
         for (int k = 0; k < 2; k++) {
             fprintf(gp, "$m%d_%d << EOD\n", nm, k);
             for (int i = 0; i < n; i++)
-                fprintf(gp, "%.17g %.6g\n", grid->axes[0].values[rows[i].ix[0]], rows[i].rms[k]);
+                fprintf(gp, "%.17g %.6g\n", grid->axes[0].values[rows[i].ix[0]], rows[i].excess[k]);
+            fprintf(gp, "EOD\n");
+            if (nm > 0)
+                continue;
+            fprintf(gp, "$floor%d << EOD\n", k);
+            for (int i = 0; i < n; i++)
+                fprintf(gp, "%.17g %.6g\n", grid->axes[0].values[rows[i].ix[0]], rows[i].noise[k]);
             fprintf(gp, "EOD\n");
         }
         free(rows);
         nm++;
     }
     fprintf(gp,
-            "set multiplot layout 1,2 title 'RMS against mc at x = 0 over %s'\nset grid\n"
-            "set xlabel '%s'\nset ylabel 'RMS (%%)'\nset key outside right top vertical\n",
+            "set multiplot layout 1,2 title 'RMS against mc at x = 0 beyond the Monte Carlo "
+            "noise (rms_excess) over %s; dashed: the noise floor'\nset grid\n"
+            "set xlabel '%s'\nset ylabel 'RMS beyond the MC noise (%%)'\n"
+            "set key outside right top vertical\nset offsets graph 0.06, graph 0.06, graph "
+            "0.06, 0\nset yrange [0:*]\n",
             xname, xname);
     for (int k = 0; k < 2; k++) {
         fprintf(gp, "set title '%s'\nplot ", k == 0 ? "R (S1)" : "T (S2)");
@@ -204,37 +233,41 @@ static int emit_lines(FILE *gp, const ppb_config *cfg, const ppb_grid *grid, con
                     j ? ", " : "", j, k, id, id, id);
             j++;
         }
+        if (nm > 0)
+            fprintf(gp,
+                    ", $floor%d using 1:2 with lines dt 2 lw 1.5 lc rgb 'black' title 'MC "
+                    "noise floor'",
+                    k);
         fprintf(gp, "%s\n", j ? "" : "NaN notitle");
     }
     fprintf(gp, "unset multiplot\n");
     return 0;
 }
 
-/* Draws one figure as <base>.png and <base>.pdf: method NULL is the 1-D line plot. */
-static int draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, const char *base,
-                const char *method, ppb_err *err)
+/* Draws one figure as <base>.png and <base>.pdf: method NULL is the 1-D line plot. A figure
+ * that cannot be drawn is added to fig and left out (reference: Sweeps). */
+static void draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, const char *base,
+                 const char *method, ppb_figures *fig)
 {
-    char csv[1200];
+    char csv[1200], why[2048];
     snprintf(csv, sizeof csv, "%s/sweep.csv", dir);
     cell_row *rows = NULL;
     int n = 0;
-    if (method && read_rows(grid, csv, method, &rows, &n, err))
-        return -1;
+    ppb_err err;
+    if (method && read_rows(grid, csv, method, &rows, &n, &err)) {
+        ppb_figures_fail(fig, base, err.msg);
+        return;
+    }
     int nz = grid->naxes >= 3 ? grid->axes[2].n : 1;
     int shown = nz <= MAX_ROWS_PANELS ? nz : MAX_ROWS_PANELS;
-    int rc = 0;
-    for (int t = 0; t < 2 && rc == 0; t++) {
+    for (int t = 0; t < 2; t++) {
         char path[1300];
         snprintf(path, sizeof path, "%s/%s.%s", dir, base, t ? "pdf" : "png");
-        ppb_apath ap; /* gnuplot opens the file by name: it writes the temporary */
-        if (ppb_apath_begin(&ap, path, err)) {
-            rc = -1;
-            break;
-        }
-        FILE *gp = popen("gnuplot 2>/dev/null", "w");
+        char *text = NULL;
+        size_t len = 0;
+        FILE *gp = open_memstream(&text, &len);
         if (!gp) {
-            ppb_apath_abort(&ap);
-            rc = ppb_fail(err, "cannot start gnuplot for %s", path);
+            ppb_figures_fail(fig, base, "out of memory");
             break;
         }
         int h = method ? 60 + 330 * shown : 420;
@@ -243,26 +276,31 @@ static int draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, co
                     h / 100.0);
         else
             fprintf(gp, "set terminal pngcairo size 1000,%d font ',10' noenhanced\n", h);
-        fprintf(gp, "set output '%s'\nload '%s/plot_style.gp'\n", ap.tmp, ppb_plots_script_dir());
+        fprintf(gp, "set output ARG1\nload ARG2\n");
+        int rc = 0;
         if (method)
-            emit_heatmap(gp, grid, method, rows, n);
+            emit_heatmap(gp, grid, rows, n);
         else
-            rc = emit_lines(gp, cfg, grid, csv, err);
-        if (pclose(gp) != 0 && rc == 0)
-            rc = ppb_fail(err, "gnuplot failed drawing %s", path);
-        if (rc == 0)
-            rc = ppb_apath_commit(&ap, err);
+            rc = emit_lines(gp, cfg, grid, csv, &err);
+        fclose(gp);
+        if (rc)
+            snprintf(why, sizeof why, "%s", err.msg);
         else
-            ppb_apath_abort(&ap);
+            rc = ppb_gnuplot_figure(path, text, len, method ? method : cfg->name, why, sizeof why);
+        free(text);
+        if (rc) {
+            ppb_figures_fail(fig, base, why);
+            break;
+        }
     }
     free(rows);
-    return rc;
 }
 
-int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir, ppb_err *err)
+void ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir,
+                        ppb_figures *fig)
 {
     if (grid->naxes < 1)
-        return 0;
+        return;
     int has_reference = 0, compared = 0;
     for (int m = 0; m < cfg->nmethods; m++) {
         int ref = ppb_method_find(cfg, cfg->methods[m])->reference == 1;
@@ -272,17 +310,17 @@ int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *
     /* No Monte Carlo: sweep.csv holds no RMS to draw, only totals. The Monte Carlo alone: no
      * method is measured against it, so there is no curve (gnuplot refuses an empty plot). */
     if (!has_reference || compared == 0)
-        return 0;
-    if (grid->naxes == 1)
-        return draw(cfg, grid, dir, "sweep_rms", NULL, err);
+        return;
+    if (grid->naxes == 1) {
+        draw(cfg, grid, dir, "sweep_rms", NULL, fig);
+        return;
+    }
     for (int m = 0; m < cfg->nmethods; m++) {
         const char *id = cfg->methods[m];
         if (ppb_method_find(cfg, id)->reference == 1)
             continue; /* the reference: its RMS against itself is empty */
         char base[128];
         snprintf(base, sizeof base, "heatmap_%s", id);
-        if (draw(cfg, grid, dir, base, id, err))
-            return -1;
+        draw(cfg, grid, dir, base, id, fig);
     }
-    return 0;
 }

@@ -9,10 +9,13 @@
 #ifndef PPB_SWEEP_PLOT_H
 #define PPB_SWEEP_PLOT_H
 
-#include "base/err.h"
+#include "io/plots.h"
 #include "model/config.h"
 #include "model/grid.h"
 
-int ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir, ppb_err *err);
+/* Draws the figures above; one that cannot be drawn is said on stderr and in fig, and left
+ * out: a sweep's figures never fail it (reference: Sweeps). */
+void ppb_sweep_heatmaps(const ppb_config *cfg, const ppb_grid *grid, const char *dir,
+                        ppb_figures *fig);
 
 #endif

@@ -30,10 +30,12 @@
  *                       the relative error e = (L_m - L_ref) / L_ref, clamped to +-50%,
  *                       diverging map blue (-50%) .. light grey (0) .. red (+50%), linear in
  *                       sRGB bytes between those three stops; black where L_ref <= 0 or L_m is
- *                       not finite (no relative error). Bare pixels, same size as <method>.png:
- *                       scripts/plots.sh composes them into the titled error_<method>.png
- *                       with a numbered colour bar, and the per-method PNGs into the labelled
- *                       all.png (reference: Outputs).
+ *                       not finite (no relative error). The map is the size of <method>.png;
+ *                       a strip of BAR_STRIP pixels at its right holds the colour bar, ticked
+ *                       and labelled +50%, +25%, 0, -25%, -50%, so the file reads on its own.
+ *                       scripts/plots.sh composes the map (without the strip) into the titled
+ *                       error_<method>.png with gnuplot's numbered colour bar, and the
+ *                       per-method PNGs into the labelled all.png (reference: Outputs).
  * Nothing is written in slab mode. */
 #include "io/images.h"
 
@@ -277,13 +279,70 @@ static void error_colour(double e, unsigned char *px)
         px[k] = (unsigned char)lround((1 - a) * neutral[k] + a * end[k]);
 }
 
+/* The error map's colour bar: a strip BAR_STRIP pixels wide at the right of the map, the
+ * colour scale from +ERR_CLAMP (top) to -ERR_CLAMP (bottom) between BAR_TOP and BAR_BOTTOM
+ * (rows), ticks and labels at +-ERR_CLAMP, +-ERR_CLAMP / 2 and 0, so the picture reads on its
+ * own (scripts/plots.sh shows the map alone, beside gnuplot's own bar, in error_<m>.png). */
+#define BAR_STRIP  64
+#define BAR_X      (VIEW_NX + 6) /* the bar's first column */
+#define BAR_W      12
+#define BAR_TOP    40
+#define BAR_BOTTOM (PANEL_NY - 40)
+#define GLYPH_S    2 /* a 3 x 5 glyph drawn at this scale */
+
+/* A 3 x 5 glyph of the characters the labels use, a row of 3 bits per line (top first). */
+static const unsigned char *glyph(char ch)
+{
+    static const unsigned char g[][5] = {{7, 5, 5, 5, 7}, {7, 1, 7, 4, 7}, {7, 4, 7, 1, 7},
+                                         {0, 2, 7, 2, 0}, {0, 0, 7, 0, 0}, {5, 1, 2, 4, 5},
+                                         {0, 0, 0, 0, 0}};
+    const char *set = "025+-%";
+    const char *at = strchr(set, ch);
+    return g[at && ch ? at - set : 6];
+}
+
+/* text with its top left corner at (x, y) of an image stride pixels wide. */
+static void draw_text(unsigned char *rgb, int stride, int x, int y, const char *text)
+{
+    static const rgb8 ink = {221, 221, 221};
+    for (; *text; text++, x += 4 * GLYPH_S) {
+        const unsigned char *g = glyph(*text);
+        for (int r = 0; r < 5 * GLYPH_S; r++)
+            for (int col = 0; col < 3 * GLYPH_S; col++)
+                if (g[r / GLYPH_S] & (4 >> (col / GLYPH_S)))
+                    put(rgb + 3 * ((size_t)(y + r) * stride + x + col), ink);
+    }
+}
+
+static void draw_error_bar(unsigned char *rgb, int stride)
+{
+    for (int y = 0; y < PANEL_NY; y++)
+        for (int x = VIEW_NX; x < stride; x++)
+            put(rgb + 3 * ((size_t)y * stride + x), background);
+    for (int y = BAR_TOP; y <= BAR_BOTTOM; y++) {
+        double e = ERR_CLAMP * (1 - 2.0 * (y - BAR_TOP) / (BAR_BOTTOM - BAR_TOP));
+        for (int x = BAR_X; x < BAR_X + BAR_W; x++)
+            error_colour(e, rgb + 3 * ((size_t)y * stride + x));
+    }
+    for (int t = 0; t <= 4; t++) {
+        int y = BAR_TOP + t * (BAR_BOTTOM - BAR_TOP) / 4;
+        for (int x = BAR_X + BAR_W; x < BAR_X + BAR_W + 4; x++)
+            put(rgb + 3 * ((size_t)y * stride + x), neutral);
+        char label[16];
+        double pct = 100 * ERR_CLAMP * (1 - t / 2.0);
+        snprintf(label, sizeof label, t == 2 ? "0" : "%+.0f%%", pct);
+        draw_text(rgb, stride, BAR_X + BAR_W + 6, y - 5 * GLYPH_S / 2, label);
+    }
+}
+
 static int write_error(const img_ctx *c, int i, ppb_err *err)
 {
-    unsigned char *rgb = malloc(3 * PANEL_PIXELS);
+    const int stride = VIEW_NX + BAR_STRIP;
+    unsigned char *rgb = malloc(3 * (size_t)stride * PANEL_NY);
     if (!rgb)
         return ppb_fail(err, "images: out of memory");
     for (size_t k = 0; k < PANEL_PIXELS; k++) {
-        unsigned char *px = rgb + 3 * k;
+        unsigned char *px = rgb + 3 * (k / VIEW_NX * stride + k % VIEW_NX);
         double ref = c->value[c->ref][k];
         if (c->kind[k] != PPB_PIX_SURFACE)
             put(px, c->kind[k] == PPB_PIX_CAP ? cap_colour : background);
@@ -292,9 +351,10 @@ static int write_error(const img_ctx *c, int i, ppb_err *err)
         else
             error_colour((c->value[i][k] - ref) / ref, px);
     }
+    draw_error_bar(rgb, stride);
     char path[1300];
     image_path(c, "errmap_", c->res[i].method, "png", path, sizeof path);
-    int rc = ppb_png_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
+    int rc = ppb_png_write_rgb(path, stride, PANEL_NY, rgb, err);
     free(rgb);
     return rc;
 }

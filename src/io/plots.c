@@ -2,6 +2,7 @@
 #include "io/plots.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <stdlib.h>
@@ -21,22 +22,172 @@ const char *ppb_plots_script_dir(void)
     return (d && *d) ? d : PPB_SCRIPT_DIR;
 }
 
+void ppb_figures_fail(ppb_figures *f, const char *figure, const char *why)
+{
+    char key[600], said[2048];
+    snprintf(key, sizeof key, "figure.%s = ", figure);
+    if (strstr(f->text, key))
+        return;
+    const char *at = f->staged && f->final ? strstr(why, f->staged) : NULL;
+    if (at)
+        snprintf(said, sizeof said, "%.*s%s%s", (int)(at - why), why, f->final,
+                 at + strlen(f->staged));
+    else
+        snprintf(said, sizeof said, "%s", why);
+    why = said;
+    size_t len = strlen(f->text);
+    snprintf(f->text + len, sizeof f->text - len, "%snot drawn: %.300s\n", key, why);
+    f->nfailed++;
+    fprintf(stderr, "%s: figure %s not drawn (the other outputs are written): %s\n",
+            f->who ? f->who : "ppbench", figure, why);
+}
+
+/* gnuplot's reason from its stderr: the last line that is not blank or only the caret under
+ * the failing column, without the "/dev/stdin" it names the script by. */
+static void last_reason(FILE *f, char *why, size_t cap)
+{
+    char line[512];
+    rewind(f);
+    while (fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\n")] = '\0';
+        const char *p = line + strspn(line, " \t^");
+        if (!*p)
+            continue;
+        if (!strncmp(p, "\"/dev/stdin\" ", 13))
+            p += 13;
+        snprintf(why, cap, "%s", p);
+    }
+}
+
+/* Writes all of buf to fd; a gnuplot that stopped reading (it failed early) is no error of
+ * the writer's: SIGPIPE is ignored meanwhile and the exit status tells. */
+static void write_all(int fd, const char *buf, size_t len)
+{
+    struct sigaction ign = {.sa_handler = SIG_IGN}, old;
+    sigemptyset(&ign.sa_mask);
+    sigaction(SIGPIPE, &ign, &old);
+    while (len > 0) {
+        ssize_t w = write(fd, buf, len);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            break;
+        buf += w;
+        len -= (size_t)w;
+    }
+    sigaction(SIGPIPE, &old, NULL);
+}
+
+int ppb_gnuplot_run(const char *script, size_t len, const char *const *args, int nargs, char *why,
+                    size_t cap)
+{
+    enum { MAX_ARGS = 9 }; /* gnuplot's ARG1..ARG9 */
+    const char *argv[MAX_ARGS + 4] = {"gnuplot", "-c", "/dev/stdin"};
+    for (int i = 0; i < nargs && i < MAX_ARGS; i++)
+        argv[3 + i] = args[i];
+    snprintf(why, cap, "gnuplot failed without a message");
+    FILE *errs = tmpfile();
+    int in[2] = {-1, -1};
+    if (!errs || pipe(in) < 0) {
+        snprintf(why, cap, "cannot start gnuplot: %s", strerror(errno));
+        if (errs)
+            fclose(errs);
+        return -1;
+    }
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(in[0], STDIN_FILENO);
+        dup2(fileno(errs), STDOUT_FILENO);
+        dup2(fileno(errs), STDERR_FILENO);
+        close(in[0]);
+        close(in[1]);
+        execvp("gnuplot", (char *const *)argv);
+        fprintf(stderr, "cannot run gnuplot: %s (is it installed?)\n", strerror(errno));
+        _exit(127);
+    }
+    close(in[0]);
+    if (pid > 0)
+        write_all(in[1], script, len);
+    close(in[1]);
+    int status = 0, rc = -1;
+    while (pid > 0 && waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR) /* an interrupt while drawing still waits for gnuplot */
+            break;
+    if (pid < 0)
+        snprintf(why, cap, "cannot start gnuplot: %s", strerror(errno));
+    else if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        rc = 0;
+    else if (WIFSIGNALED(status)) {
+        char last[400] = "";
+        last_reason(errs, last, sizeof last);
+        snprintf(why, cap, "gnuplot was killed by signal %d%s%s", WTERMSIG(status),
+                 last[0] ? ": " : "", last);
+    } else
+        last_reason(errs, why, cap);
+    fclose(errs);
+    return rc;
+}
+
+/* PPB_PLOTS_KEEP=DIR keeps each figure's script as DIR/<file name>.gp, as plots.sh keeps its
+ * bodies (the tests read them). */
+static void keep_script(const char *path, const char *script, size_t len)
+{
+    const char *keep = getenv("PPB_PLOTS_KEEP"), *base = strrchr(path, '/');
+    if (!keep || !*keep)
+        return;
+    char kept[4200];
+    snprintf(kept, sizeof kept, "%s/%s.gp", keep, base ? base + 1 : path);
+    FILE *f = fopen(kept, "w");
+    if (f) {
+        fwrite(script, 1, len, f);
+        fclose(f);
+    }
+}
+
+int ppb_gnuplot_figure(const char *path, const char *script, size_t len, const char *name,
+                       char *why, size_t cap)
+{
+    ppb_apath ap; /* gnuplot opens the file by name: it writes the temporary */
+    ppb_err err;
+    char style[4200];
+    snprintf(style, sizeof style, "%s/plot_style.gp", ppb_plots_script_dir());
+    const char *args[3] = {ap.tmp, style, name ? name : ""};
+    keep_script(path, script, len);
+    if (ppb_apath_begin(&ap, path, &err)) {
+        snprintf(why, cap, "%s", err.msg);
+        return -1;
+    }
+    if (ppb_gnuplot_run(script, len, args, 3, why, cap)) {
+        ppb_apath_abort(&ap);
+        return -1;
+    }
+    /* gnuplot's cairo exits 0 on a full disk, leaving a 0-byte or cut file */
+    if (ppb_file_complete(ap.tmp, &err) || ppb_apath_commit(&ap, &err)) {
+        snprintf(why, cap, "%s", err.msg);
+        ppb_apath_abort(&ap);
+        return -1;
+    }
+    return 0;
+}
+
 /* plots/rte2d_refinements.{png,pdf} from rte2d_refinements.csv (rows K,cell,rms_rel): one line
  * per summary cell (a gnuplot data block each), log-log, the 1 % target dashed, the key
  * outside. S3_all is drawn wide, as S4_all (the same at normal incidence) lies on it. */
 #define REF_CELLS 6
 #define REF_ROWS  64
-static int draw_refinements(const char *dir, const char *name, ppb_err *err)
+static void draw_refinements(const char *dir, const char *name, ppb_figures *fig)
 {
     static const char *const cells[REF_CELLS] = {"R_x0",   "T_x0",   "S1_all",
                                                  "S2_all", "S3_all", "S4_all"};
     static const char *const colour[REF_CELLS] = {"#0072B2", "#D55E00", "#009E73",
                                                   "#CC79A7", "#56B4E9", "#000000"};
     char csv[PPB_PATH_MAX], plots[PPB_PATH_MAX], path[PPB_PATH_MAX + 64], line[256];
+    ppb_err err;
     snprintf(csv, sizeof csv, "%s/rte2d_refinements.csv", dir);
     FILE *f = fopen(csv, "r");
     if (!f)
-        return 0; /* no converged rte2d in this set */
+        return; /* no converged rte2d in this set */
     int K[REF_CELLS][REF_ROWS], n[REF_CELLS] = {0};
     double v[REF_CELLS][REF_ROWS];
     while (fgets(line, sizeof line, f)) {
@@ -53,78 +204,107 @@ static int draw_refinements(const char *dir, const char *name, ppb_err *err)
     }
     fclose(f);
     snprintf(plots, sizeof plots, "%s/plots", dir);
-    if (ppb_mkdirs(plots, err))
-        return -1;
+    if (ppb_mkdirs(plots, &err)) {
+        ppb_figures_fail(fig, "plots/rte2d_refinements", err.msg);
+        return;
+    }
     for (int t = 0; t < 2; t++) {
         snprintf(path, sizeof path, "%s/rte2d_refinements.%s", plots, t ? "pdf" : "png");
-        ppb_apath ap; /* gnuplot opens the file by name: it writes the temporary */
-        if (ppb_apath_begin(&ap, path, err))
-            return -1;
-        fflush(NULL);
-        FILE *gp = popen("gnuplot", "w");
+        char *text = NULL;
+        size_t len = 0;
+        FILE *gp = open_memstream(&text, &len);
         if (!gp) {
-            ppb_apath_abort(&ap);
-            return ppb_fail(err, "cannot start gnuplot for %s", path);
+            ppb_figures_fail(fig, "plots/rte2d_refinements", "out of memory");
+            return;
         }
         if (t)
             fprintf(gp, "set terminal pdfcairo size 8in,4.5in font ',7' noenhanced\n");
         else
             fprintf(gp, "set terminal pngcairo size 800,450 font ',10' noenhanced\n");
-        fprintf(gp, "set output '%s'\nload '%s/plot_style.gp'\n", ap.tmp, ppb_plots_script_dir());
+        fprintf(gp, "set output ARG1\nload ARG2\n");
         for (int c = 0; c < REF_CELLS; c++) {
             fprintf(gp, "$c%d << EOD\n", c);
             for (int i = 0; i < n[c]; i++)
                 fprintf(gp, "%d %.6g\n", K[c][i], 100.0 * v[c][i]);
             fprintf(gp, "EOD\n");
         }
-        fprintf(gp,
-                "set logscale xy\nset grid\nset xrange [0.8:*]\n"
-                "set key outside right top vertical title 'cell'\n"
-                "set title '%s: rte2d after K refinements of Eq. 5 from I_pp, RMS against "
-                "the converged solve'\n"
-                "set xlabel 'refinements K'\nset ylabel 'RMS (%%)'\n"
-                "set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 "
-                "lc rgb '#444444'\n"
-                "plot keyentry with lines dt 2 lc rgb '#444444' title '1 %%'",
-                name); /* config names are [A-Za-z0-9_.+-] */
+        fprintf(gp, "set logscale xy\nset grid\nset xrange [0.8:*]\n"
+                    "set key outside right top vertical title 'cell'\n"
+                    "set title ARG3.': rte2d after K refinements of Eq. 5 from I_pp, RMS against "
+                    "the converged solve'\n"
+                    "set xlabel 'refinements K'\nset ylabel 'RMS (%%)'\n"
+                    "set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 "
+                    "lc rgb '#444444'\n"
+                    "plot keyentry with lines dt 2 lc rgb '#444444' title '1 %%'");
         for (int c = 0; c < REF_CELLS; c++)
             if (n[c])
                 fprintf(gp, ", $c%d using 1:2 with linespoints lw %g pt %d lc rgb '%s' title '%s'",
                         c, c == 4 ? 4.0 : 1.5, 4 + 2 * c, colour[c], cells[c]);
         fprintf(gp, "\n");
-        if (pclose(gp) != 0) {
-            ppb_apath_abort(&ap);
-            return ppb_fail(err, "gnuplot failed drawing %s", path);
+        fclose(gp);
+        char why[512];
+        int rc = ppb_gnuplot_figure(path, text, len, name, why, sizeof why);
+        free(text);
+        if (rc) {
+            ppb_figures_fail(fig, "plots/rte2d_refinements", why);
+            return;
         }
-        if (ppb_apath_commit(&ap, err))
-            return -1;
     }
-    return 0;
 }
 
-int ppb_plots_write(const char *dir, const char *name, ppb_err *err)
+/* The lines plots.sh writes on its stdout, "<figure>\t<why>" for each figure it left out. */
+static void read_failures(FILE *f, ppb_figures *fig)
+{
+    char line[1024];
+    while (fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\n")] = '\0';
+        char *tab = strchr(line, '\t');
+        if (!tab)
+            continue;
+        *tab = '\0';
+        ppb_figures_fail(fig, line, tab + 1);
+    }
+}
+
+void ppb_plots_write(const char *dir, const char *name, ppb_figures *fig)
 {
     char script[4096];
     snprintf(script, sizeof script, "%s/plots.sh", ppb_plots_script_dir());
-    if (access(script, R_OK) != 0)
-        return ppb_fail(err, "cannot read %s (the plot script; PPBENCH_SCRIPTS names its folder)",
-                        script);
+    int out[2];
+    if (access(script, R_OK) != 0 || pipe(out) < 0) {
+        char why[4200];
+        snprintf(why, sizeof why,
+                 "cannot read %s (the plot script; PPBENCH_SCRIPTS names its folder)", script);
+        ppb_figures_fail(fig, "plots", why);
+        return;
+    }
     fflush(NULL); /* the child must not repeat buffered output */
     pid_t pid = fork();
-    if (pid < 0)
-        return ppb_fail(err, "cannot start %s", script);
     if (pid == 0) {
-        /* The script's own messages go to stderr; stdout stays the caller's. */
-        dup2(STDERR_FILENO, STDOUT_FILENO);
+        /* stdout: the figures left out, for read_failures; the rest goes to stderr. */
+        dup2(out[1], STDOUT_FILENO);
+        close(out[0]);
+        close(out[1]);
         execlp("bash", "bash", script, dir, (char *)NULL);
         _exit(127);
     }
+    close(out[1]);
+    FILE *f = pid > 0 ? fdopen(out[0], "r") : NULL;
+    if (f) {
+        read_failures(f, fig);
+        fclose(f);
+    } else {
+        close(out[0]);
+    }
     int status = 0;
-    while (waitpid(pid, &status, 0) < 0)
+    while (pid > 0 && waitpid(pid, &status, 0) < 0)
         if (errno != EINTR) /* an interrupt during plotting still waits for the script */
-            return ppb_fail(err, "lost the plot script %s", script);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        return ppb_fail(err, "%s %s failed (exit %d; is gnuplot installed?)", script, dir,
-                        WIFEXITED(status) ? WEXITSTATUS(status) : -1);
-    return draw_refinements(dir, name, err);
+            break;
+    if (pid < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        char why[4200];
+        snprintf(why, sizeof why, "%s stopped (exit %d); the figures it had not drawn are missing",
+                 script, pid > 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+        ppb_figures_fail(fig, "plots", why);
+    }
+    draw_refinements(dir, name, fig);
 }

@@ -34,7 +34,7 @@ typedef struct ppb_run_ctx {
     const char *device_selector; /* --device, or NULL */
     ppb_ocl ocl;
     int ocl_open;
-    int quiet; /* no progress lines */
+    int quiet; /* 1: no progress lines; 2 (--quiet): nor the reference cache's line */
     /* 1: methods attach their own outputs to their results (ppb_result.extra; `run` writes them
      * with the output set); 0: none are made (a sweep point, which writes no set). */
     int extras;

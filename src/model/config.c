@@ -873,6 +873,22 @@ static void base_name(const char *path, char *out, size_t cap)
     snprintf(out, cap, "%.*s", (int)(n < cap ? n : cap - 1), b);
 }
 
+/* experiment.name from the config file's base name when it has no `name =`: under the same rule
+ * as `name =` (parse_string), as the name reaches figure titles and the output path. */
+static int derive_name(ppb_config *cfg, const char *path, ppb_err *err)
+{
+    char base[sizeof cfg->name], why[512];
+    base_name(path, base, sizeof base);
+    for (int i = 0; i < NKEYS; i++)
+        if (keys[i].type == K_NAME && parse_string(&keys[i], cfg->name, sizeof cfg->name, base, why,
+                                                   sizeof why))
+            return ppb_fail(err,
+                            "%s: the experiment's name, from the file name when the file has no "
+                            "[experiment] name: %s; give a name = line",
+                            path, why);
+    return 0;
+}
+
 static int apply_defaults(ppb_config *cfg, ppb_err *err)
 {
     char why[512];
@@ -917,8 +933,8 @@ static int read_file(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_err 
         return ppb_fail(err, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
     if (rc < 0)
         return ppb_fail(err, "%s: cannot read config", path);
-    if (!cfg->name[0])
-        base_name(path, cfg->name, sizeof cfg->name);
+    if (!cfg->name[0] && derive_name(cfg, path, err))
+        return -1;
     if (!cfg->out_dir[0])
         snprintf(cfg->out_dir, sizeof cfg->out_dir, "results/%s", cfg->name);
     return 0;

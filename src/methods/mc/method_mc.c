@@ -479,8 +479,9 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         return -1;
     if (ctx->ref_cache && ppb_mc_cache_get(ctx, chunk, &t)) {
         /* The same reference was traced before (docs/external.md): no photon is traced now. */
-        fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n", cfg->name,
-                (unsigned long long)t.count, ctx->ref_cache);
+        if (ctx->quiet < 2)
+            fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n",
+                    cfg->name, (unsigned long long)t.count, ctx->ref_cache);
     } else {
         if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
             return -1;
