@@ -44,7 +44,9 @@ theta_l=${theta_l:-0}
 step=$(prov medium.step)
 step_x=$(num "$(prov medium.step_x)" || true)
 sigma_t=$(num "$(prov medium.sigma_t)" || true)
-ref=mc
+# The result the others were measured against (ppbench passes its id), as the CSVs name it.
+ref=${PPB_REFERENCE:-}
+[[ $ref =~ ^[A-Za-z0-9_.+-]*$ ]] || ref=
 # Method ids are read from the CSVs only as ppbench's config allows them ([A-Za-z0-9_.+-], the
 # grep after each list below): the only CSV text the gnuplot scripts hold.
 # failed FIGURE WHY: the figure is left out, said on stdout (fd 3).

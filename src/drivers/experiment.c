@@ -438,7 +438,16 @@ static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
         ppb_remove_tree(path, &ignored);
         ppb_figures_fail(&fig, "images", why.msg);
     }
-    ppb_plots_write(dir, ex->cfg->name, &fig); /* last: the figures read the files above */
+    /* Last: the figures read the files above. Then each method's own, once per method. */
+    ppb_plots_write(dir, ref ? ref->method : NULL, &fig);
+    for (int i = 0; i < ex->n; i++) {
+        const ppb_method *m = ppb_method_find(ex->cfg, ex->res[i].method);
+        int first = 1;
+        for (int j = 0; j < i; j++)
+            first &= ppb_method_find(ex->cfg, ex->res[j].method) != m;
+        if (m && m->draw && first)
+            m->draw(dir, ex->cfg->name, &fig);
+    }
     void *ctx[2] = {(void *)ad, &fig};
     if (ppb_dir_verify(dir, bad_file, ctx, err))
         return -1;

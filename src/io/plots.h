@@ -1,8 +1,8 @@
 /* plots.h: an output set's figures (reference: Outputs): runs scripts/plots.sh, which draws them
  * with gnuplot from the set's CSVs and images into <dir>/plots/ and <dir>/images/ (PNG and PDF).
- * Owns the running of the script (what it plots and how is the script's), one figure of its
- * own, plots/rte2d_refinements.{png,pdf} from rte2d_refinements.csv when the set has one, and
- * the one way ppbench runs gnuplot from C (ppb_gnuplot_run). Found as $PPBENCH_SCRIPTS/plots.sh,
+ * Owns the running of the script (what it plots and how is the script's) and the one way
+ * ppbench runs gnuplot from C (ppb_gnuplot_run, ppb_gnuplot_figure), which a method's own
+ * figures use (method.h: draw). Found as $PPBENCH_SCRIPTS/plots.sh,
  * else PPB_SCRIPT_DIR/plots.sh (the Makefile sets the source tree's scripts/), as the kernels
  * are found.
  *
@@ -48,9 +48,9 @@ int ppb_gnuplot_run(const char *script, size_t len, const char *const *args, int
 int ppb_gnuplot_figure(const char *path, const char *script, size_t len, const char *name,
                        char *why, size_t cap);
 
-/* Draws the figures of the output set in dir (already holding its CSVs, provenance.txt and
- * images) of the experiment called name (the figures' titles); each one not drawn is added
- * to fig. */
-void ppb_plots_write(const char *dir, const char *name, ppb_figures *fig);
+/* Draws the figures of the output set in dir (already holding its CSVs, provenance.txt, which
+ * names the experiment, and images), ref the id of the result the others were measured
+ * against (NULL: none); each one not drawn is added to fig. */
+void ppb_plots_write(const char *dir, const char *ref, ppb_figures *fig);
 
 #endif

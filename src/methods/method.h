@@ -8,6 +8,7 @@
 #ifndef PPB_METHOD_H
 #define PPB_METHOD_H
 
+#include "io/plots.h"
 #include "model/config.h"
 #include "runtime/ocl.h"
 #include "model/result.h"
@@ -93,6 +94,10 @@ typedef struct ppb_method {
     /* Prints "NAME: ID: work: ..." for a method whose work scales with the settings, before it
      * runs (id: the config's id, a sum's for its parts); NULL: nothing to say. */
     void (*work)(const ppb_config *cfg, const char *id, FILE *f);
+    /* Draws the method's own figures from its own files in the output set dir (rte2d's
+     * refinement study), the experiment called name; one not drawn is added to fig. NULL:
+     * none (the common figures are scripts/plots.sh's). */
+    void (*draw)(const char *dir, const char *name, ppb_figures *fig);
     /* Its benchmark in `ppbench perf` under the heading perf_title; NULL: none. */
     const char *perf_title;
     int (*perf)(ppb_run_ctx *ctx, FILE *out, ppb_err *err);

@@ -68,6 +68,7 @@ static const ppb_method methods[] = {
      .summary = "the tube's transfer solved: the paper's refinement iterated",
      .run = ppb_method_rte2d,
      .section = "rte2d",
+     .draw = ppb_rte2d_draw,
      .perf_title = "rte2d: the refinement iterated (OpenCL marches)",
      .perf = ppb_perf_rte2d},
 };

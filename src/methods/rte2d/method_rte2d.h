@@ -59,4 +59,8 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
  * or holds no rung. */
 int ppb_rte2d_write_refinements(const ppb_rte2d_study *study, const char *dir, ppb_err *err);
 
+/* plots/rte2d_refinements.{png,pdf} from dir's rte2d_refinements.csv, when the set has one (the
+ * registry's draw hook). */
+void ppb_rte2d_draw(const char *dir, const char *name, ppb_figures *fig);
+
 #endif
