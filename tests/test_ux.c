@@ -14,6 +14,8 @@
  * - the study README (report): Table 2 wide (cases x methods), the noise floor from the
  *   Monte Carlo's own standard errors, the photon budget, a footer naming only files that
  *   exist and are committed (not radiance.csv).
+ * - run and score end with the summary table on stdout (rms_excess and noise_rel per summary
+ *   cell, summary.csv's numbers); --quiet leaves it out.
  * Photon budgets and grids are tiny. */
 #define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "cliutil.h"
@@ -381,6 +383,78 @@ static void test_report_readme(void **state)
                  named, foot);
 }
 
+/* The table a run and a score print on stdout (docs/reference.md: Outputs, "The table on
+ * stdout"): a title, a header with the summary cells, one row per measured method with
+ * "rms_excess (noise_rel)" in % at each cell. Expected values: the same run's summary.csv (the
+ * metrics of docs/reference.md: Metrics, printed there to 6 digits), times 100, to the
+ * table's 2 decimals (0.005 + the CSV's rounding). The reference (mc) and its companion (mc1)
+ * have no row. --quiet prints nothing on stdout. */
+static void check_table(const char *out, const char *summary_csv)
+{
+    static const char *const cells[] = {"R_x0", "T_x0", "S1_all", "S2_all", "S3_all", "S4_all"};
+    if (!strstr(out, ": rms_excess against mc in % (noise_rel in parentheses; summary.csv)\n"))
+        fail_msg("no table title on stdout:\n%s", out);
+    const char *hdr = strstr(out, "\nmethod ");
+    if (!hdr)
+        fail_msg("no table header on stdout:\n%s", out);
+    for (int c = 0; c < 6; c++)
+        if (!strstr(hdr, cells[c]))
+            fail_msg("the table header lacks %s:\n%s", cells[c], out);
+    const char *row = strstr(out, "\nss ");
+    if (!row || strstr(out, "\nmc ") || strstr(out, "\nmc1 "))
+        fail_msg("want a row for ss and none for mc, mc1:\n%s", out);
+    double ex[6], nz[6];
+    if (sscanf(row + 4, " %lf (%lf) %lf (%lf) %lf (%lf) %lf (%lf) %lf (%lf) %lf (%lf)", &ex[0],
+               &nz[0], &ex[1], &nz[1], &ex[2], &nz[2], &ex[3], &nz[3], &ex[4], &nz[4], &ex[5],
+               &nz[5]) != 12)
+        fail_msg("the ss row does not hold 6 'excess (noise)' pairs:\n%s", out);
+    const char *csv = tu_read_text(summary_csv);
+    for (int c = 0; c < 6; c++) {
+        char key[64];
+        snprintf(key, sizeof key, "\nss,%s,", cells[c]);
+        const char *l = strstr(csv, key);
+        double rms, noise, excess;
+        if (!l || sscanf(l + strlen(key), "%lf,%lf,%lf", &rms, &noise, &excess) != 3)
+            fail_msg("summary.csv lacks %s:\n%s", key + 1, csv);
+        assert_close(ex[c], 100.0 * excess, 0.0051);
+        assert_close(nz[c], 100.0 * noise, 0.0051);
+    }
+}
+
+static void test_run_and_score_print_summary_table(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxtable", tiny);
+    char s[1100], dir[1300], path[1400];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxtable_out"));
+    snprintf(dir, sizeof dir, "%s/out", s);
+    assert_int_equal(tu_sh("%s run --no-ref-cache %s --out %s > %s/stdout 2> %s/stderr", tu_bin(),
+                           cfg, dir, s, s),
+                     0);
+    snprintf(path, sizeof path, "%s/summary.csv", dir);
+    char csvpath[1400];
+    snprintf(csvpath, sizeof csvpath, "%s", path);
+    snprintf(path, sizeof path, "%s/stdout", s);
+    check_table(slurp(path, NULL), csvpath);
+    /* score: the same numbers, from the run's radiance.csv read back (10 digits). */
+    assert_int_equal(tu_sh("%s score --ref %s --out %s/sc %s/radiance.csv > %s/stdout 2> %s/stderr",
+                           tu_bin(), dir, s, dir, s, s),
+                     0);
+    check_table(slurp(path, NULL), csvpath);
+    /* --quiet: nothing on stdout, from either. */
+    assert_int_equal(tu_sh("%s score --quiet --ref %s --out %s/sc2 %s/radiance.csv > %s/stdout "
+                           "2> %s/stderr",
+                           tu_bin(), dir, s, dir, s, s),
+                     0);
+    if (slurp(path, NULL)[0])
+        fail_msg("score --quiet printed on stdout:\n%s", slurp(path, NULL));
+    assert_int_equal(tu_sh("%s run --quiet --no-ref-cache %s --out %s > %s/stdout 2> %s/stderr",
+                           tu_bin(), cfg, dir, s, s),
+                     0);
+    if (slurp(path, NULL)[0])
+        fail_msg("run --quiet printed on stdout:\n%s", slurp(path, NULL));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -393,6 +467,7 @@ int main(void)
         cmocka_unit_test(test_quiet_says_where),
         cmocka_unit_test(test_mc_merge_says_where),
         cmocka_unit_test(test_report_readme),
+        cmocka_unit_test(test_run_and_score_print_summary_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

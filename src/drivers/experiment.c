@@ -14,6 +14,7 @@
 #include "methods/method_rte2d.h"
 #include "methods/registry.h"
 #include "methods/work_estimate.h"
+#include "drivers/summary_table.h"
 #include "base/progress.h"
 
 #ifndef PPB_VERSION
@@ -331,6 +332,13 @@ static int write_set(const ppb_experiment *ex, const char *dir, ppb_err *err)
                          ref ? (int)(ref - ex->res) : -1, err))
         return -1;
     return ppb_plots_write(dir, ex->cfg->name, err); /* last: the figures read the files above */
+}
+
+void ppb_experiment_print_summary(const ppb_experiment *ex, FILE *f)
+{
+    const ppb_result *ref = ppb_experiment_reference(ex);
+    if (ref)
+        ppb_summary_table_print(f, ex->cfg->name, ex->res, ex->n, ref, skip_for(ref));
 }
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)

@@ -482,6 +482,10 @@ static int cmd_run(const cli *c)
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
+        /* The summary table on stdout (reference: Outputs), before the line saying where the
+         * set went, also when a method failed and the others were written. */
+        if (!c->quiet && (rc == 0 || ex.nfailed > 0))
+            ppb_experiment_print_summary(&ex, stdout);
         int partial = ex.partial;
         ppb_experiment_free(&ex);
         ppb_ctx_close(&ctx);
@@ -704,7 +708,7 @@ static int cmd_scene(const cli *c)
 /* `ppbench score RADIANCE.csv --ref DIR [--out DIR2]` (drivers/score.h). */
 static int cmd_score(const cli *c)
 {
-    return ppb_score_main(c->nargs ? c->args[0] : NULL, c->nargs, c->ref, c->out);
+    return ppb_score_main(c->nargs ? c->args[0] : NULL, c->nargs, c->ref, c->out, c->quiet);
 }
 
 static int cmd_report(const cli *c)
@@ -752,8 +756,8 @@ static const command commands[] = {
     {"score", "RADIANCE.csv", OPT_REF,
      "score a radiance.csv against the finished experiment\n--ref DIR: its summary, rms and "
      "totals rows into --out\n(default DIR-score, -score-2, ...; DIR is never written)",
-     "ppbench score --ref results/uniform_g0_normal mine/radiance.csv", OPT_REF | OPT_OUT, 1,
-     cmd_score},
+     "ppbench score --ref results/uniform_g0_normal mine/radiance.csv",
+     OPT_REF | OPT_OUT | OPT_QUIET, 1, cmd_score},
     {"slurm", "CONFIG", OPT_SHARDS | OPT_OUT,
      "write a Slurm job array into --out DIR (job.sh: shard I\nof a sweep, or of one config's "
      "Monte Carlo; merge.sh:\nits merge into DIR/result) and print the sbatch lines;\n--submit "

@@ -10,6 +10,7 @@
 #include "base/atomic_file.h"
 #include "base/csv_read.h"
 #include "drivers/experiment.h"
+#include "drivers/summary_table.h"
 #include "io/csv.h"
 #include "methods/method_external.h"
 #include "methods/registry.h"
@@ -134,7 +135,8 @@ static int same_file(const char *a, const char *b)
            sa.st_ino == sb.st_ino;
 }
 
-int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir)
+int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir,
+                   int quiet)
 {
     if (nargs != 1 || !ref_dir) {
         fprintf(stderr, "ppbench score: usage: ppbench score --ref DIR [--out DIR2] RADIANCE.csv "
@@ -205,6 +207,8 @@ int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const c
         if (rc)
             goto done;
     }
+    if (!quiet) /* the summary table (reference: Outputs), before the line saying where */
+        ppb_summary_table_print(stdout, cfg.name, res, n, &res[0], refm->also);
     fprintf(stderr, "score: wrote %s\n", out);
     code = EXIT_OK;
 done:

@@ -11,7 +11,8 @@
 #define PPB_SCORE_H
 
 /* The command: returns its exit code (0; 1 a failure reading or writing; 2 bad operands, with
- * the message printed). */
-int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir);
+ * the message printed). Unless quiet, ends with drivers/summary_table.h's table on stdout. */
+int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir,
+                   int quiet);
 
 #endif
