@@ -15,7 +15,8 @@
  *   Monte Carlo's own standard errors, the photon budget, a footer naming only files that
  *   exist and are committed (not radiance.csv).
  * - run and score end with the summary table on stdout (rms_excess and noise_rel per summary
- *   cell, summary.csv's numbers); --quiet leaves it out.
+ *   cell, summary.csv's numbers); --quiet leaves it out;
+ * - the Python package's tests (python/tests) on a run of the binary.
  * Photon budgets and grids are tiny. */
 #define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "cliutil.h"
@@ -455,6 +456,26 @@ static void test_run_and_score_print_summary_table(void **state)
         fail_msg("run --quiet printed on stdout:\n%s", slurp(path, NULL));
 }
 
+/* The Python package (python/ppbench) against a run of the built binary: python/tests/
+ * test_ppbench.py (its expected values: the set's own summary.csv and CSV files, and the
+ * documented ValueErrors of docs/external.md: Python) on a tiny tube run of mc and ss. */
+static void test_python_package(void **state)
+{
+    (void)state;
+    if (system("python3 -c 'import sys; sys.exit(sys.version_info < (3, 8))'") != 0)
+        fail_msg("python3 >= 3.8 is needed for the Python package");
+    char root[4096];
+    assert_non_null(realpath("python", root));
+    const char *cfg = cli_config("uxpy", tiny);
+    char dir[1300];
+    snprintf(dir, sizeof dir, "%s/out", tu_scratch("uxpy_out"));
+    assert_int_equal(
+        tu_sh("%s run --quiet --no-ref-cache %s --out %s 2>/dev/null", tu_bin(), cfg, dir), 0);
+    if (tu_sh("PYTHONPATH='%s' PPB_TEST_RUN='%s' python3 -m unittest discover -s '%s/tests' 2>&1",
+              root, dir, root) != 0)
+        fail_msg("python/tests/test_ppbench.py failed (its output above)");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -468,6 +489,7 @@ int main(void)
         cmocka_unit_test(test_mc_merge_says_where),
         cmocka_unit_test(test_report_readme),
         cmocka_unit_test(test_run_and_score_print_summary_table),
+        cmocka_unit_test(test_python_package),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
