@@ -16,7 +16,9 @@
  *   exist and are committed (not radiance.csv).
  * - run and score end with the summary table on stdout (rms_excess and noise_rel per summary
  *   cell, summary.csv's numbers); --quiet leaves it out;
- * - the Python package's tests (python/tests) on a run of the binary.
+ * - the Python package's tests (python/tests) on a run of the binary;
+ * - kernel build warnings go to the kernel build log, not stderr; a failed build's log is in
+ *   its error.
  * Photon budgets and grids are tiny. */
 #define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "cliutil.h"
@@ -26,6 +28,7 @@
 
 #include "base/progress.h"
 #include "model/config.h"
+#include "runtime/ocl.h"
 
 static char *slurp(const char *path, size_t *len)
 {
@@ -476,6 +479,65 @@ static void test_python_package(void **state)
         fail_msg("python/tests/test_ppbench.py failed (its output above)");
 }
 
+/* Kernel build warnings (docs/reference.md: Outputs, "The kernel build log"): a kernel that
+ * builds with warnings says nothing on stderr (PoCL's clang printed "2 warnings generated."
+ * there) and its diagnostics land in $PPBENCH_BUILD_LOG; a kernel that fails to build still
+ * reports its log in the error. Expected text: the two conversions below are warnings clang
+ * gives by default (an out-of-range double to int, 300 to char), the third line an error. */
+static char *stderr_during_build(const char *file, int *rc, ppb_err *err, const char *out)
+{
+    ppb_ocl ocl;
+    assert_int_equal(ppb_ocl_open(&ocl, NULL, err), 0);
+    fflush(stderr);
+    int saved = dup(2), fd = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    assert_true(saved >= 0 && fd >= 0);
+    dup2(fd, 2);
+    close(fd);
+    cl_program prog = NULL;
+    *rc = ppb_ocl_build(&ocl, file, "", &prog, err);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    if (prog)
+        clReleaseProgram(prog);
+    ppb_ocl_close(&ocl);
+    return tu_read_text(out);
+}
+
+static void test_kernel_warnings_to_log(void **state)
+{
+    (void)state;
+    char s[1100], path[1300], logp[1300], out[1300];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxkw"));
+    snprintf(path, sizeof path, "%s/warn.cl", s);
+    tu_write_file(path, "__kernel void k(__global int *o)\n{\n    int x = 1.5e40;\n"
+                        "    char c = 300;\n    o[0] = x + c;\n}\n");
+    snprintf(path, sizeof path, "%s/bad.cl", s);
+    tu_write_file(path, "__kernel void k(__global int *o) { o[0] = undeclared_name; }\n");
+    snprintf(logp, sizeof logp, "%s/log/kernel-build.log", s);
+    snprintf(out, sizeof out, "%s/stderr", s);
+    snprintf(path, sizeof path, "%s/pocl-cache", s);
+    setenv("PPBENCH_KERNELS", s, 1);
+    setenv("PPBENCH_BUILD_LOG", logp, 1);
+    setenv("POCL_CACHE_DIR", path, 1); /* a fresh cache: the compiler runs */
+    ppb_err err = {{0}};
+    int rc;
+    const char *said = stderr_during_build("warn.cl", &rc, &err, out);
+    assert_int_equal(rc, 0);
+    if (said[0])
+        fail_msg("a build with warnings printed on stderr:\n%s", said);
+    const char *log = tu_read_text(logp);
+    if (!strstr(log, "warn.cl (options ") || !strstr(log, "300"))
+        fail_msg("the kernel build log lacks the build's warnings:\n%s", log);
+    said = stderr_during_build("bad.cl", &rc, &err, out);
+    assert_int_equal(rc, -1);
+    if (!strstr(err.msg, "building ") || !strstr(err.msg, "undeclared_name"))
+        fail_msg("a failed build's error lacks its log:\n%s", err.msg);
+    unsetenv("PPBENCH_KERNELS");
+    unsetenv("PPBENCH_BUILD_LOG");
+    unsetenv("POCL_CACHE_DIR");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -490,6 +552,7 @@ int main(void)
         cmocka_unit_test(test_report_readme),
         cmocka_unit_test(test_run_and_score_print_summary_table),
         cmocka_unit_test(test_python_package),
+        cmocka_unit_test(test_kernel_warnings_to_log),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
