@@ -20,12 +20,14 @@
  * - kernel build warnings go to the kernel build log, not stderr; a failed build's log is in
  *   its error;
  * - timings.csv's seconds are the ones stderr says; an interrupt after the last method
- *   finished does not mark the complete set partial.
+ *   finished does not mark the complete set partial;
+ * - the study README opens with the summary figure and the findings paragraph.
  * Photon budgets and grids are tiny. */
 #define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "cliutil.h"
 
 #include <fcntl.h>
+#include <math.h>
 #include <unistd.h>
 
 #include "base/progress.h"
@@ -603,6 +605,57 @@ static void test_interrupt_after_last_method_not_partial(void **state)
         fail_msg("a complete set marked partial:\n%s", p);
 }
 
+/* The study README opens with the summary figure when the study has one (summary.png, drawn by
+ * scripts/summary_plot.sh as scripts/bench.sh does) and the findings in one paragraph: per
+ * method, the range of rms_excess over the Table 2 cells of every case. Expected values: the
+ * cases' summary.csv (R_x0 and T_x0 rows of a and b), in percent to the paragraph's 1 decimal;
+ * the figure's file is a PNG (its 8-byte signature). */
+static void test_report_opens_with_summary(void **state)
+{
+    (void)state;
+    const char *s = small_study();
+    char dir[1200], path[1400];
+    snprintf(dir, sizeof dir, "%s", s);
+    assert_int_equal(tu_sh("bash scripts/summary_plot.sh %s a b 2>/dev/null", dir), 0);
+    snprintf(path, sizeof path, "%s/summary.png", dir);
+    assert_int_equal(tu_sh("head -c 8 %s | od -An -tx1 | tr -d ' \\n' | grep -qx "
+                           "89504e470d0a1a0a",
+                           path),
+                     0);
+    assert_int_equal(tu_sh("%s report %s a b 2>/dev/null", tu_bin(), dir), 0);
+    snprintf(path, sizeof path, "%s/README.md", dir);
+    char readme[1 << 15];
+    snprintf(readme, sizeof readme, "%s", tu_read_text(path));
+    const char *fig = strstr(readme, "\n![The excess RMS at the Table 2 cells");
+    const char *find = strstr(readme, "\n**Findings.** At the Table 2 cells of the 2 cases");
+    const char *table = strstr(readme, "\n## Table 2\n");
+    if (!fig || !find || !table || !(fig < find && find < table))
+        fail_msg("README.md does not open with the figure, then the findings:\n%s", readme);
+    static const char *const methods[] = {"ss", "mp"};
+    for (int m = 0; m < 2; m++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (int c = 0; c < 2; c++) {
+            snprintf(path, sizeof path, "%s/%s/summary.csv", dir, c ? "b" : "a");
+            const char *csv = tu_read_text(path);
+            for (int k = 0; k < 2; k++) {
+                char key[64];
+                snprintf(key, sizeof key, "\n%s,%s,", methods[m], k ? "T_x0" : "R_x0");
+                const char *l = strstr(csv, key);
+                double rms, noise, excess;
+                if (!l || sscanf(l + strlen(key), "%lf,%lf,%lf", &rms, &noise, &excess) != 3)
+                    fail_msg("%s lacks %s", path, key + 1);
+                lo = excess < lo ? excess : lo;
+                hi = excess > hi ? excess : hi;
+            }
+        }
+        char want[128];
+        snprintf(want, sizeof want, "`%s` %.1f-%.1f %% (median ", methods[m], 100 * lo, 100 * hi);
+        const char *w = strstr(find, want);
+        if (!w || w > table)
+            fail_msg("the findings lack '%s':\n%.*s", want, (int)(table - find), find);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -620,6 +673,7 @@ int main(void)
         cmocka_unit_test(test_kernel_warnings_to_log),
         cmocka_unit_test(test_timings_agree_with_stderr),
         cmocka_unit_test(test_interrupt_after_last_method_not_partial),
+        cmocka_unit_test(test_report_opens_with_summary),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
