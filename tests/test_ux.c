@@ -478,7 +478,8 @@ static void test_python_package(void **state)
     snprintf(dir, sizeof dir, "%s/out", tu_scratch("uxpy_out"));
     assert_int_equal(
         tu_sh("%s run --quiet --no-ref-cache %s --out %s 2>/dev/null", tu_bin(), cfg, dir), 0);
-    if (tu_sh("PYTHONPATH='%s' PPB_TEST_RUN='%s' python3 -m unittest discover -s '%s/tests' 2>&1",
+    if (tu_sh("PYTHONDONTWRITEBYTECODE=1 PYTHONPATH='%s' PPB_TEST_RUN='%s' python3 -m unittest "
+              "discover -s '%s/tests' 2>&1",
               root, dir, root) != 0)
         fail_msg("python/tests/test_ppbench.py failed (its output above)");
 }
