@@ -13,6 +13,9 @@ CFLAGS  += -std=c11 $(OPT) $(WARN) $(SAN) -fno-strict-aliasing
 CPPFLAGS += -D_DEFAULT_SOURCE -D_POSIX_C_SOURCE=200809L -Isrc -I. \
             -Ikernels -DPPB_SOURCE_DIR='"$(CURDIR)"' -DPPB_SCRIPT_DIR='"$(CURDIR)/scripts"'
 LDFLAGS += $(SAN)
+# What ppbench runs started by make (test, bench, perf) log of their kernel builds goes under
+# build/, not the user's cache (docs/reference.md: Outputs, "The kernel build log").
+export PPBENCH_BUILD_LOG ?= $(CURDIR)/$(BUILD)/kernel-build.log
 
 # src/<layer>/<module>.c, and src/methods/<slice>/<module>.c for each method; the layers and
 # their order are in src/LAYERS, which scripts/check_layers.sh reads.

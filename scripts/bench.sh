@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # bench.sh [--quick] [--out DIR] [--set SEC.KEY=VAL ...]: the accuracy study (docs/reference.md,
-# Cases): every case of configs/study.list with every method, its plots, Table 2 and the
-# study README. Full runs write results/ (committed); --quick writes build/bench-quick/ with a
+# Cases): every case of configs/study.list with every method, its plots, Table 2, the summary
+# figure (scripts/summary_plot.sh: summary.png) and the study README. Full runs write results/ (committed); --quick writes build/bench-quick/ with a
 # small photon budget, for a look in about a minute.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -63,5 +63,8 @@ far higher than that of the full study in results/ (\`make bench\`): its numbers
 study's.
 EOF
 fi
+# The study README opens with the summary figure (the excess RMS at the Table 2 cells per case
+# and method, beside the noise floor), drawn from the cases' summary.csv before the report.
+bash scripts/summary_plot.sh "$out" "${cases[@]}"
 ./ppbench report "$out" "${cases[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2

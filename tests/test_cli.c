@@ -101,6 +101,56 @@ static void test_method_errors(void **state)
     expect(args, 2, "ppbench: --set experiment.methods: method 'ppslab' runs in slab mode only\n");
 }
 
+/* "Did you mean" (docs/reference.md: Keys, Exit codes): a mistyped key, section or method id is
+ * refused as before (exit 2, file:line: [section] key: reason, or --set section.key: reason)
+ * with the nearest known name added when one is close. Expected names: the key table
+ * (`ppbench keys`: light.theta_deg, mc.photons, medium.albedo) and the method ids of
+ * `ppbench --help` (pp, mp+ss, rte2d); "theta" is a prefix of theta_deg, the others 1 or 2
+ * edits away; "zz" is 2 edits from every key of [medium] (none longer than 2 is that close),
+ * so nothing is suggested. */
+static void test_did_you_mean(void **state)
+{
+    (void)state;
+    char args[1400], want[1400], path[1200];
+    snprintf(path, sizeof path, "%s", config("cli-dym", "[tube]\nwidth = 5\n"));
+    snprintf(args, sizeof args, "run --set light.theta=3 %s", path);
+    expect(args, 2, "ppbench: --set light.theta: unknown key (did you mean light.theta_deg?)\n");
+    snprintf(args, sizeof args, "run --set mc.photon=3 %s", path);
+    expect(args, 2, "ppbench: --set mc.photon: unknown key (did you mean mc.photons?)\n");
+    snprintf(args, sizeof args, "run --set tube.photons=3 %s", path);
+    expect(args, 2, "ppbench: --set tube.photons: unknown key (did you mean mc.photons?)\n");
+    snprintf(args, sizeof args, "run --set ligth.theta_deg=3 %s", path);
+    expect(args, 2,
+           "ppbench: --set ligth.theta_deg: unknown section (did you mean light.theta_deg?)\n");
+    snprintf(args, sizeof args, "run --set medium.zz=3 %s", path);
+    expect(args, 2, "ppbench: --set medium.zz: unknown key\n");
+    snprintf(args, sizeof args, "run --set experiment.methods=mc,ppp %s", path);
+    expect(args, 2,
+           "ppbench: --set experiment.methods: unknown method 'ppp' (did you mean pp? see "
+           "ppbench --help)\n");
+    snprintf(args, sizeof args, "run --set experiment.methods=mc,mp_ss %s", path);
+    expect(args, 2, "unknown method 'mp_ss' (did you mean mp+ss? see ppbench --help)\n");
+    snprintf(path, sizeof path, "%s", config("cli-dym", "[medium]\n\nalbdo = 0.9\n"));
+    snprintf(args, sizeof args, "run %s", path);
+    snprintf(want, sizeof want,
+             "ppbench: %s:3: [medium] albdo: unknown key (did you mean albedo?)\n", path);
+    expect(args, 2, want);
+    snprintf(path, sizeof path, "%s", config("cli-dym", "[ligth]\ntheta_deg = 3\n"));
+    snprintf(args, sizeof args, "run %s", path);
+    snprintf(want, sizeof want,
+             "ppbench: %s:2: [ligth] theta_deg: unknown section (did you mean [light] "
+             "theta_deg?)\n",
+             path);
+    expect(args, 2, want);
+    snprintf(path, sizeof path, "%s", config("cli-dym", "[experiment]\nmethods = mc, rte3d\n"));
+    snprintf(args, sizeof args, "run %s", path);
+    snprintf(want, sizeof want,
+             "ppbench: %s:2: [experiment] methods: unknown method 'rte3d' (did you mean rte2d? "
+             "see ppbench --help)\n",
+             path);
+    expect(args, 2, want);
+}
+
 static void test_devices_and_keys(void **state)
 {
     (void)state;
@@ -123,9 +173,8 @@ static void test_devices_and_keys(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_help_and_usage),
-        cmocka_unit_test(test_config_errors),
-        cmocka_unit_test(test_method_errors),
+        cmocka_unit_test(test_help_and_usage),   cmocka_unit_test(test_config_errors),
+        cmocka_unit_test(test_method_errors),    cmocka_unit_test(test_did_you_mean),
         cmocka_unit_test(test_devices_and_keys),
     };
     return cmocka_run_group_tests_name("cli", tests, NULL, NULL);

@@ -8,6 +8,8 @@
  * - the config copy loads back to the same settings and the same grid, axes in the file's order
  *   (not the key table's), compared with the original config loaded independently;
  * - array specs, squeue parsing, option checks, shell quoting;
+ * - --account, --qos, --gres and free --sbatch lines in the scripts, and their refusals;
+ *   check.sh, run on this machine, says ok, and names an unreadable kernels directory;
  * - the command with stand-in sbatch, squeue and scancel on PATH: the first submission, the
  *   re-run after a failed task (only the missing shard, the old merge cancelled, the new merge
  *   after the new array and the task still running), nothing submitted when all is done, and a
@@ -282,6 +284,98 @@ static void test_check_opts(void **state)
     assert_int_equal(ppb_slurm_check_opts(&n, &err), -1);
 }
 
+/* --account, --qos, --gres and --sbatch lines (drivers/slurm.h): account, qos and the free
+ * lines on every job, gres on the tasks (and check.sh) only, each line as given; refused,
+ * naming the option, where a value would not stay one #SBATCH line or is not an sbatch option
+ * (a newline followed by a command, a tab, a ';', no leading "--", an option the scripts set
+ * themselves). Expected text: sbatch(1)'s option names, as the scripts write them. */
+static void test_account_qos_gres_sbatch(void **state)
+{
+    (void)state;
+    ppb_slurm_job job = sweep_job("/scratch/j");
+    const char *lines[] = {"--constraint=a100", "--reservation=r1"};
+    ppb_slurm_opts o = {.shards = 4,
+                        .account = "proj-42",
+                        .qos = "normal",
+                        .gres = "gpu:a100:1",
+                        .sbatch = lines,
+                        .nsbatch = 2};
+    ppb_err err;
+    assert_int_equal(ppb_slurm_check_opts(&o, &err), 0);
+    char *a = ppb_slurm_array_script(&job, &o), *m = ppb_slurm_merge_script(&job, &o);
+    char *c = ppb_slurm_check_script(&job, &o, "/src");
+    const char *every = "#SBATCH --account=proj-42\n#SBATCH --qos=normal\n";
+    const char *extra = "#SBATCH --constraint=a100\n#SBATCH --reservation=r1\n";
+    for (int k = 0; k < 3; k++) {
+        char *t = k == 0 ? a : k == 1 ? m : c;
+        assert_has(t, every);
+        assert_has(t, extra);
+        if (k == 1)
+            assert_lacks(t, "--gres"); /* the merge needs no device */
+        else
+            assert_has(t, "#SBATCH --gres=gpu:a100:1\n");
+    }
+    assert_has(c, "#SBATCH --job-name=ppb-sw-0badcafe-check\n");
+    assert_has(c, "source=${PPBENCH_SOURCE:-'/src'}\n");
+    free(a);
+    free(m);
+    free(c);
+    const struct {
+        const char *opt, *account, *qos, *gres, *line;
+    } bad[] = {
+        {"--account", "a b", NULL, NULL, NULL},
+        {"--account", "a\nb", NULL, NULL, NULL},
+        {"--qos", NULL, "q;rm", NULL, NULL},
+        {"--gres", NULL, NULL, "gpu:1\n", NULL},
+        {"--sbatch", NULL, NULL, NULL, "--constraint=x\ntouch /tmp/owned"},
+        {"--sbatch", NULL, NULL, NULL, "--constraint=x\ttab"},
+        {"--sbatch", NULL, NULL, NULL, ""},
+        {"--sbatch", NULL, NULL, NULL, "constraint=x"},
+        {"--sbatch", NULL, NULL, NULL, "--array=1-9"},
+        {"--sbatch", NULL, NULL, NULL, "--output=/tmp/x"},
+        {"--sbatch", NULL, NULL, NULL, "--dependency=afterok:1"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        ppb_slurm_opts b = {.shards = 1,
+                            .account = bad[k].account,
+                            .qos = bad[k].qos,
+                            .gres = bad[k].gres,
+                            .sbatch = &bad[k].line,
+                            .nsbatch = bad[k].line ? 1 : 0};
+        if (ppb_slurm_check_opts(&b, &err) != -1)
+            fail_msg("case %zu (%s) accepted", k, bad[k].opt);
+        assert_has(err.msg, bad[k].opt);
+    }
+}
+
+/* check.sh run by bash on this machine (which has what a node needs: the built binary's
+ * libraries, the kernel sources, PoCL): "ok on <host>", exit 0, the device list printed; with
+ * the kernel sources unreadable ($PPBENCH_SOURCE, as ppbench reads it) it names them and exits
+ * 1. */
+static void test_check_script_runs(void **state)
+{
+    (void)state;
+    const char *d = tu_scratch("slurm-check");
+    char path[1300];
+    ppb_slurm_job job = sweep_job(d);
+    ppb_slurm_opts o = {.shards = 4};
+    assert_int_equal(tu_sh("cp '%s' '%s/ppbench'", tu_bin(), d), 0);
+    char *c = ppb_slurm_check_script(&job, &o, PPB_SOURCE_DIR);
+    snprintf(path, sizeof path, "%s/check.sh", d);
+    write_text(path, c, 1);
+    free(c);
+    assert_int_equal(tu_sh("bash '%s/check.sh' > '%s/out' 2>&1", d, d), 0);
+    snprintf(path, sizeof path, "%s/out", d);
+    const char *out = tu_read_text(path);
+    assert_has(out, "ppbench slurm check: ok on ");
+    assert_has(out, "0: ");
+    assert_int_equal(
+        tu_sh("PPBENCH_SOURCE=/nonexistent-source bash '%s/check.sh' > '%s/out' 2>&1", d, d), 1);
+    out = tu_read_text(path);
+    assert_has(out, "cannot read the kernel sources in /nonexistent-source");
+    assert_lacks(out, "ok on");
+}
+
 static void test_shell_quote(void **state)
 {
     (void)state;
@@ -432,6 +526,8 @@ int main(void)
         cmocka_unit_test(test_array_spec),
         cmocka_unit_test(test_parse_squeue),
         cmocka_unit_test(test_check_opts),
+        cmocka_unit_test(test_account_qos_gres_sbatch),
+        cmocka_unit_test(test_check_script_runs),
         cmocka_unit_test(test_shell_quote),
         cmocka_unit_test(test_submit_with_stand_ins),
     };

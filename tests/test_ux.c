@@ -14,15 +14,25 @@
  * - the study README (report): Table 2 wide (cases x methods), the noise floor from the
  *   Monte Carlo's own standard errors, the photon budget, a footer naming only files that
  *   exist and are committed (not radiance.csv).
+ * - run and score end with the summary table on stdout (rms_excess and noise_rel per summary
+ *   cell, summary.csv's numbers); --quiet leaves it out;
+ * - the Python package's tests (python/tests) on a run of the binary;
+ * - kernel build warnings go to the kernel build log, not stderr; a failed build's log is in
+ *   its error;
+ * - timings.csv's seconds are the ones stderr says; an interrupt after the last method
+ *   finished does not mark the complete set partial;
+ * - the study README opens with the summary figure and the findings paragraph.
  * Photon budgets and grids are tiny. */
 #define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "cliutil.h"
 
 #include <fcntl.h>
+#include <math.h>
 #include <unistd.h>
 
 #include "base/progress.h"
 #include "model/config.h"
+#include "runtime/ocl.h"
 
 static char *slurp(const char *path, size_t *len)
 {
@@ -388,6 +398,272 @@ static void test_report_readme(void **state)
                  named, foot);
 }
 
+/* The table a run and a score print on stdout (docs/reference.md: Outputs, "The table on
+ * stdout"): a title, a header with the summary cells, one row per measured method with
+ * "rms_excess (noise_rel)" in % at each cell. Expected values: the same run's summary.csv (the
+ * metrics of docs/reference.md: Metrics, printed there to 6 digits), times 100, to the
+ * table's 2 decimals (0.005 + the CSV's rounding). The reference (mc) and its companion (mc1)
+ * have no row. --quiet prints nothing on stdout. */
+static void check_table(const char *out, const char *summary_csv)
+{
+    static const char *const cells[] = {"R_x0", "T_x0", "S1_all", "S2_all", "S3_all", "S4_all"};
+    if (!strstr(out, ": rms_excess against mc in % (noise_rel in parentheses; summary.csv)\n"))
+        fail_msg("no table title on stdout:\n%s", out);
+    const char *hdr = strstr(out, "\nmethod ");
+    if (!hdr)
+        fail_msg("no table header on stdout:\n%s", out);
+    for (int c = 0; c < 6; c++)
+        if (!strstr(hdr, cells[c]))
+            fail_msg("the table header lacks %s:\n%s", cells[c], out);
+    const char *row = strstr(out, "\nss ");
+    if (!row || strstr(out, "\nmc ") || strstr(out, "\nmc1 "))
+        fail_msg("want a row for ss and none for mc, mc1:\n%s", out);
+    double ex[6], nz[6];
+    if (sscanf(row + 4, " %lf (%lf) %lf (%lf) %lf (%lf) %lf (%lf) %lf (%lf) %lf (%lf)", &ex[0],
+               &nz[0], &ex[1], &nz[1], &ex[2], &nz[2], &ex[3], &nz[3], &ex[4], &nz[4], &ex[5],
+               &nz[5]) != 12)
+        fail_msg("the ss row does not hold 6 'excess (noise)' pairs:\n%s", out);
+    const char *csv = tu_read_text(summary_csv);
+    for (int c = 0; c < 6; c++) {
+        char key[64];
+        snprintf(key, sizeof key, "\nss,%s,", cells[c]);
+        const char *l = strstr(csv, key);
+        double rms, noise, excess;
+        if (!l || sscanf(l + strlen(key), "%lf,%lf,%lf", &rms, &noise, &excess) != 3)
+            fail_msg("summary.csv lacks %s:\n%s", key + 1, csv);
+        assert_close(ex[c], 100.0 * excess, 0.0051);
+        assert_close(nz[c], 100.0 * noise, 0.0051);
+    }
+}
+
+static void test_run_and_score_print_summary_table(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxtable", tiny);
+    char s[1100], dir[1300], path[1400];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxtable_out"));
+    snprintf(dir, sizeof dir, "%s/out", s);
+    assert_int_equal(tu_sh("%s run --no-ref-cache %s --out %s > %s/stdout 2> %s/stderr", tu_bin(),
+                           cfg, dir, s, s),
+                     0);
+    snprintf(path, sizeof path, "%s/summary.csv", dir);
+    char csvpath[1400];
+    snprintf(csvpath, sizeof csvpath, "%s", path);
+    snprintf(path, sizeof path, "%s/stdout", s);
+    check_table(slurp(path, NULL), csvpath);
+    /* score: the same numbers, from the run's radiance.csv read back (10 digits). */
+    assert_int_equal(tu_sh("%s score --ref %s --out %s/sc %s/radiance.csv > %s/stdout 2> %s/stderr",
+                           tu_bin(), dir, s, dir, s, s),
+                     0);
+    check_table(slurp(path, NULL), csvpath);
+    /* --quiet: nothing on stdout, from either. */
+    assert_int_equal(tu_sh("%s score --quiet --ref %s --out %s/sc2 %s/radiance.csv > %s/stdout "
+                           "2> %s/stderr",
+                           tu_bin(), dir, s, dir, s, s),
+                     0);
+    if (slurp(path, NULL)[0])
+        fail_msg("score --quiet printed on stdout:\n%s", slurp(path, NULL));
+    assert_int_equal(tu_sh("%s run --quiet --no-ref-cache %s --out %s > %s/stdout 2> %s/stderr",
+                           tu_bin(), cfg, dir, s, s),
+                     0);
+    if (slurp(path, NULL)[0])
+        fail_msg("run --quiet printed on stdout:\n%s", slurp(path, NULL));
+}
+
+/* The Python package (python/ppbench) against a run of the built binary: python/tests/
+ * test_ppbench.py (its expected values: the set's own summary.csv and CSV files, and the
+ * documented ValueErrors of docs/external.md: Python) on a tiny tube run of mc and ss. */
+static void test_python_package(void **state)
+{
+    (void)state;
+    if (system("python3 -c 'import sys; sys.exit(sys.version_info < (3, 8))'") != 0)
+        fail_msg("python3 >= 3.8 is needed for the Python package");
+    char root[4096];
+    assert_non_null(realpath("python", root));
+    const char *cfg = cli_config("uxpy", tiny);
+    char dir[1300];
+    snprintf(dir, sizeof dir, "%s/out", tu_scratch("uxpy_out"));
+    assert_int_equal(
+        tu_sh("%s run --quiet --no-ref-cache %s --out %s 2>/dev/null", tu_bin(), cfg, dir), 0);
+    if (tu_sh("PYTHONDONTWRITEBYTECODE=1 PYTHONPATH='%s' PPB_TEST_RUN='%s' python3 -m unittest "
+              "discover -s '%s/tests' 2>&1",
+              root, dir, root) != 0)
+        fail_msg("python/tests/test_ppbench.py failed (its output above)");
+}
+
+/* Kernel build warnings (docs/reference.md: Outputs, "The kernel build log"): a kernel that
+ * builds with warnings says nothing on stderr (PoCL's clang printed "2 warnings generated."
+ * there) and its diagnostics land in $PPBENCH_BUILD_LOG; a kernel that fails to build still
+ * reports its log in the error. Expected text: the two conversions below are warnings clang
+ * gives by default (an out-of-range double to int, 300 to char), the third line an error. */
+static char *stderr_during_build(const char *file, int *rc, ppb_err *err, const char *out)
+{
+    ppb_ocl ocl;
+    assert_int_equal(ppb_ocl_open(&ocl, NULL, err), 0);
+    fflush(stderr);
+    int saved = dup(2), fd = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    assert_true(saved >= 0 && fd >= 0);
+    dup2(fd, 2);
+    close(fd);
+    cl_program prog = NULL;
+    *rc = ppb_ocl_build(&ocl, file, "", &prog, err);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    if (prog)
+        clReleaseProgram(prog);
+    ppb_ocl_close(&ocl);
+    return tu_read_text(out);
+}
+
+static void test_kernel_warnings_to_log(void **state)
+{
+    (void)state;
+    char s[1100], path[1300], logp[1300], out[1300];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxkw"));
+    snprintf(path, sizeof path, "%s/warn.cl", s);
+    tu_write_file(path, "__kernel void k(__global int *o)\n{\n    int x = 1.5e40;\n"
+                        "    char c = 300;\n    o[0] = x + c;\n}\n");
+    snprintf(path, sizeof path, "%s/bad.cl", s);
+    tu_write_file(path, "__kernel void k(__global int *o) { o[0] = undeclared_name; }\n");
+    snprintf(logp, sizeof logp, "%s/log/kernel-build.log", s);
+    snprintf(out, sizeof out, "%s/stderr", s);
+    snprintf(path, sizeof path, "%s/pocl-cache", s);
+    setenv("PPBENCH_SOURCE", s, 1);
+    setenv("PPBENCH_BUILD_LOG", logp, 1);
+    setenv("POCL_CACHE_DIR", path, 1); /* a fresh cache: the compiler runs */
+    ppb_err err = {{0}};
+    int rc;
+    const char *said = stderr_during_build("warn.cl", &rc, &err, out);
+    assert_int_equal(rc, 0);
+    if (said[0])
+        fail_msg("a build with warnings printed on stderr:\n%s", said);
+    const char *log = tu_read_text(logp);
+    if (!strstr(log, "warn.cl (options ") || !strstr(log, "300"))
+        fail_msg("the kernel build log lacks the build's warnings:\n%s", log);
+    said = stderr_during_build("bad.cl", &rc, &err, out);
+    assert_int_equal(rc, -1);
+    if (!strstr(err.msg, "building ") || !strstr(err.msg, "undeclared_name"))
+        fail_msg("a failed build's error lacks its log:\n%s", err.msg);
+    unsetenv("PPBENCH_SOURCE");
+    unsetenv("PPBENCH_BUILD_LOG");
+    unsetenv("POCL_CACHE_DIR");
+}
+
+/* timings.csv and stderr time the same thing (docs/reference.md: Outputs, timings.csv): each
+ * method's whole run, said on stderr as "NAME: ID done in X s" when it finishes. Expected: the
+ * same number, to the line's 2 decimals (timings.csv prints 4). Before, stderr said only the
+ * trace's time (mc: 1.98 s) where timings.csv had the whole method's (4.69 s). */
+static void test_timings_agree_with_stderr(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("uxtime", tiny);
+    char s[1100], dir[1300], path[1400];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxtime_out"));
+    snprintf(dir, sizeof dir, "%s/out", s);
+    assert_int_equal(tu_sh("%s run --no-ref-cache --set experiment.name=tm %s --out %s "
+                           "> /dev/null 2> %s/stderr",
+                           tu_bin(), cfg, dir, s),
+                     0);
+    snprintf(path, sizeof path, "%s/stderr", s);
+    char err[1 << 15];
+    snprintf(err, sizeof err, "%s", tu_read_text(path));
+    snprintf(path, sizeof path, "%s/timings.csv", dir);
+    const char *csv = tu_read_text(path);
+    static const char *const ids[] = {"mc", "ss"};
+    for (int i = 0; i < 2; i++) {
+        char key[64];
+        snprintf(key, sizeof key, "\n%s,", ids[i]);
+        const char *l = strstr(csv, key);
+        double want, got;
+        if (!l || sscanf(l + strlen(key), "%lf", &want) != 1)
+            fail_msg("timings.csv lacks %s:\n%s", ids[i], csv);
+        snprintf(key, sizeof key, "tm: %s done in ", ids[i]);
+        l = strstr(err, key);
+        if (!l || sscanf(l + strlen(key), "%lf", &got) != 1)
+            fail_msg("stderr lacks '%s':\n%s", key, err);
+        assert_close(got, want, 0.0051);
+    }
+}
+
+/* An interrupt that arrives while the last method runs, in a method that finishes regardless
+ * (mp has no interruption point), leaves no row missing: provenance.txt says partial = 0 and no
+ * method incomplete, the exit code is 130 (the interrupt was received) and stderr says the set
+ * is complete (docs/reference.md: Exit codes). Before, every interrupted run was marked
+ * partial = 1. mp.samples = 24 makes mp take several seconds (9 s on a loaded 2-core machine);
+ * the interrupt comes after 1 s. */
+static void test_interrupt_after_last_method_not_partial(void **state)
+{
+    (void)state;
+    char s[1100], dir[1300], path[1400];
+    snprintf(s, sizeof s, "%s", tu_scratch("uxlate"));
+    snprintf(dir, sizeof dir, "%s/out", s);
+    int rc = tu_sh("%s run --set experiment.methods=mp --set mp.samples=24 --out %s "
+                   "configs/uniform_g0_normal.ini > /dev/null 2> %s/stderr & pid=$!; sleep 1; "
+                   "kill -INT $pid; wait $pid",
+                   tu_bin(), dir, s);
+    snprintf(path, sizeof path, "%s/stderr", s);
+    char err[1 << 15];
+    snprintf(err, sizeof err, "%s", tu_read_text(path));
+    if (rc != 130 || !strstr(err, "(interrupted after every method finished: complete)"))
+        fail_msg("exit %d (want 130), stderr:\n%s", rc, err);
+    snprintf(path, sizeof path, "%s/provenance.txt", dir);
+    const char *p = tu_read_text(path);
+    if (!strstr(p, "\npartial = 0\n") || strstr(p, ".incomplete"))
+        fail_msg("a complete set marked partial:\n%s", p);
+}
+
+/* The study README opens with the summary figure when the study has one (summary.png, drawn by
+ * scripts/summary_plot.sh as scripts/bench.sh does) and the findings in one paragraph: per
+ * method, the range of rms_excess over the Table 2 cells of every case. Expected values: the
+ * cases' summary.csv (R_x0 and T_x0 rows of a and b), in percent to the paragraph's 1 decimal;
+ * the figure's file is a PNG (its 8-byte signature). */
+static void test_report_opens_with_summary(void **state)
+{
+    (void)state;
+    const char *s = small_study();
+    char dir[1200], path[1400];
+    snprintf(dir, sizeof dir, "%s", s);
+    assert_int_equal(tu_sh("bash scripts/summary_plot.sh %s a b 2>/dev/null", dir), 0);
+    snprintf(path, sizeof path, "%s/summary.png", dir);
+    assert_int_equal(tu_sh("head -c 8 %s | od -An -tx1 | tr -d ' \\n' | grep -qx "
+                           "89504e470d0a1a0a",
+                           path),
+                     0);
+    assert_int_equal(tu_sh("%s report %s a b 2>/dev/null", tu_bin(), dir), 0);
+    snprintf(path, sizeof path, "%s/README.md", dir);
+    char readme[1 << 15];
+    snprintf(readme, sizeof readme, "%s", tu_read_text(path));
+    const char *fig = strstr(readme, "\n![The excess RMS at the Table 2 cells");
+    const char *find = strstr(readme, "\n**Findings.** At the Table 2 cells of the 2 cases");
+    const char *table = strstr(readme, "\n## Table 2\n");
+    if (!fig || !find || !table || !(fig < find && find < table))
+        fail_msg("README.md does not open with the figure, then the findings:\n%s", readme);
+    static const char *const methods[] = {"ss", "mp"};
+    for (int m = 0; m < 2; m++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (int c = 0; c < 2; c++) {
+            snprintf(path, sizeof path, "%s/%s/summary.csv", dir, c ? "b" : "a");
+            const char *csv = tu_read_text(path);
+            for (int k = 0; k < 2; k++) {
+                char key[64];
+                snprintf(key, sizeof key, "\n%s,%s,", methods[m], k ? "T_x0" : "R_x0");
+                const char *l = strstr(csv, key);
+                double rms, noise, excess;
+                if (!l || sscanf(l + strlen(key), "%lf,%lf,%lf", &rms, &noise, &excess) != 3)
+                    fail_msg("%s lacks %s", path, key + 1);
+                lo = excess < lo ? excess : lo;
+                hi = excess > hi ? excess : hi;
+            }
+        }
+        char want[128];
+        snprintf(want, sizeof want, "`%s` %.1f-%.1f %% (median ", methods[m], 100 * lo, 100 * hi);
+        const char *w = strstr(find, want);
+        if (!w || w > table)
+            fail_msg("the findings lack '%s':\n%.*s", want, (int)(table - find), find);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -400,6 +676,12 @@ int main(void)
         cmocka_unit_test(test_quiet_says_where),
         cmocka_unit_test(test_mc_merge_says_where),
         cmocka_unit_test(test_report_readme),
+        cmocka_unit_test(test_run_and_score_print_summary_table),
+        cmocka_unit_test(test_python_package),
+        cmocka_unit_test(test_kernel_warnings_to_log),
+        cmocka_unit_test(test_timings_agree_with_stderr),
+        cmocka_unit_test(test_interrupt_after_last_method_not_partial),
+        cmocka_unit_test(test_report_opens_with_summary),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

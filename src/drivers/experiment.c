@@ -17,6 +17,7 @@
 #include "io/plots.h"
 #include "methods/registry.h"
 #include "methods/work_estimate.h"
+#include "drivers/summary_table.h"
 #include "base/progress.h"
 
 #ifndef PPB_VERSION
@@ -70,10 +71,17 @@ static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, p
         fprintf(stderr, "%s: %s failed: %s\n", ex->cfg->name, id, why.msg);
         return 0;
     }
+    /* timings.csv's seconds (reference: Outputs): the method's whole run, from its start to its
+     * result (setup, kernel builds, the reference cache, the work, reading back), the same
+     * number said here; the progress lines time the work loop alone (mc: the trace). */
+    double seconds = ppb_now() - t0;
     for (int i = 0; i < nout; i++) {
-        ex->seconds[ex->n - nout + i] = ppb_now() - t0;
+        ex->seconds[ex->n - nout + i] = seconds;
         ex->partial |= out[i].partial;
     }
+    if (!ctx->quiet)
+        fprintf(stderr, "%s: %s done in %.2f s (timings.csv: setup and kernel build included)\n",
+                ex->cfg->name, id, seconds);
     if (out[0].partial && m->reference != 1) {
         /* Issue 14: a deterministic method stopped midway holds cells it never computed, which
          * would read as zero radiance, like data: none of its rows are written (README:
@@ -111,9 +119,11 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
             return -1;
     ctx->prior = NULL;
     ctx->nprior = 0;
-    if (ppb_interrupted()) {
+    if (ppb_interrupted() && i < cfg->nmethods) {
         /* After an interrupt the methods not yet started are skipped, and said so; the outputs
-         * of those that ran are written, marked partial (README: exit codes). */
+         * of those that ran are written, marked partial (docs/reference.md, Exit codes). An
+         * interrupt after the last method finished leaves no row missing: the set is not
+         * partial (a method stopped midway marked it already). */
         ex->partial = 1;
         for (; i < cfg->nmethods; i++)
             fprintf(stderr, "%s: %s skipped: interrupted before it started\n", cfg->name,
@@ -454,6 +464,13 @@ static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
     if (fig.nfailed && write_provenance(ex, dir, &fig, err))
         return -1;
     return 0;
+}
+
+void ppb_experiment_print_summary(const ppb_experiment *ex, FILE *f)
+{
+    const ppb_result *ref = ppb_experiment_reference(ex);
+    if (ref)
+        ppb_summary_table_print(f, ex->cfg->name, ex->res, ex->n, ref, skip_for(ref));
 }
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)

@@ -59,6 +59,9 @@ int ppb_out_claim(const char *dir, const char *mark, ppb_adir *ad, ppb_err *err)
  * previous directory as it was); then fails, naming them, if any method failed. */
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err);
 void ppb_experiment_free(ppb_experiment *ex);
+/* The table of drivers/summary_table.h for the results against the reference (nothing without
+ * one): what `run` prints on stdout at the end. */
+void ppb_experiment_print_summary(const ppb_experiment *ex, FILE *f);
 
 /* The result every other one is measured against (mc), or NULL. */
 const ppb_result *ppb_experiment_reference(const ppb_experiment *ex);

@@ -52,6 +52,10 @@ enum {
     OPT_MEM = 1 << 10,
     OPT_CPUS = 1 << 11,
     OPT_SUBMIT = 1 << 12,
+    OPT_ACCOUNT = 1 << 13,
+    OPT_QOS = 1 << 14,
+    OPT_GRES = 1 << 15,
+    OPT_SBATCH = 1 << 16,
 };
 
 static const struct option_doc {
@@ -82,6 +86,11 @@ static const struct option_doc {
      "HH:MM:SS, D-HH:MM, ...; default: the partition's)"},
     {OPT_MEM, "--mem", "M", "slurm: #SBATCH --mem per task (MB, or with K/M/G/T)"},
     {OPT_CPUS, "--cpus", "C", "slurm: #SBATCH --cpus-per-task (1 to 4096)"},
+    {OPT_ACCOUNT, "--account", "A", "slurm: #SBATCH --account, every job"},
+    {OPT_QOS, "--qos", "Q", "slurm: #SBATCH --qos, every job"},
+    {OPT_GRES, "--gres", "G", "slurm: #SBATCH --gres per task (e.g. gpu:1)"},
+    {OPT_SBATCH, "--sbatch", "LINE",
+     "slurm: one more #SBATCH line, every job (may repeat;\ne.g. --sbatch --constraint=a100)"},
     {OPT_SUBMIT, "--submit", NULL,
      "slurm: submit the shards neither done nor queued, and a\nmerge job after them (sbatch "
      "--dependency=afterok)"},
@@ -101,6 +110,9 @@ typedef struct cli {
     int no_ref_cache;
     int shards, cpus, submit; /* slurm's */
     const char *partition, *time, *mem;
+    const char *account, *qos, *gres;
+    const char **sbatch; /* --sbatch lines, nsbatch of them */
+    int nsbatch;
     const char **args;
     int nargs;
 } cli;
@@ -154,7 +166,8 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
     c->shard_i = c->shard_n = 1;
     c->sets = calloc((size_t)argc, sizeof *c->sets);
     c->args = calloc((size_t)argc, sizeof *c->args);
-    if (!c->sets || !c->args) {
+    c->sbatch = calloc((size_t)argc, sizeof *c->sbatch);
+    if (!c->sets || !c->args || !c->sbatch) {
         fprintf(stderr, "ppbench: out of memory\n");
         return EXIT_RUN;
     }
@@ -217,6 +230,18 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
         case OPT_MEM:
             c->mem = v;
             break;
+        case OPT_ACCOUNT:
+            c->account = v;
+            break;
+        case OPT_QOS:
+            c->qos = v;
+            break;
+        case OPT_GRES:
+            c->gres = v;
+            break;
+        case OPT_SBATCH:
+            c->sbatch[c->nsbatch++] = v;
+            break;
         case OPT_SHARDS:
         case OPT_CPUS:
             if (!parse_int(v, 1, o->bit == OPT_SHARDS ? PPB_SLURM_MAX_SHARDS : 4096,
@@ -278,6 +303,7 @@ static void free_cli(cli *c)
 {
     free(c->sets);
     free(c->args);
+    free(c->sbatch);
 }
 
 /* The Monte Carlo reference cache of run and sweep (methods/mc_cache.h): --ref-cache DIR,
@@ -483,6 +509,10 @@ static int cmd_run(const cli *c)
         int rc = ppb_experiment_compute(&ex, cfg, &ctx, &err);
         if (rc == 0)
             rc = ppb_experiment_write(&ex, &err);
+        /* The summary table on stdout (reference: Outputs), before the line saying where the
+         * set went, also when a method failed and the others were written. */
+        if (!c->quiet && (rc == 0 || ex.nfailed > 0))
+            ppb_experiment_print_summary(&ex, stdout);
         int partial = ex.partial;
         ppb_experiment_free(&ex);
         ppb_ctx_close(&ctx);
@@ -496,7 +526,7 @@ static int cmd_run(const cli *c)
             if (!c->quiet)
                 fprintf(stderr, "%s: wrote %s%s\n", cfg->name, cfg->out_dir,
                         partial ? " (partial: interrupted)"
-                        : late  ? " (interrupted while writing: the set is whole)"
+                        : late  ? " (interrupted after every method finished: complete)"
                                 : "");
             if (partial || late)
                 code = EXIT_INTERRUPTED;
@@ -674,6 +704,11 @@ static int cmd_slurm(const cli *c)
                         .time = c->time,
                         .mem = c->mem,
                         .cpus = c->cpus,
+                        .account = c->account,
+                        .qos = c->qos,
+                        .gres = c->gres,
+                        .sbatch = c->sbatch,
+                        .nsbatch = c->nsbatch,
                         .device = c->device,
                         .out = c->out,
                         .submit = c->submit};
@@ -795,7 +830,7 @@ static const command commands[] = {
      "submits the shards neither done nor queued",
      "ppbench slurm --shards 4 --time 30 --out /scratch/sw --submit configs/sweep_example.ini",
      OPT_DEVICE | OPT_OUT | OPT_SET | OPT_SHARDS | OPT_PARTITION | OPT_TIME | OPT_MEM | OPT_CPUS |
-         OPT_SUBMIT,
+         OPT_ACCOUNT | OPT_QOS | OPT_GRES | OPT_SBATCH | OPT_SUBMIT,
      1, cmd_slurm},
     {"devices", NULL, 0, "list OpenCL devices (index: platform / device)",
      "PPBENCH_DEVICE=pthread ppbench devices", 0, 0, cmd_devices},

@@ -551,6 +551,93 @@ static void write_footer(FILE *f, const char *dir, const char *const *cases, int
     fprintf(f, "\n");
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The README's opening: the summary figure (summary.png, drawn from the cases' summary.csv by
+ * scripts/summary_plot.sh, which scripts/bench.sh runs before the report) when the study has
+ * one, and the findings in one paragraph, computed from the same rows: per method of the wide
+ * table, ordered by its median, the range and median of rms_excess over the Table 2 cells of
+ * every case and at how many of them it is within the Monte Carlo's noise floor (rms_excess at
+ * most noise_rel); then the floor's range. */
+static void write_opening(FILE *f, const char *dir, const case_data *cd, int ncases)
+{
+    static const char *const cells[2] = {"R_x0", "T_x0"};
+    char path[1200];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/summary.png", dir);
+    if (stat(path, &st) == 0 && S_ISREG(st.st_mode))
+        fprintf(f, "![The excess RMS at the Table 2 cells, per case and method, beside the Monte "
+                   "Carlo's noise floor](summary.png)\n\n"
+                   "The excess RMS (rms_excess: the RMS error against the Monte Carlo with its "
+                   "noise removed; docs/reference.md, Metrics) of every method at the paper's "
+                   "Table 2 cells, the two segments next to x = 0 on S1 (R_x0) and S2 (T_x0), "
+                   "per case, on a log scale (an excess under 0.1 %% is drawn at 0.1 %%); the "
+                   "black bars are the Monte Carlo's own noise floor there (noise_rel). From "
+                   "each case's summary.csv (scripts/summary_plot.sh).\n\n");
+    char cols[MAX_COLS][32];
+    int ncols = table_methods(cd, ncases, cols);
+    double *v = malloc(sizeof *v * (size_t)(2 * ncases + 1));
+    struct {
+        double lo, hi, median;
+        int n, within;
+    } stat_of[MAX_COLS];
+    int order[MAX_COLS];
+    double nlo = INFINITY, nhi = -INFINITY;
+    for (int j = 0; v && j < ncols; j++) {
+        int n = 0, within = 0;
+        for (int c = 0; c < ncases; c++)
+            for (int k = 0; k < 2; k++) {
+                const summary_row *r = find_row(&cd[c], cols[j], cells[k]);
+                if (!r || isnan(r->excess))
+                    continue;
+                v[n++] = 100 * r->excess;
+                within += r->excess <= r->noise;
+                if (r->noise < nlo)
+                    nlo = r->noise;
+                if (r->noise > nhi)
+                    nhi = r->noise;
+            }
+        qsort(v, (size_t)n, sizeof *v, cmp_double);
+        stat_of[j].n = n;
+        stat_of[j].within = within;
+        stat_of[j].lo = n ? v[0] : NAN;
+        stat_of[j].hi = n ? v[n - 1] : NAN;
+        stat_of[j].median = n ? (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2])) : NAN;
+        order[j] = j;
+    }
+    free(v);
+    if (ncols == 0 || !isfinite(nlo))
+        return;
+    for (int a = 1; a < ncols; a++) /* by median, stable: the table's order among equals */
+        for (int b = a; b > 0 && stat_of[order[b]].median < stat_of[order[b - 1]].median; b--) {
+            int t = order[b];
+            order[b] = order[b - 1];
+            order[b - 1] = t;
+        }
+    fprintf(f,
+            "**Findings.** At the Table 2 cells of the %d case%s, ordered by their median "
+            "excess RMS against the Monte Carlo:",
+            ncases, ncases == 1 ? "" : "s");
+    for (int a = 0; a < ncols; a++) {
+        int j = order[a];
+        if (stat_of[j].n == 0)
+            continue;
+        fprintf(f,
+                "%s `%s` %.1f-%.1f %% (median %.1f %%; within the noise floor at %d of %d "
+                "cells)",
+                a == 0 ? "" : ",", cols[j], stat_of[j].lo, stat_of[j].hi, stat_of[j].median,
+                stat_of[j].within, stat_of[j].n);
+    }
+    fprintf(f,
+            ". The Monte Carlo's noise floor there is %.1f-%.1f %%. Where each method errs, "
+            "and why, is in \"What the study shows\" below.\n\n",
+            100 * nlo, 100 * nhi);
+}
+
 /* README.md into rf->f[2], closed (not yet in place). */
 static int write_readme(const char *dir, const char *const *cases, const case_data *cd, int ncases,
                         report_files *rf, ppb_err *err)
@@ -562,6 +649,7 @@ static int write_readme(const char *dir, const char *const *cases, const case_da
         return -1;
     FILE *f = af->f;
     fprintf(f, "%s\n%s\n\n", readme_mark, readme_mark_v1);
+    write_opening(f, dir, cd, ncases);
     write_budget(f, cases, cd, ncases);
     fprintf(f, "## Table 2\n\n");
     fprintf(f, "RMS error against the Monte Carlo (docs/reference.md) in percent at the two "
@@ -573,17 +661,18 @@ static int write_readme(const char *dir, const char *const *cases, const case_da
     write_noise(f, cases, cd, ncases);
     snprintf(path, sizeof path, "%s/notes.md", dir);
     copy_file(f, path);
-    fprintf(f, "\n## Plots\n\n");
-    fprintf(f, "RMS versus x (paper Fig. 8) and in-plane angular distributions at x = 0 (Fig. "
-               "5):\n\n");
-    for (int c = 0; c < ncases; c++)
-        fprintf(f,
-                "- %s: ![rms](%s/plots/rms_vs_x.png) ![angular](%s/plots/angular_x0.png) "
-                "![angular, polar](%s/plots/angular_x0_polar.png)\n",
-                cases[c], cases[c], cases[c], cases[c]);
-    fprintf(f, "\n## Images (paper Fig. 6-7)\n\n");
+    /* The figures the findings above use stand beside their sentences (notes.md); every
+     * case's figures are linked here, not shown. */
+    fprintf(f, "\n## Every case's figures\n\n");
+    fprintf(f, "RMS versus x (paper Fig. 8), in-plane angular distributions at x = 0 (Fig. 5), "
+               "the tube as each method renders it (Fig. 6-7) and its error against the Monte "
+               "Carlo:\n\n");
     for (int c = 0; c < ncases; c++) {
-        fprintf(f, "- %s: ![all methods](%s/images/all.png)\n", cases[c], cases[c]);
+        fprintf(f,
+                "- %s: [rms vs x](%s/plots/rms_vs_x.png), [angular](%s/plots/angular_x0.png), "
+                "[angular, polar](%s/plots/angular_x0_polar.png), [all methods](%s/images/"
+                "all.png)\n",
+                cases[c], cases[c], cases[c], cases[c], cases[c]);
         link_error_images(f, dir, cases[c]);
     }
     write_footer(f, dir, cases, ncases);

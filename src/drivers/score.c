@@ -11,6 +11,7 @@
 #include "base/progress.h"
 #include "base/csv_read.h"
 #include "drivers/experiment.h"
+#include "drivers/summary_table.h"
 #include "io/csv.h"
 #include "methods/external/method_external.h"
 #include "methods/registry.h"
@@ -257,8 +258,10 @@ int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const c
     }
     if (ppb_adir_commit(&ad, &err))
         goto done;
-    if (!quiet)
+    if (!quiet) { /* the summary table (reference: Outputs), before the line saying where */
+        ppb_summary_table_print(stdout, cfg.name, res, n, &res[0], refm->also);
         fprintf(stderr, "score: wrote %s\n", out);
+    }
     code = EXIT_OK;
 done:
     if (code)

@@ -15,7 +15,8 @@
 
 /* The command: returns its exit code (0; 1 a failure writing; 2 bad operands or input files
  * (RADIANCE.csv, DIR), or a DIR2 that is not score's; 130 interrupted, nothing written), the
- * message printed. quiet: no "score: wrote" line. */
+ * message printed. quiet: no "score: wrote" line; unless quiet, it ends with
+ * drivers/summary_table.h's table on stdout. */
 int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const char *out_dir,
                    int quiet);
 

@@ -1,5 +1,6 @@
 #include "drivers/slurm.h"
 
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -71,10 +72,45 @@ int ppb_slurm_check_opts(const ppb_slurm_opts *o, ppb_err *err)
             return ppb_fail(err, "--mem %s: expected a whole number of MB, or with K, M, G or T",
                             o->mem);
     }
-    if (o->partition && !all_of(o->partition, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                              "0123456789_-.,"))
-        return ppb_fail(err, "--partition %s: expected letters, digits, '_', '-', '.' and ','",
-                        o->partition);
+    static const char name_chars[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                     "0123456789_-.,";
+    const struct {
+        const char *opt, *v;
+    } names[] = {{"--partition", o->partition}, {"--account", o->account}, {"--qos", o->qos}};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+        if (names[k].v && !all_of(names[k].v, name_chars))
+            return ppb_fail(err, "%s %s: expected letters, digits, '_', '-', '.' and ','",
+                            names[k].opt, names[k].v);
+    if (o->gres && !all_of(o->gres, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                    "0123456789_-.,:"))
+        return ppb_fail(err,
+                        "--gres %s: expected letters, digits, '_', '-', '.', ',' and ':' "
+                        "(e.g. gpu:1)",
+                        o->gres);
+    /* Free #SBATCH lines: one sbatch option each, printable, so that nothing can end the line
+     * and start a command in the script; not an option the scripts set themselves. */
+    static const char *const own[] = {"--array",      "--job-name", "--output", "--error",
+                                      "--dependency", "--parsable", "-J",       "-o",
+                                      "-e",           "-a",         "-d"};
+    for (int i = 0; i < o->nsbatch; i++) {
+        const char *l = o->sbatch[i];
+        int printable = *l != '\0';
+        for (const char *p = l; *p; p++)
+            printable &= (unsigned char)*p >= 0x20 && (unsigned char)*p < 0x7f;
+        if (!printable)
+            return ppb_fail(err,
+                            "--sbatch: %s: an #SBATCH line holds printable characters only "
+                            "(no newline, tab or control character)",
+                            *l ? "the line" : "an empty line");
+        if (strncmp(l, "--", 2) != 0 || !isalpha((unsigned char)l[2]))
+            return ppb_fail(err, "--sbatch %s: expected one sbatch option, e.g. --constraint=x", l);
+        for (size_t k = 0; k < sizeof own / sizeof own[0]; k++) {
+            size_t n = strlen(own[k]);
+            if (own[k][1] == '-' && !strncmp(l, own[k], n) &&
+                (l[n] == '\0' || l[n] == '=' || l[n] == ' '))
+                return ppb_fail(err, "--sbatch %s: %s is set by ppbench slurm itself", l, own[k]);
+        }
+    }
     return 0;
 }
 
@@ -212,16 +248,26 @@ char *ppb_slurm_config_text(const ppb_config *cfg, const ppb_grid *grid, const c
     return text_close(&t);
 }
 
-static void sbatch_lines(FILE *f, const ppb_slurm_opts *o, int cpus)
+/* The #SBATCH lines of the options; task: the array's tasks (and check.sh, which runs as one),
+ * which take --cpus-per-task and --gres; the merge takes neither. */
+static void sbatch_lines(FILE *f, const ppb_slurm_opts *o, int task)
 {
     if (o->partition)
         fprintf(f, "#SBATCH --partition=%s\n", o->partition);
+    if (o->account)
+        fprintf(f, "#SBATCH --account=%s\n", o->account);
+    if (o->qos)
+        fprintf(f, "#SBATCH --qos=%s\n", o->qos);
     if (o->time)
         fprintf(f, "#SBATCH --time=%s\n", o->time);
     if (o->mem)
         fprintf(f, "#SBATCH --mem=%s\n", o->mem);
-    if (cpus > 0)
-        fprintf(f, "#SBATCH --cpus-per-task=%d\n", cpus);
+    if (task && o->cpus > 0)
+        fprintf(f, "#SBATCH --cpus-per-task=%d\n", o->cpus);
+    if (task && o->gres)
+        fprintf(f, "#SBATCH --gres=%s\n", o->gres);
+    for (int i = 0; i < o->nsbatch; i++)
+        fprintf(f, "#SBATCH %s\n", o->sbatch[i]);
 }
 
 static const char *what(const ppb_slurm_job *job)
@@ -244,7 +290,7 @@ char *ppb_slurm_array_script(const ppb_slurm_job *job, const ppb_slurm_opts *o)
             job->shards, what(job), job->units);
     fprintf(f, "#SBATCH --job-name=%s\n#SBATCH --array=1-%d\n", job->name, job->shards);
     fprintf(f, "#SBATCH --output=%s/logs/task_%%a_job_%%A.out\n", job->dir);
-    sbatch_lines(f, o, o->cpus);
+    sbatch_lines(f, o, 1);
     fprintf(f, "set -euo pipefail\ndir=");
     put_quoted(f, job->dir);
     fprintf(f, "\nstamp=");
@@ -373,6 +419,46 @@ int ppb_slurm_parse_squeue(const char *text, const char *name, int shards, unsig
 }
 
 /* ---- the job directory ---- */
+
+char *ppb_slurm_check_script(const ppb_slurm_job *job, const ppb_slurm_opts *o,
+                             const char *kernel_dir)
+{
+    text t;
+    if (text_open(&t))
+        return NULL;
+    FILE *f = t.f;
+    fprintf(f,
+            "#!/bin/bash\n"
+            "# Written by `ppbench slurm`: checks, as one job with the tasks' #SBATCH lines, that\n"
+            "# a compute node can run them: the binary's shared libraries, the kernel\n"
+            "# sources and an OpenCL device. Submit it first: sbatch --wait check.sh\n");
+    fprintf(f, "#SBATCH --job-name=%s-check\n", job->name);
+    fprintf(f, "#SBATCH --output=%s/logs/check_job_%%j.out\n", job->dir);
+    sbatch_lines(f, o, 1);
+    fprintf(f, "set -uo pipefail\ndir=");
+    put_quoted(f, job->dir);
+    fprintf(f, "\nsource=${PPBENCH_SOURCE:-");
+    put_quoted(f, kernel_dir);
+    fprintf(f, "}\n");
+    fprintf(f, "node=$(hostname)\nbad=0\n"
+               "missing=$(ldd \"$dir/ppbench\" 2>&1 | grep 'not found')\n"
+               "if [ -n \"$missing\" ]; then\n"
+               "  echo \"ppbench slurm check: $node lacks shared libraries of $dir/ppbench:\"\n"
+               "  echo \"$missing\"\n  bad=1\nfi\n"
+               "if [ ! -r \"$source/kernels\" ] || [ ! -r \"$source/src/methods\" ]; then\n"
+               "  echo \"ppbench slurm check: $node cannot read the kernel sources in $source \"\\\n"
+               "       \"(a file system the nodes share, or PPBENCH_SOURCE)\"\n  bad=1\nfi\n"
+               "if [ $bad = 0 ]; then\n"
+               "  devices=$(\"$dir/ppbench\" devices 2>&1)\n"
+               "  if [ $? != 0 ] || ! grep -q '^[0-9]' <<<\"$devices\"; then\n"
+               "    echo \"ppbench slurm check: $node has no OpenCL device (an ICD in \"\\\n"
+               "         \"/etc/OpenCL/vendors and its driver):\"\n"
+               "    echo \"$devices\"\n    bad=1\n  else\n"
+               "    echo \"$devices\"\n  fi\nfi\n"
+               "[ $bad = 0 ] && echo \"ppbench slurm check: ok on $node\"\n"
+               "exit $bad\n");
+    return text_close(&t);
+}
 
 static int write_file(const char *path, const char *data, size_t len, int exec, ppb_err *err)
 {
@@ -542,6 +628,9 @@ static void print_commands(const ppb_slurm_job *job, const char *spec, int nmiss
         printf("to submit the merge:\n  sbatch %s/merge.sh\n", job->dir);
     printf("(or run this command again with --submit: it also leaves out the tasks still "
            "queued)\n");
+    printf("to check first that a compute node can run them (libraries, kernels, an OpenCL "
+           "device):\n  sbatch --wait %s/check.sh\n",
+           job->dir);
 }
 
 /* Asks Slurm which of the job's tasks are still queued or running, cancels a merge job left
@@ -729,7 +818,7 @@ int ppb_slurm_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_slurm_o
     char *conf = ppb_slurm_config_text(cfg, grid, result);
     size_t bin_len = 0;
     char *bin = conf ? self_binary(&bin_len, err) : NULL;
-    char *array = NULL, *merge = NULL;
+    char *array = NULL, *merge = NULL, *check = NULL;
     unsigned char *done = NULL;
     ppb_grid *back_grid = NULL;
     int rc = -1;
@@ -768,9 +857,10 @@ int ppb_slurm_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_slurm_o
 
     array = ppb_slurm_array_script(&job, o);
     merge = ppb_slurm_merge_script(&job, o);
+    check = ppb_slurm_check_script(&job, o, PPB_SOURCE_DIR);
     done = calloc((size_t)job.shards + 1, 1);
     back_grid = ppb_grid_new();
-    if (!array || !merge || !done || !back_grid) {
+    if (!array || !merge || !check || !done || !back_grid) {
         ppb_fail(err, "slurm: out of memory");
         goto out;
     }
@@ -805,6 +895,7 @@ int ppb_slurm_run(const ppb_config *cfg, const ppb_grid *grid, const ppb_slurm_o
         {"ppbench", bin, bin_len, 1},
         {"job.sh", array, strlen(array), 1},
         {"merge.sh", merge, strlen(merge), 1},
+        {"check.sh", check, strlen(check), 1},
     };
     for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
         snprintf(path, sizeof path, "%s/%s", job.dir, files[k].name);
@@ -859,6 +950,7 @@ out:
     free(bin);
     free(array);
     free(merge);
+    free(check);
     free(done);
     ppb_grid_free(back_grid);
     return rc;

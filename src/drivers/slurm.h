@@ -8,7 +8,8 @@
  * into result/, once every marker is there and names this job), and job.txt, which says which
  * config, shard count and build the directory belongs to. Re-running the same command finds
  * the shards neither done nor queued in Slurm and submits only those, with a new merge job
- * after them; a directory of another config, shard count or build is refused.
+ * after them; a directory of another config, shard count or build is refused. check.sh,
+ * submitted alone (`sbatch --wait DIR/check.sh`), checks a compute node first.
  *
  * Every text is made by a pure function (tested without a cluster, tests/test_slurm.c);
  * ppb_slurm_run writes them and, with submit, calls sbatch, squeue and scancel (found on PATH).
@@ -30,9 +31,13 @@ typedef struct ppb_slurm_opts {
     int shards;                         /* N: array tasks, 1..PPB_SLURM_MAX_SHARDS */
     const char *partition, *time, *mem; /* #SBATCH values; NULL: the cluster's default */
     int cpus;                           /* --cpus-per-task; 0: the cluster's default */
-    const char *device;                 /* --device given to each task; NULL: none */
-    const char *out;                    /* the job directory */
-    int submit;                         /* 0: write the scripts and print the commands */
+    const char *account, *qos;          /* #SBATCH --account, --qos (every job); NULL: none */
+    const char *gres;                   /* #SBATCH --gres (the array's tasks); NULL: none */
+    const char *const *sbatch;          /* extra "#SBATCH <line>" lines, every job (--sbatch) */
+    int nsbatch;
+    const char *device; /* --device given to each task; NULL: none */
+    const char *out;    /* the job directory */
+    int submit;         /* 0: write the scripts and print the commands */
 } ppb_slurm_opts;
 
 typedef enum { PPB_SLURM_SWEEP, PPB_SLURM_MC } ppb_slurm_kind;
@@ -49,8 +54,11 @@ typedef struct ppb_slurm_job {
 
 /* Checks the #SBATCH values (they go into the scripts verbatim): --time in a form Slurm
  * reads (minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS, or UNLIMITED), --mem a whole
- * number with an optional K, M, G or T, --partition letters, digits, '_', '-', '.' and ','.
- * Fails naming the option. */
+ * number with an optional K, M, G or T, --partition, --account and --qos letters, digits, '_',
+ * '-', '.' and ',', --gres the same and ':' ("gpu:a100:1"); each --sbatch line an sbatch
+ * option ("--constraint=x": starting "--", printable characters only, so no newline can end the
+ * line and start a command) other than those ppbench writes itself (--array, --job-name,
+ * --output, --error, --dependency, --parsable). Fails naming the option. */
 int ppb_slurm_check_opts(const ppb_slurm_opts *o, ppb_err *err);
 
 /* The resolved config as INI text (malloc'd, NULL when out of memory): every key at its
@@ -62,6 +70,16 @@ char *ppb_slurm_config_text(const ppb_config *cfg, const ppb_grid *grid, const c
 /* The array script and the merge script (malloc'd, NULL when out of memory). */
 char *ppb_slurm_array_script(const ppb_slurm_job *job, const ppb_slurm_opts *o);
 char *ppb_slurm_merge_script(const ppb_slurm_job *job, const ppb_slurm_opts *o);
+
+/* check.sh (malloc'd, NULL when out of memory): one job with the tasks' #SBATCH lines that
+ * checks what a compute node needs to run them (reference: Outputs, Slurm job directory): the
+ * copied binary's shared libraries (ldd: none "not found"), the kernel sources the binary
+ * reads (source_dir: kernels/ and src/methods/; $PPBENCH_SOURCE overrides it there as in
+ * ppbench), and an OpenCL ICD with
+ * at least one device (`ppbench devices`). Exits 0 saying "ok on NODE", else 1 naming what is
+ * missing. */
+char *ppb_slurm_check_script(const ppb_slurm_job *job, const ppb_slurm_opts *o,
+                             const char *source_dir);
 
 /* "1-3,5,7-8": the indices i in [1, n] with pick[i] set, as sbatch --array takes them.
  * Returns the number of indices; buf is cut (and the count still right) if too small. */

@@ -127,6 +127,31 @@ const ppb_method *ppb_method_find(const ppb_config *cfg, const char *id)
     return m;
 }
 
+/* The id closest to a mistyped one (model/config.h's ppb_name_distance): a built-in id, its
+ * companion (mc1) or a [method.NAME] of the config; NULL when none is close. */
+static const char *nearest_id(const ppb_config *cfg, const char *typed)
+{
+    const char *best = NULL;
+    int bestd = 99;
+    for (int j = 0; j < ppb_method_count(); j++)
+        for (int k = 0; k < 2; k++) {
+            const char *id = k ? methods[j].also : methods[j].id;
+            int d = id ? ppb_name_distance(typed, id) : -1;
+            if (d >= 0 && d < bestd) {
+                best = id;
+                bestd = d;
+            }
+        }
+    for (int i = 0; i < cfg->nexternal; i++) {
+        int d = ppb_name_distance(typed, cfg->external[i].name);
+        if (d >= 0 && d < bestd) {
+            best = cfg->external[i].name;
+            bestd = d;
+        }
+    }
+    return best;
+}
+
 int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
 {
     /* A [method.NAME] may not take a built-in id: the config would then mean two methods. */
@@ -146,9 +171,12 @@ int ppb_methods_check(const ppb_config *cfg, ppb_err *err)
     /* Unknown ids first, over the whole list, then slab-only methods: the order in which the
      * config used to refuse them when it parsed the list itself. */
     for (int i = 0; i < cfg->nmethods; i++)
-        if (!builtin(cfg->methods[i]) && !ppb_config_external(cfg, cfg->methods[i]))
-            return ppb_config_key_fail(cfg, "experiment", "methods", err,
-                                       "unknown method '%s' (see ppbench --help)", cfg->methods[i]);
+        if (!builtin(cfg->methods[i]) && !ppb_config_external(cfg, cfg->methods[i])) {
+            const char *near = nearest_id(cfg, cfg->methods[i]);
+            return ppb_config_key_fail(
+                cfg, "experiment", "methods", err, "unknown method '%s' (%s%s%ssee ppbench --help)",
+                cfg->methods[i], near ? "did you mean " : "", near ? near : "", near ? "? " : "");
+        }
     int slab = cfg->scene.geometry == PPB_GEOM_SLAB;
     for (int i = 0; i < cfg->nmethods; i++) {
         const ppb_method *m = ppb_method_find(cfg, cfg->methods[i]);

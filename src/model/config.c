@@ -9,6 +9,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdlib.h>
+#include <strings.h>
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
@@ -171,6 +172,78 @@ static int section_known(const char *section)
         if (strcmp(keys[i].section, section) == 0)
             return 1;
     return 0;
+}
+
+/* "Did you mean": how close a mistyped name is to a known one, for the suggestion after
+ * "unknown key", "unknown section" and (methods/registry.c) "unknown method". The
+ * Levenshtein distance over case-folded characters (one insertion, deletion or substitution
+ * each); a typed name that is a prefix of the known one ("theta" for "theta_deg") counts as
+ * close whatever its length. Returns the distance, or -1 when the names are not close: more
+ * than 1 edit for names of up to 4 characters, more than 2 beyond. */
+int ppb_name_distance(const char *typed, const char *known)
+{
+    size_t a = strlen(typed), b = strlen(known);
+    if (a >= 3 && a < b && strncasecmp(typed, known, a) == 0)
+        return (int)(b - a) < 2 ? (int)(b - a) : 2;
+    if (a > 63 || b > 63)
+        return -1;
+    int row[64];
+    for (size_t j = 0; j <= b; j++)
+        row[j] = (int)j;
+    for (size_t i = 1; i <= a; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= b; j++) {
+            int up = row[j];
+            int sub = diag + (tolower((unsigned char)typed[i - 1]) !=
+                              tolower((unsigned char)known[j - 1]));
+            int best = up + 1 < row[j - 1] + 1 ? up + 1 : row[j - 1] + 1;
+            row[j] = sub < best ? sub : best;
+            diag = up;
+        }
+    }
+    int d = row[b], limit = (a < b ? a : b) <= 4 ? 1 : 2;
+    return d <= limit ? d : -1;
+}
+
+/* Why section.key is refused, with the nearest known key when one is close (ppb_name_distance):
+ * first a key of the same section ("unknown key (did you mean theta_deg?)"), else the same key
+ * in a close section or a close key anywhere ("(did you mean [light] theta_deg?)"; dotted, as
+ * --set writes it: "light.theta_deg"). */
+static void unknown_why(const char *section, const char *key, int dotted, char *why, size_t n)
+{
+    int known = section_known(section), best = -1, bestd = 99, same = 0;
+    for (int i = 0; i < NKEYS; i++) {
+        int in = strcmp(keys[i].section, section) == 0;
+        int ds = in ? 0 : ppb_name_distance(section, keys[i].section);
+        int dk = ppb_name_distance(key, keys[i].key);
+        if (ds < 0 || dk < 0 || (known && !in && ds > 0))
+            continue;
+        int d = ds + dk;
+        if (d < bestd || (d == bestd && in && !same)) {
+            best = i;
+            bestd = d;
+            same = in;
+        }
+    }
+    /* A known section with no close key: a close key of another section ("[tube] photons"). */
+    if (best < 0 && known)
+        for (int i = 0; i < NKEYS; i++) {
+            int dk = ppb_name_distance(key, keys[i].key);
+            if (dk >= 0 && dk < bestd) {
+                best = i;
+                bestd = dk;
+            }
+        }
+    const char *what = known ? "unknown key" : "unknown section";
+    if (best < 0)
+        snprintf(why, n, "%s", what);
+    else if (dotted)
+        snprintf(why, n, "%s (did you mean %s.%s?)", what, keys[best].section, keys[best].key);
+    else if (strcmp(keys[best].section, section) == 0)
+        snprintf(why, n, "%s (did you mean %s?)", what, keys[best].key);
+    else
+        snprintf(why, n, "%s (did you mean [%s] %s?)", what, keys[best].section, keys[best].key);
 }
 
 static char *trim(char *s)
@@ -730,8 +803,7 @@ static int on_key(void *user, const char *section, const char *name, const char 
             st->err_line = 0;
             return 1;
         }
-        snprintf(st->why, sizeof st->why, "%s",
-                 section_known(section) ? "unknown key" : "unknown section");
+        unknown_why(section, name, 0, st->why, sizeof st->why);
         return 0;
     }
     if (st->seen[i]) {
@@ -958,11 +1030,12 @@ static int override(ppb_config *cfg, ppb_grid *grid, const char *section, const 
 {
     char qs[96], qk[96];
     int i = find_key(section, key);
-    if (i < 0)
-        return ppb_fail(err, "--set %s.%s: %s", shown(section, qs, sizeof qs),
-                        shown(key, qk, sizeof qk),
-                        section_known(section) ? "unknown key" : "unknown section");
     char why[1200];
+    if (i < 0) {
+        unknown_why(section, key, 1, why, sizeof why);
+        return ppb_fail(err, "--set %s.%s: %s", shown(section, qs, sizeof qs),
+                        shown(key, qk, sizeof qk), why);
+    }
     /* A key set again replaces an earlier list on it. */
     if (grid)
         ppb_grid_remove(grid, i);

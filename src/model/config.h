@@ -191,4 +191,9 @@ const ppb_external_def *ppb_config_external(const ppb_config *cfg, const char *i
 const char *ppb_config_external_where(const ppb_config *cfg, const ppb_external_def *d,
                                       const char *key, char *buf, size_t cap);
 
+/* How close a mistyped name is to a known one (case-folded Levenshtein distance; a typed
+ * prefix of 3 or more characters is close): the distance, or -1 when not close enough for a
+ * "did you mean" (more than 1 edit for names of up to 4 characters, more than 2 beyond). */
+int ppb_name_distance(const char *typed, const char *known);
+
 #endif

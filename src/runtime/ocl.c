@@ -1,10 +1,14 @@
 #include "runtime/ocl.h"
 
 #include <ctype.h>
+#include <fcntl.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
+#include "base/atomic_file.h"
 #include "base/hash.h"
 
 #ifndef PPB_SOURCE_DIR
@@ -412,9 +416,8 @@ int ppb_ocl_source_hash(const char *file, uint64_t *hash, ppb_err *err)
     return rc;
 }
 
-/* Reports the build log and releases the program; the caller's handle is cleared by
- * ppb_ocl_build, so no caller can release it a second time (PoCL aborts on that). */
-static int build_failed(ppb_ocl *ocl, cl_program prog, const char *path, cl_int rc, ppb_err *err)
+/* The program's build log (malloc'ed, "" when empty; NULL without memory). */
+static char *build_log(ppb_ocl *ocl, cl_program prog)
 {
     size_t n = 0;
     clGetProgramBuildInfo(prog, ocl->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
@@ -424,8 +427,122 @@ static int build_failed(ppb_ocl *ocl, cl_program prog, const char *path, cl_int 
         clGetProgramBuildInfo(prog, ocl->device, CL_PROGRAM_BUILD_LOG, n, log, NULL);
         log[n] = '\0';
     }
-    ppb_fail(err, "OpenCL: building %s failed: %s\nbuild log:\n%s", path, ppb_cl_errname(rc),
-             log ? log : "(no log)");
+    return log;
+}
+
+/* Whether s holds more than blanks. */
+static int said_something(const char *s)
+{
+    for (; s && *s; s++)
+        if (!isspace((unsigned char)*s))
+            return 1;
+    return 0;
+}
+
+/* What the OpenCL compiler writes to the process's stderr while it builds (PoCL's clang prints
+ * its diagnostics and "56 warnings generated." there, outside the build log) is caught in a
+ * temporary file: fd 2 points there during clBuildProgram. begin returns the saved fd 2 (-1
+ * when nothing could be redirected, and the compiler then writes where it always did). */
+static int stderr_catch_begin(FILE **tmp)
+{
+    fflush(stderr);
+    *tmp = tmpfile();
+    int saved = *tmp ? dup(2) : -1;
+    if (saved >= 0 && dup2(fileno(*tmp), 2) < 0) {
+        close(saved);
+        saved = -1;
+    }
+    return saved;
+}
+
+/* Puts fd 2 back; returns what was written meanwhile (malloc'ed; NULL when nothing). */
+static char *stderr_catch_end(int saved, FILE *tmp)
+{
+    char *text = NULL;
+    fflush(stderr);
+    if (saved >= 0) {
+        dup2(saved, 2);
+        close(saved);
+    }
+    if (!tmp)
+        return NULL;
+    long n = ftell(tmp);
+    if (saved >= 0 && n > 0 && (text = malloc((size_t)n + 1))) {
+        rewind(tmp);
+        size_t got = fread(text, 1, (size_t)n, tmp);
+        text[got] = '\0';
+    }
+    fclose(tmp);
+    return text;
+}
+
+int ppb_ocl_build_log_path(char *buf, size_t cap)
+{
+    const char *env = getenv("PPBENCH_BUILD_LOG"), *xdg = getenv("XDG_CACHE_HOME"),
+               *home = getenv("HOME");
+    int n;
+    if (env)
+        n = snprintf(buf, cap, "%s", env);
+    else if (xdg && xdg[0])
+        n = snprintf(buf, cap, "%s/ppbench/kernel-build.log", xdg);
+    else if (home && home[0])
+        n = snprintf(buf, cap, "%s/.cache/ppbench/kernel-build.log", home);
+    else
+        n = -1;
+    return n > 0 && (size_t)n < cap ? 0 : -1;
+}
+
+/* Appends one build's diagnostics to the kernel build log (ppb_ocl_build_log_path), as one
+ * write on an O_APPEND file so that concurrent processes (sweep --jobs) do not interleave;
+ * nothing is said when the log cannot be written (the build itself succeeded). */
+static void log_build(const ppb_ocl *ocl, const char *path, const char *opts, const char *said,
+                      const char *log)
+{
+    char file[4096];
+    if (ppb_ocl_build_log_path(file, sizeof file))
+        return;
+    char *slash = strrchr(file, '/');
+    if (slash && slash != file) {
+        *slash = '\0';
+        ppb_err ignored = {{0}};
+        int rc = ppb_mkdirs(file, &ignored);
+        *slash = '/';
+        if (rc)
+            return;
+    }
+    char when[32];
+    time_t now = time(NULL);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
+    size_t cap = strlen(path) + strlen(opts) + strlen(ocl->name) + (said ? strlen(said) : 0) +
+                 (log ? strlen(log) : 0) + 256;
+    char *entry = malloc(cap);
+    if (!entry)
+        return;
+    int n = snprintf(entry, cap, "== %s pid %d: %s (options %s) on %s\n%s%s%s%s", when,
+                     (int)getpid(), path, opts, ocl->name, said ? said : "",
+                     said && said[0] && said[strlen(said) - 1] != '\n' ? "\n" : "",
+                     said_something(log) ? "build log:\n" : "", said_something(log) ? log : "");
+    int fd = open(file, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+        if (n > 0 && write(fd, entry, strlen(entry)) < 0) {
+            /* a log that cannot take it: the build succeeded all the same */
+        }
+        close(fd);
+    }
+    free(entry);
+}
+
+/* Reports the build log and what the compiler said on stderr, and releases the program; the
+ * caller's handle is cleared by ppb_ocl_build, so no caller can release it a second time (PoCL
+ * aborts on that). */
+static int build_failed(ppb_ocl *ocl, cl_program prog, const char *path, cl_int rc,
+                        const char *said, ppb_err *err)
+{
+    char *log = build_log(ocl, prog);
+    ppb_fail(err, "OpenCL: building %s failed: %s\nbuild log:\n%s%s%s", path, ppb_cl_errname(rc),
+             said_something(log) ? log : "(no log)\n",
+             said_something(said) ? "\nthe compiler's output:\n" : "",
+             said_something(said) ? said : "");
     free(log);
     clReleaseProgram(prog);
     return -1;
@@ -457,12 +574,24 @@ int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program 
     char inc[NINC][1024];
     include_dirs(path, inc);
     snprintf(opts, sizeof opts, "-I %s -I %s -I %s %s", inc[0], inc[1], inc[2], extra ? extra : "");
+    /* Warnings go to the kernel build log, not the user's terminal (reference: Outputs); a
+     * failure's log is in the error, which is printed. */
+    FILE *tmp;
+    int saved = stderr_catch_begin(&tmp);
     rc = clBuildProgram(*prog, 1, &ocl->device, opts, NULL, NULL);
+    char *said = stderr_catch_end(saved, tmp);
     if (rc != CL_SUCCESS) {
         cl_program failed = *prog;
         *prog = NULL;
-        return build_failed(ocl, failed, path, rc, err);
+        build_failed(ocl, failed, path, rc, said, err);
+        free(said);
+        return -1;
     }
+    char *log = build_log(ocl, *prog);
+    if (said_something(said) || said_something(log))
+        log_build(ocl, path, opts, said, log);
+    free(log);
+    free(said);
     int n = ocl->nbuilt;
     if (keyed && n < (int)(sizeof ocl->built / sizeof ocl->built[0]) &&
         clRetainProgram(*prog) == CL_SUCCESS) {

@@ -48,11 +48,19 @@ void ppb_ocl_close(ppb_ocl *ocl);
 
 /* Builds <root>/<file>, the root being the source tree ($PPBENCH_SOURCE, else the build-time
  * path) and file a kernel such as "src/methods/mc/mc.cl", with options "-I <file's folder>
- * -I <root>/kernels -I <Random123> <extra>". On failure err holds the build log. A program
- * built before on this ocl with the same file and extra is returned again (retained: the caller
- * releases it as a fresh one); ppb_ocl_close releases them. */
+ * -I <root>/kernels -I <Random123> <extra>". On failure err holds the build log and what the
+ * compiler printed; a successful build's warnings go to the kernel build log
+ * (ppb_ocl_build_log_path), not to stderr. A program built before on this ocl with the same
+ * file and extra is returned again (retained: the caller releases it as a fresh one);
+ * ppb_ocl_close releases them. */
 int ppb_ocl_build(ppb_ocl *ocl, const char *file, const char *extra, cl_program *prog,
                   ppb_err *err);
+
+/* The kernel build log, where a successful build's warnings go (the compiler's stderr output
+ * and the program's build log, appended with a header line naming the time, process, file,
+ * options and device): $PPBENCH_BUILD_LOG, else $XDG_CACHE_HOME/ppbench/kernel-build.log, else
+ * ~/.cache/ppbench/kernel-build.log. 0 and the path in buf, or -1 when none can be named. */
+int ppb_ocl_build_log_path(char *buf, size_t cap);
 
 /* A hash of the source text a build of <root>/<file> compiles: the file and, transitively,
  * every header it includes that the build's include path finds (the shared kernels/ headers,
