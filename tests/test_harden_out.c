@@ -64,7 +64,7 @@ static int assert_all_complete(const char *dir)
     return n;
 }
 
-/* The report's item 1: an --out holding a quote and gnuplot's system() once ran it as a command
+/* An --out holding a quote and gnuplot's system() once ran it as a command
  * (plots.sh wrote `set output '$out...'`), and exited 1 with no outputs. Now the path is data:
  * nothing runs, the figures are drawn into that very directory, exit 0. */
 static void test_out_path_never_runs_as_gnuplot(void **state)
@@ -147,7 +147,7 @@ static void test_failed_figures_keep_the_run(void **state)
     assert_false(exists(path));
 }
 
-/* The report's case: medium.albedo = 0 puts NaN in rms.csv and gnuplot refused the figure;
+/* medium.albedo = 0 puts NaN in rms.csv and gnuplot refused the figure;
  * the run exited 1 with nothing written. Now: exit 0, rms.csv written. */
 static void test_albedo_zero_run_written(void **state)
 {
