@@ -64,7 +64,7 @@ static int assert_all_complete(const char *dir)
     return n;
 }
 
-/* The report's item 1: an --out holding a quote and gnuplot's system() once ran it as a command
+/* An --out holding a quote and gnuplot's system() once ran it as a command
  * (plots.sh wrote `set output '$out...'`), and exited 1 with no outputs. Now the path is data:
  * nothing runs, the figures are drawn into that very directory, exit 0. */
 static void test_out_path_never_runs_as_gnuplot(void **state)
@@ -147,7 +147,7 @@ static void test_failed_figures_keep_the_run(void **state)
     assert_false(exists(path));
 }
 
-/* The report's case: medium.albedo = 0 puts NaN in rms.csv and gnuplot refused the figure;
+/* medium.albedo = 0 puts NaN in rms.csv and gnuplot refused the figure;
  * the run exited 1 with nothing written. Now: exit 0, rms.csv written. */
 static void test_albedo_zero_run_written(void **state)
 {
@@ -377,6 +377,58 @@ static void test_same_run_same_pdfs(void **state)
                      0);
 }
 
+/* report's three files go in place together: a README that cannot be written (a 1 KB file
+ * size limit, which the two tables fit) leaves all three as they were, never new tables beside
+ * the old README. Before, the tables were renamed into place first, then the README failed:
+ * new tables with an old README, exit 1. */
+static void test_report_files_replaced_together(void **state)
+{
+    (void)state;
+    const char *d = finished_runs();
+    char args[4096];
+    snprintf(args, sizeof args, "report '%s' A B", d);
+    cli_expect(args, 0, "");
+    assert_int_equal(
+        tu_sh("cd '%s' && mkdir -p saved_report && cp table2.csv table2.md README.md saved_report/",
+              d),
+        0);
+    snprintf(args, sizeof args, "report '%s' A", d);
+    cli_expect_env("sh -c 'trap \"\" XFSZ; ulimit -f 2; exec \"$0\" \"$@\"'", args, 1, "README.md");
+    assert_int_equal(tu_sh("cd '%s' && for f in table2.csv table2.md README.md; do "
+                           "cmp $f saved_report/$f || exit 1; done",
+                           d),
+                     0);
+}
+
+/* A sweep's heat maps under a 10 KB file size limit (the points already computed, so only the
+ * figures are drawn): gnuplot's cairo wrote them cut short and exited 0, and the sweep put the
+ * 10240-byte PNG and PDF in place. Now each is checked complete (ppb_file_complete) and left
+ * out, said on stderr; exit 0, sweep.csv written. */
+static void test_sweep_heatmap_cut_short_left_out(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("harden_sweep");
+    char ini[1300], args[4096], path[1400];
+    snprintf(ini, sizeof ini, "%s/s.ini", dir);
+    snprintf(args, sizeof args,
+             "[experiment]\nname = s\ngeometry = slab\nmethods = mc, ss\n[medium]\ng = 0, 0.5\n"
+             "albedo = 0.5, 0.9\n[mc]\nphotons = 2e4\n[pp]\ndirections = 16\n[output]\n"
+             "dir = %s/out\n",
+             dir);
+    tu_write_file(ini, args);
+    snprintf(args, sizeof args, "sweep --quiet '%s'", ini);
+    cli_expect_env("PPBENCH_CACHE=", args, 0, "");
+    cli_expect_env("PPBENCH_CACHE= sh -c 'trap \"\" XFSZ; ulimit -f 20; exec \"$0\" \"$@\"'", args,
+                   0, "figure heatmap_ss not drawn");
+    snprintf(path, sizeof path, "%s/out/sweep.csv", dir);
+    assert_true(file_ok(path));
+    for (int t = 0; t < 2; t++) {
+        snprintf(path, sizeof path, "%s/out/heatmap_ss.%s", dir, t ? "pdf" : "png");
+        if (exists(path) && !file_ok(path))
+            fail_msg("%s: put in place cut short", path);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -393,6 +445,8 @@ int main(void)
         cmocka_unit_test(test_second_run_on_one_out_refused),
         cmocka_unit_test(test_sigterm_while_writing_exits_130),
         cmocka_unit_test(test_same_run_same_pdfs),
+        cmocka_unit_test(test_report_files_replaced_together),
+        cmocka_unit_test(test_sweep_heatmap_cut_short_left_out),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

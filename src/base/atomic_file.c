@@ -448,6 +448,19 @@ static int read_tail(int fd, off_t size, unsigned char *buf, size_t n)
     return pread(fd, buf, n, size - (off_t)n) == (ssize_t)n ? 0 : -1;
 }
 
+/* Whether path names a file of kind ext (".png"), itself or as its temporary
+ * ("x.png.tmp.<pid>", what ppb_apath hands gnuplot). */
+static int is_kind(const char *path, const char *ext)
+{
+    if (ends_with(path, ext))
+        return 1;
+    const char *tmp = NULL;
+    for (const char *q = strstr(path, ".tmp."); q; q = strstr(q + 1, ".tmp."))
+        tmp = q;
+    size_t k = strlen(ext);
+    return tmp && ppb_temp_pid(path, 0) && (size_t)(tmp - path) >= k && !strncmp(tmp - k, ext, k);
+}
+
 int ppb_file_complete(const char *path, ppb_err *err)
 {
     static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
@@ -465,10 +478,10 @@ int ppb_file_complete(const char *path, ppb_err *err)
         bad = "not a regular file";
     else if (st.st_size == 0)
         bad = "0 bytes (a full disk?)";
-    else if (ends_with(path, ".png") &&
+    else if (is_kind(path, ".png") &&
              (read_tail(fd, st.st_size, tail, 12) || memcmp(tail, iend, 12)))
         bad = "a PNG cut short (no IEND chunk at its end; a full disk?)";
-    else if (ends_with(path, ".pdf")) {
+    else if (is_kind(path, ".pdf")) {
         size_t n = st.st_size < 64 ? (size_t)st.st_size : 64;
         if (read_tail(fd, st.st_size, tail, n) || !memmem(tail, n, "%%EOF", 5))
             bad = "a PDF cut short (no %%EOF at its end; a full disk?)";

@@ -77,7 +77,8 @@ int ppb_adir_commit(ppb_adir *ad, ppb_err *err);
 void ppb_adir_abort(ppb_adir *ad);
 
 /* Whether the file at path is complete, as far as its kind shows: a regular file of non-zero
- * size; a PNG ending with its IEND chunk; a PDF ending with %%EOF. A writer that ignores a
+ * size; a PNG ending with its IEND chunk; a PDF ending with %%EOF (the kind from the name, or
+ * from the name a temporary "x.png.tmp.<pid>" stands for). A writer that ignores a
  * full disk (gnuplot's cairo) leaves a 0-byte or cut file with a success status: this finds
  * it (docs/reference.md: Outputs). Fails naming the path and what is wrong. */
 int ppb_file_complete(const char *path, ppb_err *err);

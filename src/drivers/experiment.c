@@ -404,10 +404,12 @@ static int bad_file(const char *rel, const char *why, void *ctx, ppb_err *err)
                  (!strcmp(rel + n - 4, ".png") || !strcmp(rel + n - 4, ".pdf"));
     if (!figure)
         return ppb_fail(err, "%s", why);
-    char path[PPB_PATH_MAX + 600], name[600];
-    snprintf(path, sizeof path, "%s/%s", ad->tmp, rel);
-    remove(path);
+    char path[PPB_PATH_MAX + 700], name[600];
     snprintf(name, sizeof name, "%.*s", (int)n - 4, rel);
+    for (int t = 0; t < 2; t++) { /* the figure goes whole: its PNG and its PDF */
+        snprintf(path, sizeof path, "%s/%s.%s", ad->tmp, name, t ? "pdf" : "png");
+        remove(path);
+    }
     ppb_figures_fail(fig, name, why);
     return 0;
 }

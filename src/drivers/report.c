@@ -713,7 +713,7 @@ int ppb_report_write(const char *dir, const char *const *cases, int ncases, ppb_
         return -1;
     for (int i = 0; i < REPORT_FILES; i++)
         fprintf(stderr, "ppbench report: wrote %s\n", names[i]->path);
-    /* issue 16: the last line says where the results went, as `run` does */
+    /* the last line says where the results went, as `run` does (docs/reference.md: Outputs) */
     fprintf(stderr, "ppbench report: wrote %s (%d files)\n", dir, REPORT_FILES);
     return 0;
 }

@@ -260,6 +260,7 @@ static void draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, c
     }
     int nz = grid->naxes >= 3 ? grid->axes[2].n : 1;
     int shown = nz <= MAX_ROWS_PANELS ? nz : MAX_ROWS_PANELS;
+    int failed_before = fig->nfailed;
     for (int t = 0; t < 2; t++) {
         char path[1300];
         snprintf(path, sizeof path, "%s/%s.%s", dir, base, t ? "pdf" : "png");
@@ -293,6 +294,12 @@ static void draw(const ppb_config *cfg, const ppb_grid *grid, const char *dir, c
             break;
         }
     }
+    if (fig->nfailed > failed_before) /* no earlier figure of the name, of other data, stays */
+        for (int t = 0; t < 2; t++) {
+            char path[1300];
+            snprintf(path, sizeof path, "%s/%s.%s", dir, base, t ? "pdf" : "png");
+            remove(path);
+        }
     free(rows);
 }
 

@@ -1,9 +1,9 @@
 /* images.h: shaded images of the tube (paper Fig. 6-7) from every method's radiance, written
  * as OpenEXR (linear) and PNG (tone-mapped, one exposure per view shared by all methods, the
  * light arrow on the top view), plus a false-colour map of each method's error against the
- * Monte Carlo with its own labelled colour bar (scripts/plots.sh adds the titles and figures). Takes results, not an
- * experiment, so the drivers above it (the experiment writer) call down into it and never the other
- * way. */
+ * Monte Carlo with its own labelled colour bar (scripts/plots.sh adds the titles and figures).
+ * Takes results, not an experiment, so the drivers above it (the experiment writer) call down into
+ * it and never the other way. */
 #ifndef PPB_IMAGES_H
 #define PPB_IMAGES_H
 

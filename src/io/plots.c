@@ -164,7 +164,11 @@ int ppb_gnuplot_figure(const char *path, const char *script, size_t len, const c
     }
     /* gnuplot's cairo exits 0 on a full disk, leaving a 0-byte or cut file */
     if (ppb_file_complete(ap.tmp, &err) || ppb_apath_commit(&ap, &err)) {
-        snprintf(why, cap, "%s", err.msg);
+        const char *what = strstr(err.msg, ": incomplete: "); /* named by the final path */
+        if (what)
+            snprintf(why, cap, "%s%s", path, what);
+        else
+            snprintf(why, cap, "%s", err.msg);
         ppb_apath_abort(&ap);
         return -1;
     }

@@ -952,8 +952,8 @@ static int derive_name(ppb_config *cfg, const char *path, ppb_err *err)
     char base[sizeof cfg->name], why[512];
     base_name(path, base, sizeof base);
     for (int i = 0; i < NKEYS; i++)
-        if (keys[i].type == K_NAME && parse_string(&keys[i], cfg->name, sizeof cfg->name, base, why,
-                                                   sizeof why))
+        if (keys[i].type == K_NAME &&
+            parse_string(&keys[i], cfg->name, sizeof cfg->name, base, why, sizeof why))
             return ppb_fail(err,
                             "%s: the experiment's name, from the file name when the file has no "
                             "[experiment] name: %s; give a name = line",
