@@ -342,6 +342,54 @@ static void test_study_configs(void **state)
     }
 }
 
+static void test_extremes(void **state)
+{
+    (void)state;
+    /* The corners of the robustness grid (tests/test_robust.c's values): albedo 0 to 1, g
+     * +-0.95, H from 1e-3 to 1e3, theta_L 0 and 89 deg, n 1 and 1.4, tube and slab: every cell
+     * finite and >= 0, R within (1 - F) A, and the result checks of the method passed. */
+    const double albedo[] = {0, 0.01, 0.5, 0.999, 1}, g[] = {-0.95, 0, 0.95},
+                 height[] = {1e-3, 1, 1e3}, theta[] = {0, 89}, n[] = {1, 1.4};
+    int runs = 0;
+    for (int geo = 0; geo < 2; geo++)
+        for (int ia = 0; ia < 5; ia++)
+            for (int ig = 0; ig < 3; ig++)
+                for (int ih = 0; ih < 3; ih++)
+                    for (int it = 0; it < 2; it++)
+                        for (int in = 0; in < 2; in++) {
+                            ppb_config cfg;
+                            ppb_err err;
+                            assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
+                            cfg.scene =
+                                geo ? tu_slab(height[ih], albedo[ia], g[ig], theta[it]) : tu_tube();
+                            cfg.scene.albedo = albedo[ia];
+                            cfg.scene.g = g[ig];
+                            cfg.scene.height = height[ih];
+                            cfg.scene.theta_deg = theta[it];
+                            cfg.scene.n = n[in];
+                            cfg.scene.segments_top = 8;
+                            cfg.scene.segments_side = 4;
+                            cfg.samples_seg = 1;
+                            cfg.burley.directions = 32;
+                            ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
+                            ppb_result out;
+                            run_id(&ctx, "burley", &out);
+                            for (size_t i = 0; i < out.layout.ncells; i++)
+                                if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
+                                    fail_msg("albedo %g g %g H %g theta %g n %g: cell %zu = %g",
+                                             albedo[ia], g[ig], height[ih], theta[it], n[in], i,
+                                             out.radiance[i]);
+                            double A, mu = cos(theta[it] * PPB_PI / 180);
+                            assert_int_equal(
+                                ppb_burley_albedo(albedo[ia], g[ig], n[in], mu, 32, &A, &err), 0);
+                            assert_between(A, 0, 1);
+                            assert_le(out.totals.R, A * (1 + 1e-12));
+                            ppb_result_free(&out);
+                            runs++;
+                        }
+    print_message("%d runs at the extremes\n", runs);
+}
+
 static void test_quadrature_converges_on_tube(void **state)
 {
     (void)state;
@@ -440,11 +488,18 @@ static void test_sum_with_ss(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_k0_tables),     cmocka_unit_test(test_profile_plane_integral),
-        cmocka_unit_test(test_line_kernel),   cmocka_unit_test(test_strip_quadrature),
-        cmocka_unit_test(test_shape_factor),  cmocka_unit_test(test_albedo_exact),
-        cmocka_unit_test(test_study_configs), cmocka_unit_test(test_quadrature_converges_on_tube),
-        cmocka_unit_test(test_slab_mode),     cmocka_unit_test(test_sum_with_ss),
+        cmocka_unit_test(test_k0_tables),
+        cmocka_unit_test(test_profile_plane_integral),
+        cmocka_unit_test(test_line_kernel),
+        cmocka_unit_test(test_strip_quadrature),
+        cmocka_unit_test(test_shape_factor),
+        cmocka_unit_test(test_albedo_exact),
+        cmocka_unit_test(test_study_configs),
+        cmocka_unit_test(test_extremes),
+        cmocka_unit_test(test_quadrature_converges_on_tube),
+        cmocka_unit_test(test_slab_mode),
+        cmocka_unit_test(test_sum_with_ss),
+        /* one per line */
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
