@@ -392,8 +392,8 @@ static void test_diffuse_fresnel_exact(void **state)
     /* From air (n_rel = n): the quadrature equals Walsh's closed form to rounding. */
     const double n[] = {1.05, 1.1, 1.2, 1.3, 1.33, 1.4, 1.5, 1.7, 2.0, 2.5};
     for (int i = 0; i < 10; i++)
-        assert_close(ppb_mp_diffuse_fresnel(n[i]), walsh_r1(n[i]), 1e-13);
-    assert_close(ppb_mp_diffuse_fresnel(1.0), 0.0, 0.0);
+        assert_close(ppb_diffuse_fresnel(n[i]), walsh_r1(n[i]), 1e-13);
+    assert_close(ppb_diffuse_fresnel(1.0), 0.0, 0.0);
     /* From inside, the identity 1 - (1 - F_dr,e) / n^2 against a direct quadrature of
      * 2 int F(mu, 1/n) mu dmu: 1 below the critical cosine, and 20000 midpoint cells above it
      * (the integrand has a square-root kink at mu_c, so the midpoint rule gives ~1e-7). */
@@ -405,7 +405,7 @@ static void test_diffuse_fresnel_exact(void **state)
             double mu = mu_c + (k + 0.5) * h;
             sum += 2 * ppb_fresnel(mu, 1 / n[i]) * mu * h;
         }
-        assert_close(ppb_mp_diffuse_fresnel(1 / n[i]), sum, 1e-6);
+        assert_close(ppb_diffuse_fresnel(1 / n[i]), sum, 1e-6);
     }
     /* Prahl 1988 Table B.4 (Appendix B, "Egan Polynomial Approximation for R1",
      * http://omlc.ogi.edu/pubs/prahl-pubs/prahl88/node101.html), column R1_Walsh, printed to three
@@ -416,7 +416,7 @@ static void test_diffuse_fresnel_exact(void **state)
     const double r1[] = {0.161, 0.116, 0.081, 0.053, 0.027, 0.194, 0.336,
                          0.444, 0.529, 0.596, 0.651, 0.696, 0.733, 0.764};
     for (int i = 0; i < 14; i++) {
-        double v = ppb_mp_diffuse_fresnel(1 / ratio[i]);
+        double v = ppb_diffuse_fresnel(1 / ratio[i]);
         if (ratio[i] == 1.4)
             print_message("F_dr(inside, n = 1.4) = %.6f (Prahl Table B.4: 0.529)\n", v);
         assert_close(v, r1[i], 0.0005 + 1e-12);
@@ -434,7 +434,7 @@ static void test_diffuse_fresnel_fit(void **state)
      * F_dr moves A by +-0.0045). */
     double worst = 0;
     for (double n = 1.1; n <= 1.9 + 1e-9; n += 0.05) {
-        double exact = ppb_mp_diffuse_fresnel(1 / n), fit = ppb_mp_diffuse_fresnel_fit(n);
+        double exact = ppb_diffuse_fresnel(1 / n), fit = ppb_mp_diffuse_fresnel_fit(n);
         worst = fmax(worst, fabs(fit - exact));
         double a_fit = (1 + fit) / (1 - fit);
         assert_rel(a_fit, ppb_multipole_boundary_A(n), 3e-3);
@@ -443,7 +443,7 @@ static void test_diffuse_fresnel_fit(void **state)
     for (int i = 0; i < 4; i++) {
         double fit = ppb_mp_diffuse_fresnel_fit(show[i]);
         print_message("n %.2f: F_dr exact %.5f fit %.5f; A exact %.4f fit %.4f\n", show[i],
-                      ppb_mp_diffuse_fresnel(1 / show[i]), fit, ppb_multipole_boundary_A(show[i]),
+                      ppb_diffuse_fresnel(1 / show[i]), fit, ppb_multipole_boundary_A(show[i]),
                       (1 + fit) / (1 - fit));
     }
     print_message("fit vs exact F_dr over [1.1, 1.9]: worst %.2e\n", worst);
@@ -547,15 +547,15 @@ static void test_exit_lobe(void **state)
      * own midpoint-rule mean of (1 - F(mu)) 2 mu dmu over 4000 cells. */
     for (int nt = 1; nt <= 64; nt *= 4) {
         double lobe[64], sum = 0;
-        ppb_multipole_exit_lobe(1.4, nt, lobe);
+        ppb_diffuse_exit_lobe(1.4, nt, lobe);
         for (int k = 0; k < nt; k++)
             sum += lobe[k];
         assert_close(sum / nt, 1.0, 1e-14);
         for (int k = 1; k < nt; k++)
             assert_lt(lobe[k], lobe[k - 1]);
     }
-    double lobe[8], fe = ppb_mp_diffuse_fresnel(1.4);
-    ppb_multipole_exit_lobe(1.4, 8, lobe);
+    double lobe[8], fe = ppb_diffuse_fresnel(1.4);
+    ppb_diffuse_exit_lobe(1.4, 8, lobe);
     for (int k = 0; k < 8; k++) {
         double lo = sqrt(1 - (k + 1) / 8.0), hi = sqrt(1 - k / 8.0), h = (hi - lo) / 4000, m = 0;
         for (int c = 0; c < 4000; c++) {
@@ -645,7 +645,7 @@ static void test_exit_normalisation_against_transport(void **state)
         ppb_result out;
         run_mp(&cfg, &out);
         double ref = solver_R(30.0, 0.99, 0.0, n[i]);
-        double literal = out.totals.R * (1 - ppb_mp_diffuse_fresnel(n[i]));
+        double literal = out.totals.R * (1 - ppb_diffuse_fresnel(n[i]));
         print_message("n %.2f: solver R %.5f, mp normalised %.5f (%+.2f %%), literal %.5f "
                       "(%+.2f %%)\n",
                       n[i], ref, out.totals.R, 100 * (out.totals.R / ref - 1), literal,
@@ -719,7 +719,7 @@ static void test_tube_refractive(void **state)
                                                  ppb_multipole_boundary_A(1.4), mu_t, &err),
                      0);
     double st = sqrt(1 - mu_t * mu_t), lobe[8];
-    ppb_multipole_exit_lobe(1.4, 8, lobe);
+    ppb_diffuse_exit_lobe(1.4, 8, lobe);
     double seg = 10.0 / 32, flux = ppb_multipole_segment_flux(&placed, 0.0, -3.0, seg, -3.0, 0, -1,
                                                               -5 + st, 5 + st, 16, 4);
     assert_rel(rad(&out, PPB_S2, 16, 0), cos_l * (1 - fl) * flux * lobe[0] / PPB_PI, 1e-12);

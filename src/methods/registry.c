@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "methods/burley/method_burley.h"
 #include "methods/external/method_external.h"
 #include "methods/mc/method_mc.h"
 #include "methods/mc/perf_mc.h"
@@ -58,6 +59,15 @@ static const ppb_method methods[] = {
      .run = run_sum,
      .sum_of = (const char *const[]){"mp", "ss", NULL},
      .paper_column = "MP+S"},
+    {.id = "burley",
+     .summary = "Christensen-Burley normalized diffusion profile, A from the slab solver",
+     .run = ppb_method_burley,
+     .check = ppb_burley_check,
+     .section = "burley"},
+    {.id = "burley+ss",
+     .summary = "Christensen-Burley profile plus single scattering",
+     .run = run_sum,
+     .sum_of = (const char *const[]){"burley", "ss", NULL}},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,

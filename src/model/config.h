@@ -57,6 +57,11 @@ typedef struct ppb_mp_settings {
     int samples; /* quadrature nodes per mfp over the lit strip */
 } ppb_mp_settings;
 
+typedef struct ppb_burley_settings {
+    int samples;    /* quadrature nodes per profile length d over the lit strip */
+    int directions; /* direction cells per hemisphere of the slab solve that gives A */
+} ppb_burley_settings;
+
 typedef struct ppb_rte2d_settings {
     double spacing;  /* grid node spacing over the cross-section, mfp */
     int directions;  /* direction cells per hemisphere */
@@ -99,6 +104,7 @@ typedef struct ppb_config {
     ppb_mc_settings mc;
     ppb_pp_settings pp;
     ppb_mp_settings mp;
+    ppb_burley_settings burley;
     ppb_rte2d_settings rte2d;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */

@@ -23,7 +23,7 @@
  *   baseline, kept bit for bit), so at oblique light mp jumps between n = 1 and n = 1 + 0. At
  *   45 deg the refracted placement measured closer to mc at both n (README).
  * - Exit: Jensen et al. 2001's S_d = (1/pi) F_t(w_i) R_d F_t(w_o) form with the exit lobe
- *   normalised (multipole.h, ppb_multipole_exit_lobe): radiance J lobe(theta_o) / pi, so a
+ *   normalised (physics/diffuse_exit.h, ppb_diffuse_exit_lobe): radiance J lobe(theta_o) / pi, so a
  *   face's total is its diffusion flux J; R, T, sides are then (1 - F(theta_L)) times the
  *   fluxes of the multipole with A and the placed sources.
  * - Ballistic: the unscattered refracted beam followed through its internal reflections (F at
@@ -37,6 +37,7 @@
 #include "base/progress.h"
 #include "kernels/ppb_fresnel.h"
 #include "methods/result_check.h"
+#include "physics/diffuse_exit.h"
 #include "physics/maps.h"
 #include "methods/mp/multipole.h"
 
@@ -68,7 +69,7 @@ static int mp_boundary_init(const ppb_scene *sc, mp_boundary *b, ppb_err *err)
     b->entry = 1.0 - b->specular;
     b->cos_t = ppb_refract_cos(ppb_scene_cos_theta_l(sc), sc->n);
     b->sin_t = sqrt(fmax(0.0, 1.0 - b->cos_t * b->cos_t));
-    ppb_multipole_exit_lobe(sc->n, sc->ntheta, b->lobe);
+    ppb_diffuse_exit_lobe(sc->n, sc->ntheta, b->lobe);
     return 0;
 }
 
@@ -142,60 +143,6 @@ static void fill_bins(ppb_result *out, const ppb_scene *sc, const mp_boundary *b
             bd->fresnel ? radiance * bd->lobe[b / sc->nphi] : radiance;
 }
 
-/* ---- the unscattered beam at n > 1 ---- */
-
-typedef struct beam_dir {
-    double n, sin_t, cos_t;
-} beam_dir;
-
-/* Fraction of the power entering at x_e on S1 that leaves the tube unscattered: the refracted
- * beam runs to a face, leaves with 1 - F(cos_i, 1/n) and reflects specularly with F (TIR: all),
- * until less than 1e-16 of it is left (a corner hit reflects both components). */
-static double beam_left(const ppb_scene *sc, double xe, void *arg)
-{
-    const beam_dir *b = arg;
-    double hw = 0.5 * sc->width, depth = sc->height;
-    double x = xe, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, left = 0.0;
-    for (int hit = 0; hit < 1000000 && w > 1e-16; hit++) {
-        double tx = dx > 0 ? (hw - x) / dx : (dx < 0 ? (-hw - x) / dx : INFINITY);
-        double ty = dy > 0 ? -y / dy : (dy < 0 ? (-depth - y) / dy : INFINITY);
-        int wall_x = tx <= ty, wall_y = ty <= tx;
-        double t = fmin(tx, ty);
-        double x1 = wall_x ? (dx > 0 ? hw : -hw) : x + t * dx;
-        double y1 = wall_y ? (dy > 0 ? 0.0 : -depth) : y + t * dy;
-        w *= exp(-ppb_segment_optical_depth(sc, x, y, x1, y1));
-        double f = ppb_fresnel(wall_y ? fabs(dy) : fabs(dx), 1.0 / b->n);
-        left += w * (1.0 - f);
-        w *= f;
-        if (wall_x)
-            dx = -dx;
-        if (wall_y)
-            dy = -dy;
-        x = x1;
-        y = y1;
-    }
-    return left;
-}
-
-/* The ballistic total at n > 1 per unit incident power: the entering 1 - F(theta_L) times what
- * leaves unscattered. Slab: with e = exp(-tau0 / cos theta_t) and F_b = F(cos theta_t, 1/n) at
- * both faces, the bounces sum to (1 - F_b) e / (1 - F_b e). Tube: beam_left averaged over the
- * lit entry points (ppb_lit_integral's Gauss-Legendre panels). Where every side hit is total
- * internal reflection (sin theta_t below the critical cosine: theta_L < 78.5 deg at n = 1.4)
- * the mirrored path is the slab's and the integrand is the slab's constant; otherwise the
- * panels' breaks, those of the unreflected path, miss the kinks that side exits add. */
-static double ballistic_refracted(const ppb_scene *sc, const mp_boundary *bd)
-{
-    beam_dir b = {sc->n, 0.0, ppb_refract_cos(ppb_scene_cos_theta_l(sc), sc->n)};
-    b.sin_t = sqrt(fmax(0.0, 1.0 - b.cos_t * b.cos_t));
-    if (sc->geometry == PPB_GEOM_SLAB) {
-        double e = exp(-sc->sigma_t * sc->height / b.cos_t), fb = ppb_fresnel(b.cos_t, 1.0 / sc->n);
-        return bd->entry * (1.0 - fb) * e / (1.0 - fb * e);
-    }
-    double width, sum = ppb_lit_integral(sc, beam_left, &b, &width);
-    return width > 0.0 ? bd->entry * sum / width : 0.0;
-}
-
 /* Issue 15: the diffusion flux through a surface can come out negative (the dipole images
  * outweigh the real sources where the slab is thin against the extrapolation distance, and at
  * strongly anisotropic g). Radiance cannot be negative, so such a segment is set to 0, counted,
@@ -251,7 +198,7 @@ static int mp_tube(const ppb_config *cfg, const mp_boundary *bd, ppb_result *out
     out->totals.R = surface_power[PPB_S1] * scale;
     out->totals.T = surface_power[PPB_S2] * scale;
     out->totals.sides = (surface_power[PPB_S3] + surface_power[PPB_S4]) * scale;
-    out->totals.ballistic = bd->fresnel ? ballistic_refracted(sc, bd)
+    out->totals.ballistic = bd->fresnel ? ppb_ballistic_refracted(sc)
                                         : ppb_ballistic_fraction(sc); /* over the lit strip */
     out->totals.specular = bd->specular;
     return 0;
@@ -275,7 +222,7 @@ static int mp_slab(const ppb_config *cfg, const mp_boundary *bd, ppb_result *out
     out->totals.T = clamp_flux(&neg, T);
     clamp_report(cfg, out, &neg);
     out->totals.sides = 0;
-    out->totals.ballistic = bd->fresnel ? ballistic_refracted(sc, bd) : ppb_ballistic_fraction(sc);
+    out->totals.ballistic = bd->fresnel ? ppb_ballistic_refracted(sc) : ppb_ballistic_fraction(sc);
     out->totals.specular = bd->specular;
     fill_bins(out, sc, bd, PPB_S1, 0, cos_l * out->totals.R);
     fill_bins(out, sc, bd, PPB_S2, 0, cos_l * out->totals.T);

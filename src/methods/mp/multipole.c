@@ -8,6 +8,7 @@
 #include "kernels/ppb_fresnel.h"
 
 #include "base/quadrature.h"
+#include "physics/diffuse_exit.h"
 
 /* Mirror index of pair k in the order 0, +1, -1, +2, -2, ... */
 static int pair_index(int k)
@@ -72,32 +73,6 @@ int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo
     return 0;
 }
 
-/* 2 int_a^b (1 - F(mu, n)) mu dmu for light from air (n_rel = n >= 1), where F is analytic in
- * mu on [0, 1] (cos_t >= sqrt(1 - 1/n^2) > 0): `panels` panels of 16-point Gauss-Legendre. */
-static double transmitted_moment(double n, double a, double b, int panels)
-{
-    double x[16], w[16], sum = 0, half = 0.5 * (b - a) / panels;
-    ppb_gauss_legendre(16, x, w);
-    for (int p = 0; p < panels; p++) {
-        double mid = a + (2 * p + 1) * half;
-        for (int j = 0; j < 16; j++) {
-            double mu = mid + half * x[j];
-            sum += w[j] * (1.0 - ppb_fresnel(mu, n)) * mu;
-        }
-    }
-    return 2.0 * half * sum;
-}
-
-double ppb_mp_diffuse_fresnel(double n_rel)
-{
-    if (n_rel == 1.0)
-        return 0.0;
-    if (n_rel > 1.0)
-        return 1.0 - transmitted_moment(n_rel, 0.0, 1.0, 8);
-    double n = 1.0 / n_rel; /* from inside: Prahl 1988 Eq. B.14 (multipole.h) */
-    return 1.0 - transmitted_moment(n, 0.0, 1.0, 8) / (n * n);
-}
-
 double ppb_mp_diffuse_fresnel_fit(double n)
 {
     return -1.440 / (n * n) + 0.710 / n + 0.668 + 0.0636 * n;
@@ -107,21 +82,8 @@ double ppb_multipole_boundary_A(double n)
 {
     if (!(n > 1.0))
         return 1.0;
-    double fdr = ppb_mp_diffuse_fresnel(1.0 / n);
+    double fdr = ppb_diffuse_fresnel(1.0 / n);
     return (1.0 + fdr) / (1.0 - fdr);
-}
-
-void ppb_multipole_exit_lobe(double n, int ntheta, double *lobe)
-{
-    double mean = 1.0 - ppb_mp_diffuse_fresnel(n); /* 1 - F_dr,e */
-    for (int k = 0; k < ntheta; k++) {
-        /* Bin k spans sin^2 in [k, k + 1] / ntheta, i.e. mu_o from sqrt(1 - (k + 1) / ntheta)
-         * to sqrt(1 - k / ntheta); d(sin^2) = 2 mu dmu, so the bin mean is ntheta times the
-         * transmitted moment over that mu range. */
-        double lo = sqrt(fmax(0.0, 1.0 - (double)(k + 1) / ntheta));
-        double hi = sqrt(1.0 - (double)k / ntheta);
-        lobe[k] = ntheta * transmitted_moment(n, lo, hi, 1) / mean;
-    }
 }
 
 int ppb_multipole_nsources(const ppb_multipole *mp)

@@ -17,6 +17,7 @@
 #define PPB_MULTIPOLE_H
 
 #include "base/err.h"
+#include "physics/diffuse_exit.h" /* the diffuse Fresnel reflectance, the exit lobe */
 
 #define PPB_MP_MAX_PAIRS 257
 
@@ -56,34 +57,14 @@ int ppb_multipole_init_boundary(ppb_multipole *mp, double sigma_t, double albedo
 
 /* ---- Refractive boundaries (n > 1; reference: Methods, `mp`) ---- */
 
-/* Diffuse (hemispherical, cosine-weighted) Fresnel reflectance 2 int_0^1 F(mu, n_rel) mu dmu of
- * the exact unpolarized F of kernels/ppb_fresnel.h, for light arriving from the side where the
- * relative index is n_rel: n_rel = n from air (F_dr,e, smooth in mu: composite 16-point
- * Gauss-Legendre, ~1e-15), n_rel = 1/n from inside (the F_dr of Jensen et al. 2001, with TIR).
- * The inside value is 1 - (1 - F_dr,e(n)) / n^2 exactly: substituting the air-side cosine
- * (n^2 mu dmu = mu_o dmu_o by Snell) in the part below the critical angle, with F equal on both
- * sides of a refraction (Stokes); Prahl 1988 Eq. B.14. 0 at n_rel = 1. */
-double ppb_mp_diffuse_fresnel(double n_rel);
-
 /* The Egan-Hilgeman / Groenhuis polynomial fit of the inside F_dr that Jensen et al. 2001 Eq. 5
  * uses, -1.440/n^2 + 0.710/n + 0.668 + 0.0636 n (n the medium's index): kept for comparison
  * (tests), not used by mp (0.0016 at n = 1, where the exact value is 0). */
 double ppb_mp_diffuse_fresnel_fit(double n);
 
-/* A = (1 + F_dr) / (1 - F_dr) with the exact inside F_dr = ppb_mp_diffuse_fresnel(1/n)
+/* A = (1 + F_dr) / (1 - F_dr) with the exact inside F_dr = ppb_diffuse_fresnel(1/n)
  * (Jensen et al. 2001 Eq. 4); exactly 1 at n <= 1. */
 double ppb_multipole_boundary_A(double n);
-
-/* The exit lobe in air at n > 1, per theta bin of kernels/ppb_conventions.h (edges sin^2 =
- * k / ntheta, equal projected solid angle): lobe[k] = the bin's projected-solid-angle mean of
- * F_t(mu_o) = 1 - F(mu_o, n), divided by 1 - F_dr,e(n), its mean over the hemisphere. The
- * radiance leaving a face is J lobe[k] / pi for a diffusion flux J through it: Jensen et al.
- * 2001's F_t(eta, w_o) / pi form, normalised so that the lobe integrates to J over the exit
- * hemisphere (the flux -D grad(phi) already is the power that crosses the boundary: the
- * boundary condition with A holds its internal reflections; unnormalised, J (1 - F_dr,e) would
- * leave and F_dr,e J would be lost). The mean of lobe[] over the bins is 1 to rounding; each
- * bin's mean by 16-point Gauss-Legendre in mu_o, where F is smooth. */
-void ppb_multipole_exit_lobe(double n, int ntheta, double *lobe);
 
 int ppb_multipole_nsources(const ppb_multipole *mp);
 
