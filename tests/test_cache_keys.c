@@ -219,12 +219,13 @@ static void test_noise_chunk_key(void **state)
 }
 
 /* The photons a run traced (provenance.txt's mc.photons_traced), or -1 when it took them from
- * the cache (it writes no such line then, and says so). */
+ * the cache (it writes no such line then, and says so on stderr: the run is not --quiet, which
+ * says nothing on success). */
 static long long run_traced(const char *cache, const char *out, long long chunk)
 {
     char args[4096];
-    snprintf(args, sizeof args, "run --quiet --ref-cache %s --set mc.chunk=%lld --out %s %s", cache,
-             chunk, out,
+    snprintf(args, sizeof args, "run --ref-cache %s --set mc.chunk=%lld --out %s %s", cache, chunk,
+             out,
              cli_config("cache_noise", "[experiment]\nmethods = mc\n[tube]\nsegments_top = 8\n"
                                        "segments_side = 3\n[bins]\ntheta = 2\nphi = 2\n[mc]\n"
                                        "photons = 400000\ntarget_noise = 0.05\n"));
