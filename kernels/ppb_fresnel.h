@@ -1,4 +1,4 @@
-/* ppb_fresnel.h: the smooth dielectric boundary at n > 1 (issue 18; reference: Keys), coded
+/* ppb_fresnel.h: the smooth dielectric boundary at n > 1 (reference: Keys), coded
  * once for host and kernels.
  *
  * Owns: the exact unpolarized Fresnel reflectance from the s- and p-amplitude coefficients

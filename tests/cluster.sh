@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# cluster.sh: issue 20's end-to-end test of scale-out, run by `make test-cluster` (and so by
+# cluster.sh: the end-to-end test of scale-out, run by `make test-cluster` (and so by
 # `make test`). Every result is compared with cmp to a whole run on this machine:
 #   1. GNU parallel: a 12-point sweep as 4 `ppbench sweep --shard I/4` on this machine, merged;
 #   2. a real single-node Slurm cluster (Debian's slurm-wlm and munge), started here without
@@ -27,7 +27,7 @@ sweep_cfg=configs/sweep_example.ini
 sweep_set=(--set experiment.methods=mc,mp --set mc.photons=2e4 --set tube.segments_top=16
            --set tube.segments_side=6)
 # The Monte Carlo: each shard runs a few seconds, so that one can be killed while running. At
-# 1e7 photons (2.5e6 a shard) the 3x faster kernel of issue 21 finished a shard within a second:
+# 1e7 photons (2.5e6 a shard) the 3x faster kernel finished a shard within a second:
 # a fresh-clone CI run (2026-12-02) cancelled task 4 after it had written its tallies. 4e8: a
 # shard is 1e8 photons, several seconds on 2 cores shared by 2 tasks (the whole run about 12 s).
 mc_cfg=configs/uniform_g0_normal.ini

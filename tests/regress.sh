@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# regress.sh: the regression gate `make test` runs after the unit tests (issue 7).
+# regress.sh: the regression gate `make test` runs after the unit tests.
 # Runs the reduced study (every case of configs/study.list at a small photon budget) and the
 # slab checks (tests/regress/*.ini) under build/regress/ -- never over results/ -- then checks
 # every line of tests/thresholds.txt and prints each check with its measured value.

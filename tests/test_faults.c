@@ -1,4 +1,4 @@
-/* Faults and hostile input driven through the command line (issue 14): each test reproduces a
+/* Faults and hostile input driven through the command line: each test reproduces a
  * defect found on the earlier code and checks the fixed behaviour: a clear message naming the
  * file, key or option, the documented exit code (1 run failure, 2 bad input, 130 interrupted),
  * and no crash. Runs the built binary ($PPBENCH). */

@@ -447,7 +447,7 @@ static void test_shared_exposure_and_files(void **state)
     fake_free(f);
 }
 
-/* One exposure per view (issue 16: a shared one saturated the top view): the reference's S1
+/* One exposure per view (a shared one saturated the top view): the reference's S1
  * four times as bright as the rest. Each view's white is the reference's 99th percentile in
  * that view, so S1 (most of the top view) and S2 (most of the bottom view) are both white on
  * the reference, and half of each is sRGB(0.5) = 188 on pp. With one exposure for the panel,
@@ -531,7 +531,7 @@ static void test_slab_writes_nothing(void **state)
 }
 
 /* Every EXR of an experiment names its method, case, seed, photon budget, version and what it
- * shows (issue 16: pbrt-v4 writes its settings into its EXRs); without a meta, "unknown". */
+ * shows (pbrt-v4 writes its settings into its EXRs); without a meta, "unknown". */
 static void test_image_exr_metadata(void **state)
 {
     (void)state;

@@ -1,4 +1,4 @@
-/* The command line's options (issue 14, "Options", "--help", "a bad --device", "output and
+/* The command line's options ("Options", "--help", "a bad --device", "output and
  * device problems found only after computing"): each test reproduces a defect of the earlier
  * src/drivers/main.c and checks the fixed behaviour. A bad command line is exit 2 with a
  * message naming the option (and the command), before any work starts: where the old binary

@@ -1,4 +1,4 @@
-/* Output sets (issue 14), through the built binary ($PPBENCH): an experiment's output set is
+/* Output sets, through the built binary ($PPBENCH): an experiment's output set is
  * committed whole or not at all, and a run owns its output directory. Each test reproduces a
  * defect of the earlier code (named in its comment) and checks the fixed behaviour:
  * - a re-run with fewer methods leaves none of the previous run's files;

@@ -180,7 +180,7 @@ static double case_rms(FILE *f, ref_case *c, char *line, size_t len)
 }
 
 /* Exit radiance at M = 668 against PythonicDISORT (tests/data/gen_ppslab_ref.py): rms_rel
- * below 0.5% for every case of issue 3 (tau0 = 3, alpha 0.95 / 0.475, g 0 / +-0.5, theta_L 0 /
+ * below 0.5% for every case (tau0 = 3, alpha 0.95 / 0.475, g 0 / +-0.5, theta_L 0 /
  * 45 deg). */
 static void test_radiance_matches_disort(void **state)
 {
@@ -222,7 +222,7 @@ static int all_finite(pp_solution *s, double tau0)
 }
 
 /* No NaN or Inf over alpha in [0, 1], g in [-0.95, 0.95], tau0 in [1e-3, 1e3], theta_L in
- * [0, 89] deg (issue 3); small N keeps it fast, the scaling does not depend on N. */
+ * [0, 89] deg; small N keeps it fast, the scaling does not depend on N. */
 static void test_no_nan_over_grid(void **state)
 {
     (void)state;

@@ -1,4 +1,4 @@
-/* test_shards.c: issue 14's sweep and Monte Carlo shard defects, each through the built binary
+/* test_shards.c: the sweep and Monte Carlo shard defects, each through the built binary
  * ($PPBENCH) unless it is a library function's, every one failing on the code before its fix:
  * - sweep --jobs 2: killed with -9, its workers die too (they ran on as orphans); interrupted
  *   (SIGINT to its process group as a Ctrl-C sends it, or to the parent alone), it exits 130

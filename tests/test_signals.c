@@ -1,4 +1,4 @@
-/* Signals and the method runner (issue 14, part "signals"), driven through the command line
+/* Signals and the method runner (part "signals"), driven through the command line
  * ($PPBENCH): SIGINT during the plane-parallel setup and during a large ppslab solve is honoured
  * within seconds; a second SIGINT or SIGTERM exits at once; an interrupt skips the methods not
  * yet started, says so and writes what was done, marked partial; mp+ss reuses the experiment's
@@ -351,7 +351,7 @@ static void test_mp_ss_reuses_mp_and_ss(void **state)
     }
 }
 
-/* Issue 16: an interrupted sweep counted the point it was computing as done. Two points of an
+/* An interrupted sweep counted the point it was computing as done. Two points of an
  * endless Monte Carlo, interrupted in the first: the completion line and the summary both say
  * 0 points done (before: "1 point in ... (interrupted)" beside "0 of 2 points done"), and no
  * point's rows are written (the expected count: the files, which the summary counts). */

@@ -1,4 +1,4 @@
-/* test_slurm.c: `ppbench slurm` without a cluster (issue 20; tests/cluster.sh runs it on a real
+/* test_slurm.c: `ppbench slurm` without a cluster (tests/cluster.sh runs it on a real
  * one). Every expected text is the one drivers/slurm.h specifies, written out by hand here:
  * - the array and merge scripts for given options: #SBATCH lines, the task's command (sweep or
  *   mc-shard), the done marker, the merge's check of every marker and its command;

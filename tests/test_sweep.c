@@ -1,4 +1,4 @@
-/* Sweeps and Monte Carlo shards (issue 8), through the built binary ($PPBENCH):
+/* Sweeps and Monte Carlo shards, through the built binary ($PPBENCH):
  * - a 2 x 3 x 2 sweep run whole, as 3 shards under GNU parallel then merged, with --jobs 2, and
  *   killed midway then resumed, gives byte-identical sweep.csv files (expected: the whole
  *   run's bytes);
@@ -8,10 +8,10 @@
  * - the reference cache serves sweep points: a 2-point sweep run again into another directory
  *   traces no photon (counted from what each point's mc says, not timed), by --ref-cache and by
  *   the default ($PPBENCH_CACHE), with the same sweep.csv;
- * - --jobs 2 reports the sweep's point count, not one worker's (issue 16);
+ * - --jobs 2 reports the sweep's point count, not one worker's;
  * - a 1-D sweep of mc alone succeeds without a line plot (nothing is measured against mc), and
  *   with mp beside it draws sweep_rms.png;
- * - a sweep over the refractive index (issue 18) writes each point's `specular` column: the
+ * - a sweep over the refractive index writes each point's `specular` column: the
  *   Fresnel reflectance of the beam at normal incidence, ((n - 1) / (n + 1))^2 (0 and 1/36 for
  *   n = 1 and 1.4), for every method. */
 #include "cliutil.h"

@@ -1,4 +1,4 @@
-/* A sweep goes on past a method that cannot run a point and records it (issue 15), through the
+/* A sweep goes on past a method that cannot run a point and records it, through the
  * built binary ($PPBENCH): mp has no meaning at albedo 1 (README "Known limits") and refuses
  * such a point when it runs; swept over albedo 0.5, 1 the sweep exits 0 and
  * - with mc, ss and mp: sweep.csv holds ss at both points and mp at the first only, failures.csv

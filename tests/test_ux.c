@@ -1,4 +1,4 @@
-/* test_ux.c: issue 16's CLI and provenance items, through the built binary ($PPBENCH) where a
+/* test_ux.c: the CLI and provenance items, through the built binary ($PPBENCH) where a
  * user sees them and through the library where the property is a function's:
  * - provenance.txt records the commit, compiler, OpenCL and library versions, and prints reals
  *   in their shortest round-trip form (0.95; expected from IEEE 754: %.17g of 0.95 is

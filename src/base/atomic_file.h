@@ -5,7 +5,7 @@
  * one) and the commit/abort rules. Two forms: ppb_afile for code that writes through a FILE *,
  * and ppb_apath for libraries that open the file by name themselves (OpenEXR, gnuplot): they
  * are handed apath.tmp, and the caller commits or aborts. A third, ppb_adir, does the same for
- * a whole directory (an experiment's output set, issue 14): it is written under a staging name
+ * a whole directory (an experiment's output set): it is written under a staging name
  * beside it (dir.tmp.<pid>) and swapped into place when complete, so a reader sees the previous
  * set or the new one, never a mix. Also owns the clean-up of the temporaries a killed process
  * left (a name's <pid> no longer alive). Every failure message names the path and the OS's

@@ -7,7 +7,7 @@
  * quiet is set. On a terminal one line is rewritten in place (\r), a few times a second; when
  * stderr is not a terminal (a log, Slurm's output file) each update is a plain line of its own,
  * at most one every PPB_PROGRESS_LOG_SECONDS, so a log holds no \r and a bounded number of
- * lines (issue 16). */
+ * lines. */
 #ifndef PPB_PROGRESS_H
 #define PPB_PROGRESS_H
 

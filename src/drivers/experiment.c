@@ -48,7 +48,7 @@ static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, p
     ctx->nprior = ex->n - nout;
     ctx->self = m;
     if (m->run(ctx, out, &why)) {
-        /* Issue 15: this method's failure is its own; the others run on. */
+        /* This method's failure is its own; the others run on. */
         for (int i = 0; i < nout; i++)
             ppb_result_free(&out[i]);
         ex->n -= nout;
@@ -83,7 +83,7 @@ static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, p
         fprintf(stderr, "%s: %s done in %.2f s (timings.csv: setup and kernel build included)\n",
                 ex->cfg->name, id, seconds);
     if (out[0].partial && m->reference != 1) {
-        /* Issue 14: a deterministic method stopped midway holds cells it never computed, which
+        /* A deterministic method stopped midway holds cells it never computed, which
          * would read as zero radiance, like data: none of its rows are written (README:
          * outputs). The Monte Carlo's partial result is an estimate from fewer photons: kept. */
         for (int i = 0; i < nout; i++)
@@ -103,7 +103,7 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
     memset(ex, 0, sizeof *ex);
     ex->cfg = cfg;
     ctx->cfg = cfg;
-    /* Issue 15: the result arrays are estimated and checked before any is allocated, and the
+    /* The result arrays are estimated and checked before any is allocated, and the
      * work is said before it starts (methods/work_estimate.h). */
     double bytes = ppb_work_results_bytes(cfg);
     char detail[128];
@@ -240,7 +240,7 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, const ppb
     return ppb_afile_commit(&af, err);
 }
 
-/* config.ini: the resolved config as an INI file, which `ppbench run` takes (issue 16: a run
+/* config.ini: the resolved config as an INI file, which `ppbench run` takes (a run
  * can be repeated from its own output set; docs/reference.md: Outputs). */
 static int write_config_ini(const ppb_experiment *ex, const char *dir, ppb_err *err)
 {
@@ -477,7 +477,7 @@ void ppb_experiment_print_summary(const ppb_experiment *ex, FILE *f)
 
 int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
 {
-    /* Issue 14: the set is written whole into a staging directory beside the output directory
+    /* The set is written whole into a staging directory beside the output directory
      * and swapped into place, so a failure midway (a full disk) leaves the previous set as it
      * was and a smaller set never sits beside a previous run's files. */
     ppb_adir ad;

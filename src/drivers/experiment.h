@@ -25,12 +25,12 @@ typedef struct ppb_experiment {
     char device[512];                /* "" when no method used OpenCL */
     ppb_ocl_versions ocl_versions;   /* the device's versions (when device is not "") */
     int partial;                     /* interrupted: results are incomplete */
-    /* Methods that failed at this point (issue 15): no results of theirs, their reasons kept,
+    /* Methods that failed at this point: no results of theirs, their reasons kept,
      * the other methods run on. */
     int nfailed;
     char failed[PPB_MAX_METHODS][32];
     char failed_why[PPB_MAX_METHODS][2048];
-    /* Deterministic methods interrupted midway (issue 14): none of their rows are written. */
+    /* Deterministic methods interrupted midway: none of their rows are written. */
     int nincomplete;
     char incomplete[PPB_MAX_METHODS][32];
 } ppb_experiment;
@@ -39,7 +39,7 @@ typedef struct ppb_experiment {
  * the others go on; fails only when no method produced a result (with the first reason). */
 int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx *ctx,
                            ppb_err *err);
-/* Whether dir may take an output set (issue 14: a run owns its output directory, and replaces
+/* Whether dir may take an output set (a run owns its output directory, and replaces
  * it whole): it does not exist, is empty, or holds a ppbench output set (its provenance.txt
  * says so). Removes what dead processes left in and beside it (ppb_adir_clean). Fails,
  * having touched nothing, for a directory holding files ppbench did not write or one another

@@ -174,7 +174,7 @@ int ppb_mc_shard_merge(const ppb_config *cfg, const char *const *dirs, int ndirs
         ex.res[0].photons = ex.res[1].photons = cfg->mc.photons;
         rc = ppb_experiment_write(&ex, err);
     }
-    if (rc == 0) /* issue 16: the last line says where the results went, as `run` does */
+    if (rc == 0) /* the last line says where the results went, as `run` does */
         fprintf(stderr, "%s: wrote %s\n", cfg->name, cfg->out_dir);
     ppb_experiment_free(&ex);
     ppb_mc_tallies_free(&sum);

@@ -1,4 +1,4 @@
-/* mc_shard.h: one Monte Carlo run split across machines (issue 8): each shard traces a
+/* mc_shard.h: one Monte Carlo run split across machines: each shard traces a
  * disjoint photon range of the same config into integer tallies (mc_tallies.bin), and the
  * merge adds them and writes the experiment's outputs for mc and mc1 -- byte-identical to one
  * `ppbench run` of the whole budget with methods = mc, since photon i's random numbers and

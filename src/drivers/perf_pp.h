@@ -1,4 +1,4 @@
-/* perf_pp.h: the plane-parallel solver's benchmark (issue 3): median times of the stages of a
+/* perf_pp.h: the plane-parallel solver's benchmark: median times of the stages of a
  * full slab solve (src/physics/ppsolver.h) at M = 668 and M = 128, on one core. */
 #ifndef PPB_PERF_PP_H
 #define PPB_PERF_PP_H

@@ -173,7 +173,7 @@ static int is_table2_cell(const char *cell)
     return !strcmp(cell, "R_x0") || !strcmp(cell, "T_x0");
 }
 
-/* The first line of each file report writes, by which it knows its own (issue 14). table2.csv
+/* The first line of each file report writes, by which it knows its own. table2.csv
  * and table2.md start with their header rows, which no other file has; README.md with an HTML
  * comment (invisible on the rendered page). A README.md an earlier ppbench report wrote starts
  * with its title line instead, also accepted. */

@@ -7,10 +7,10 @@
  * the images, and the case files kept in the repository, so a reader sees the study at a
  * glance (reference: Outputs).
  *
- * It replaces only files it wrote (issue 14: `ppbench report . CASE` overwrote the repository's
+ * It replaces only files it wrote (`ppbench report . CASE` overwrote the repository's
  * README.md): each file it writes starts with a line saying so, checked before anything is
  * written. It says on stderr what it wrote, one line per file, and ends with the line
- * `ppbench report: wrote STUDY_DIR (3 files)` (issue 16: as `run` says where results went).
+ * `ppbench report: wrote STUDY_DIR (3 files)` (as `run` says where results went).
  * The three files are written under temporary names and put in place together, with SIGINT
  * and SIGTERM held off for the renames (ppb_apaths_commit): never new tables beside an old
  * README. */

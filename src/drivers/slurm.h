@@ -1,5 +1,4 @@
-/* slurm.h: `ppbench slurm`, a sweep or one experiment's Monte Carlo as a Slurm job array
- * (issue 20).
+/* slurm.h: `ppbench slurm`, a sweep or one experiment's Monte Carlo as a Slurm job array.
  *
  * Owns the job directory and the scripts written into it: the resolved config (config.ini),
  * the ppbench binary that every task runs (a copy), the array script (job.sh: task I runs

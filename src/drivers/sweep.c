@@ -126,7 +126,7 @@ static int run_point(const ppb_config *cfg, const ppb_config *pt, uint64_t h, pp
         ppb_experiment_free(&ex);
         return 0;
     }
-    rc = ppb_sweep_failures_point(cfg->out_dir, h, &ex, rc, err); /* issue 15: recorded */
+    rc = ppb_sweep_failures_point(cfg->out_dir, h, &ex, rc, err); /* recorded */
     if (rc == 0) {
         char path[1300];
         ppb_afile af;
@@ -370,7 +370,7 @@ static long long shard_done(const ppb_config *cfg, const ppb_grid *grid, const u
 }
 
 /* The points with index % parts == part, one device context for all of them. A point counts as
- * done once its rows are written: an interrupted or failed one is not (issue 16: the point in
+ * done once its rows are written: an interrupted or failed one is not (the point in
  * progress at a Ctrl-C was counted). The completion line is printed when end_line is set (the
  * serial sweep; with --jobs the parent prints it for all workers). */
 static int run_shard(const ppb_config *cfg, const ppb_grid *grid, const uint64_t *hashes,
@@ -412,7 +412,7 @@ static void sleep_ms(long ms)
 
 /* --jobs J: J processes, each its own device context, taking every J-th point of this shard;
  * the first one shows progress, and this process, once all have ended, the completion line
- * with the points of the whole shard done (issue 16: it was the first worker's own count,
+ * with the points of the whole shard done (it was the first worker's own count,
  * "1 points" of a 2-point sweep under --jobs 2). A failing child's message is on its stderr.
  *
  * The workers die with the sweep: each asks the kernel for SIGTERM when its parent dies

@@ -1,4 +1,4 @@
-/* sweep_failures.h: the failed points of a sweep (issue 15): a method that fails or is refused
+/* sweep_failures.h: the failed points of a sweep: a method that fails or is refused
  * at a grid point is recorded with its reason while the sweep goes on, and failures.csv beside
  * sweep.csv lists them (docs/reference.md: Outputs).
  *

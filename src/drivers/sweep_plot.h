@@ -1,4 +1,4 @@
-/* sweep_plot.h: the plots of a sweep (issue 8, issue 16; reference: Sweeps), drawn by gnuplot
+/* sweep_plot.h: the plots of a sweep (reference: Sweeps), drawn by gnuplot
  * as PNG and PDF with scripts/plot_style.gp's colours and palette. Two or more swept keys:
  * <dir>/heatmap_<method>.{png,pdf} for every method but the reference, its RMS at x = 0 on S1
  * (R) and S2 (T) in percent over the first two keys, one cell per grid point (index-spaced,

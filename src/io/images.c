@@ -18,8 +18,8 @@
  *                       to x = KNEE (0.75) and above it rolls off smoothly (same slope at the
  *                       knee) toward 1, k + (1 - k)(1 - exp(-(x - k) / (1 - k))), so only
  *                       pixels above about 1.8 L_white are pure white. A plain clamp with one
- *                       exposure for the whole picture left much of S1 pure white (issue 16:
- *                       about 36% of S1 pixels) and hid the density step's pattern on S1
+ *                       exposure for the whole picture left much of S1 pure white (about
+ *                       36% of S1 pixels) and hid the density step's pattern on S1
  *                       (paper Fig. 7); a method brighter than the reference (pp, mp) clipped
  *                       most of its top view even with one exposure per view (63% of pp's on
  *                       uniform_g0_normal). Below the knee, grey levels compare linearly

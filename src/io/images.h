@@ -11,7 +11,7 @@
 #include "model/result.h"
 #include "model/scene.h"
 
-/* What the run was, written into every EXR's header (issue 16; reference: Outputs) with the
+/* What the run was, written into every EXR's header (reference: Outputs) with the
  * method and what the image shows. NULL strings are written as "unknown". */
 typedef struct ppb_image_meta {
     const char *case_name; /* experiment.name */

@@ -21,7 +21,7 @@ typedef struct ppb_scene {
     double width, height; /* mfp; width unused in slab mode */
     int segments_top, segments_side;
     double sigma_t, albedo, g;
-    double n; /* refractive index inside (outside is 1); n <= 1 means no boundary (issue 18) */
+    double n; /* refractive index inside (outside is 1); n <= 1 means no boundary */
     int step; /* PPB_STEP_* */
     double step_x, sigma_t_right, albedo_right;
     double theta_deg; /* light incidence from the S1 normal */

@@ -9,7 +9,7 @@
  * the only map error is bilinear interpolation across a kink or jump that cuts a cell (oblique
  * light with a density or albedo step), and it vanishes as map_res grows.
  *
- * At n > 1 (issue 18) the maps and ppb_light_path_exact follow the refracted beam inside
+ * At n > 1 the maps and ppb_light_path_exact follow the refracted beam inside
  * (sin theta_t = sin theta_L / n); ppb_beam_depth, ppb_lit_integral and ppb_ballistic_fraction
  * keep theta_L and no Fresnel factor (the marcher's totals at n > 1 use them at normal
  * incidence only, where theta_t = theta_L, and add the factors themselves: march.c). */
@@ -34,7 +34,7 @@ typedef struct ppb_maps {
  * shadow (reference: Light; a path meeting S1's plane left of -W/2 is unlit), so only the
  * nearest of them is stored: the lookup clamps the others to it, where lit = 0 exactly and the
  * march adds nothing. At oblique light that is the difference between W and W + H tan(theta_L)
- * columns (22 GB at H = 100, theta_L = 80: issue 15). */
+ * columns (22 GB at H = 100, theta_L = 80). */
 int ppb_maps_build(const ppb_scene *sc, int map_res, ppb_maps *m, ppb_err *err);
 
 /* Bytes ppb_maps_build will allocate (estimated before any allocation). */

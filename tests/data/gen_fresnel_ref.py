@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Regenerates tests/data/fresnel_ref.csv: slab totals with Fresnel boundaries (issue 18) from an
+"""Regenerates tests/data/fresnel_ref.csv: slab totals with Fresnel boundaries from an
 independent solver, iadpython (pip install iadpython==0.5.3 scipy), Prahl's adding-doubling
 method, for tests/test_fresnel.c.
 

@@ -3,7 +3,7 @@
 totals from an independent solver, PythonicDISORT (pip install PythonicDISORT==1.8), a
 discrete-ordinates code (Stamnes' DISORT in Python), for tests/test_ppsolver.c.
 
-Cases: tau0 = 3, albedo in {0.95, 0.475}, g in {0, 0.5, -0.5}, theta_L in {0, 45} deg (issue 3).
+Cases: tau0 = 3, albedo in {0.95, 0.475}, g in {0, 0.5, -0.5}, theta_L in {0, 45} deg.
 HG Legendre coefficients g^l, NQuad = 32 streams, no delta-M, no corrections (g <= 0.5 is
 resolved without them). DISORT's frame matches ppsolver's: mu > 0 up, tau down, and the beam
 and the outgoing direction are both directions of travel, so the beam at phi0 = 0 travels

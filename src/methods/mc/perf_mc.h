@@ -1,7 +1,7 @@
-/* perf_mc.h: the Monte Carlo throughput benchmark (issue 4): photons/s and scattering events/s
+/* perf_mc.h: the Monte Carlo throughput benchmark: photons/s and scattering events/s
  * of kernels/mc.cl on the chosen device, for the uniform tube (reference: Cases) at g = 0 and
  * g = 0.5 (normal incidence, alpha = 0.95), printed with the device name and the 20 M events/s
- * target, and the figure of merit of issue 21: the seconds to reach a 1% and a 0.5% noise floor
+ * target, and the figure of merit: the seconds to reach a 1% and a 0.5% noise floor
  * at the Table 2 cells (noise_rel at the x = 0 cells of S1 and S2, the larger), from the timed
  * run's noise scaled as 1/sqrt(photons). */
 #ifndef PPB_MC_PERF_H

@@ -143,7 +143,7 @@ static void fill_bins(ppb_result *out, const ppb_scene *sc, const mp_boundary *b
             bd->fresnel ? radiance * bd->lobe[b / sc->nphi] : radiance;
 }
 
-/* Issue 15: the diffusion flux through a surface can come out negative (the dipole images
+/* The diffusion flux through a surface can come out negative (the dipole images
  * outweigh the real sources where the slab is thin against the extrapolation distance, and at
  * strongly anisotropic g). Radiance cannot be negative, so such a segment is set to 0, counted,
  * and the count reported: never clamped silently. */
@@ -261,7 +261,7 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
-    /* Where the model has no meaning, say so before any work (issue 15). */
+    /* Where the model has no meaning, say so before any work. */
     if (sc->albedo >= 1.0)
         return ppb_config_key_fail(
             cfg, "medium", "albedo", err,

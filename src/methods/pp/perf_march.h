@@ -1,4 +1,4 @@
-/* perf_march.h: the ray marcher's benchmark (issue 5): ray-march evaluations per second and the
+/* perf_march.h: the ray marcher's benchmark: ray-march evaluations per second and the
  * time of one whole tube case (every segment x every bin) for `pp` (S and R tables) and `ss` on
  * the device, beside the host time to build the maps and tables. */
 #ifndef PPB_PP_PERF_MARCH_H

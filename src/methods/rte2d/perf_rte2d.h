@@ -1,4 +1,4 @@
-/* perf_rte2d.h: the benchmark of `rte2d` (issue 19): one converged study case (the run's
+/* perf_rte2d.h: the benchmark of `rte2d`: one converged study case (the run's
  * config, default the uniform g = 0 tube) on the device, its time per case (with the refinement
  * study, as `ppbench run` pays it) and per refinement (one march over the grid), the study's
  * share, and the solve's size. */

@@ -1,6 +1,6 @@
 /* rte2d_beam.h: the direct beam's collision density integrated exactly over an axis-aligned
  * rectangle of the cross-section, the first-scattering source of a flat-source region of `rte2d`
- * (reference: Methods, Light; issue 18 for n > 1).
+ * (reference: Methods, Light; Medium for n > 1).
  *
  * Owns: the closed-form integral of sigma_t E_k over [x0, x1] x [y0, y1] for the beam's four
  * direction classes k, with E_k exactly as kernels/rte2d.cl's rte_ray_side weights them:
