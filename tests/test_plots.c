@@ -1,10 +1,10 @@
 /* test_plots.c: the figures of a run and of a sweep (scripts/plots.sh, src/io/plots.c,
  * src/drivers/sweep_plot.c; reference: Outputs, Sweeps). `ppbench run` draws them inside its
  * output set; every figure is there as PNG and PDF with the panels, labels and markers
- * docs/reference.md (Outputs) describes, read from the gnuplot scripts plots.sh keeps under PPB_PLOTS_KEEP; without mc the
- * run still succeeds and draws what exists; a sweep's heat map has a row of panels per value of
- * its third key and a 1-D sweep gets a line plot; rms_vs_x's four panels share one y range;
- * sweeps plot the RMS beyond the noise floor (docs/reference.md: Sweeps). */
+ * docs/reference.md (Outputs) describes, read from the gnuplot scripts plots.sh keeps under
+ * PPB_PLOTS_KEEP; without mc the run still succeeds and draws what exists; a sweep's heat map has a
+ * row of panels per value of its third key and a 1-D sweep gets a line plot; rms_vs_x's four panels
+ * share one y range; sweeps plot the RMS beyond the noise floor (docs/reference.md: Sweeps). */
 #include "testutil.h"
 
 #include <sys/stat.h>

@@ -440,23 +440,24 @@ char *ppb_slurm_check_script(const ppb_slurm_job *job, const ppb_slurm_opts *o,
     fprintf(f, "\nsource=${PPBENCH_SOURCE:-");
     put_quoted(f, kernel_dir);
     fprintf(f, "}\n");
-    fprintf(f, "node=$(hostname)\nbad=0\n"
-               "missing=$(ldd \"$dir/ppbench\" 2>&1 | grep 'not found')\n"
-               "if [ -n \"$missing\" ]; then\n"
-               "  echo \"ppbench slurm check: $node lacks shared libraries of $dir/ppbench:\"\n"
-               "  echo \"$missing\"\n  bad=1\nfi\n"
-               "if [ ! -r \"$source/kernels\" ] || [ ! -r \"$source/src/methods\" ]; then\n"
-               "  echo \"ppbench slurm check: $node cannot read the kernel sources in $source \"\\\n"
-               "       \"(a file system the nodes share, or PPBENCH_SOURCE)\"\n  bad=1\nfi\n"
-               "if [ $bad = 0 ]; then\n"
-               "  devices=$(\"$dir/ppbench\" devices 2>&1)\n"
-               "  if [ $? != 0 ] || ! grep -q '^[0-9]' <<<\"$devices\"; then\n"
-               "    echo \"ppbench slurm check: $node has no OpenCL device (an ICD in \"\\\n"
-               "         \"/etc/OpenCL/vendors and its driver):\"\n"
-               "    echo \"$devices\"\n    bad=1\n  else\n"
-               "    echo \"$devices\"\n  fi\nfi\n"
-               "[ $bad = 0 ] && echo \"ppbench slurm check: ok on $node\"\n"
-               "exit $bad\n");
+    fprintf(f,
+            "node=$(hostname)\nbad=0\n"
+            "missing=$(ldd \"$dir/ppbench\" 2>&1 | grep 'not found')\n"
+            "if [ -n \"$missing\" ]; then\n"
+            "  echo \"ppbench slurm check: $node lacks shared libraries of $dir/ppbench:\"\n"
+            "  echo \"$missing\"\n  bad=1\nfi\n"
+            "if [ ! -r \"$source/kernels\" ] || [ ! -r \"$source/src/methods\" ]; then\n"
+            "  echo \"ppbench slurm check: $node cannot read the kernel sources in $source \"\\\n"
+            "       \"(a file system the nodes share, or PPBENCH_SOURCE)\"\n  bad=1\nfi\n"
+            "if [ $bad = 0 ]; then\n"
+            "  devices=$(\"$dir/ppbench\" devices 2>&1)\n"
+            "  if [ $? != 0 ] || ! grep -q '^[0-9]' <<<\"$devices\"; then\n"
+            "    echo \"ppbench slurm check: $node has no OpenCL device (an ICD in \"\\\n"
+            "         \"/etc/OpenCL/vendors and its driver):\"\n"
+            "    echo \"$devices\"\n    bad=1\n  else\n"
+            "    echo \"$devices\"\n  fi\nfi\n"
+            "[ $bad = 0 ] && echo \"ppbench slurm check: ok on $node\"\n"
+            "exit $bad\n");
     return text_close(&t);
 }
 
