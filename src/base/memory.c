@@ -1,6 +1,11 @@
 /* memory.c: the memory limit of a run (memory.h). */
 #include "base/memory.h"
 
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <stdint.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 double ppb_memory_physical(void)
@@ -28,4 +33,51 @@ int ppb_memory_check(double bytes, double setting_gb, const char *what, const ch
                     "memory_limit%s)",
                     what, bytes / 1e9, detail, limit / 1e9,
                     setting_gb > 0.0 ? "" : " = 0: half the machine's memory");
+}
+
+void ppb_memory_blas_threads(char **argv)
+{
+    const char *mark = getenv("PPB_BLAS_THREADS_SET");
+    if (mark) { /* the second run: the library has read it; children see what we were given */
+        unsetenv("OPENBLAS_NUM_THREADS");
+        unsetenv("PPB_BLAS_THREADS_SET");
+        return;
+    }
+    if (getenv("OPENBLAS_NUM_THREADS"))
+        return; /* the user's count */
+    setenv("OPENBLAS_NUM_THREADS", "1", 1);
+    setenv("PPB_BLAS_THREADS_SET", "1", 1);
+    execv("/proc/self/exe", argv);
+    /* No /proc: the library's own count, as before. */
+    unsetenv("OPENBLAS_NUM_THREADS");
+    unsetenv("PPB_BLAS_THREADS_SET");
+}
+
+int ppb_memory_can_have(double bytes)
+{
+    if (!(bytes >= 0.0) || bytes > (double)SIZE_MAX)
+        return 0;
+    void *p = malloc((size_t)bytes);
+    free(p);
+    return p != NULL || bytes == 0.0;
+}
+
+double ppb_memory_as_limit(void)
+{
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
+        return 0.0;
+    return (double)rl.rlim_cur;
+}
+
+int ppb_memory_need(double bytes, const char *what, ppb_err *err)
+{
+    if (ppb_memory_can_have(bytes))
+        return 0;
+    double as = ppb_memory_as_limit();
+    char lim[128] = "";
+    if (as > 0.0)
+        snprintf(lim, sizeof lim, " (the address-space limit, ulimit -v, is %.0f MB)", as / 1e6);
+    return ppb_fail(err, "out of memory: %s needs about %.0f MB, which cannot be had%s", what,
+                    bytes / 1e6, lim);
 }

@@ -20,4 +20,31 @@ double ppb_memory_limit(double setting_gb);
 int ppb_memory_check(double bytes, double setting_gb, const char *what, const char *detail,
                      ppb_err *err);
 
+/* The linear-algebra library's threads (docs/reference.md: Keys, run.memory_limit): ppbench
+ * runs OpenBLAS with OPENBLAS_NUM_THREADS = 1 unless that variable is set. OpenBLAS starts its
+ * threads and reads the variable when it is loaded, before main, and a thread whose work buffer
+ * cannot be had retries for ever (an exit then waits on it, deaf to SIGTERM); so when the
+ * variable is not set, ppbench sets it and executes itself again (argv), and the second run
+ * unsets it, so that the commands ppbench starts see the environment it was given. */
+void ppb_memory_blas_threads(char **argv);
+
+/* Whether `bytes` can be allocated now (malloc, touched nowhere, freed). */
+int ppb_memory_can_have(double bytes);
+
+/* The bytes OpenBLAS allocates for its work buffer at its first call (BUFFER_SIZE of its x86-64
+ * builds, 128 MiB, and its guard page): it retries the allocation for ever, so ppbench checks it
+ * first. */
+#define PPB_BLAS_BUFFER_BYTES 134221824.0
+
+/* Address space the OpenCL runtime (the ICD loader, PoCL and LLVM) maps when it is loaded:
+ * about 200 MB with PoCL 3; below that, "no platform found" means out of memory. */
+#define PPB_OCL_LOAD_BYTES 256e6
+
+/* Fails with "out of memory: WHAT needs about X MB, which cannot be had (address-space limit
+ * ...)" unless `bytes` can be had now. */
+int ppb_memory_need(double bytes, const char *what, ppb_err *err);
+
+/* The address-space limit (ulimit -v) in bytes, 0 when there is none. */
+double ppb_memory_as_limit(void);
+
 #endif

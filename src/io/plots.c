@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/child.h"
 
 #ifndef PPB_SCRIPT_DIR
 #define PPB_SCRIPT_DIR "scripts"
@@ -109,16 +110,12 @@ int ppb_plots_write(const char *dir, const char *name, ppb_err *err)
     if (access(script, R_OK) != 0)
         return ppb_fail(err, "cannot read %s (the plot script; PPBENCH_SCRIPTS names its folder)",
                         script);
-    fflush(NULL); /* the child must not repeat buffered output */
-    pid_t pid = fork();
+    /* The script's own messages go to stderr; stdout stays the caller's. Under a guard: the
+     * script and what it starts die with ppbench (base/child.h). */
+    char *argv[] = {"bash", script, (char *)dir, NULL};
+    pid_t pid = ppb_child_spawn("bash", argv, 1, 0);
     if (pid < 0)
         return ppb_fail(err, "cannot start %s", script);
-    if (pid == 0) {
-        /* The script's own messages go to stderr; stdout stays the caller's. */
-        dup2(STDERR_FILENO, STDOUT_FILENO);
-        execlp("bash", "bash", script, dir, (char *)NULL);
-        _exit(127);
-    }
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)
         if (errno != EINTR) /* an interrupt during plotting still waits for the script */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "base/memory.h"
 #include "base/progress.h"
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
@@ -766,4 +767,16 @@ void pp_boundary_totals(const pp_solution *s, double *specular, double *ballisti
 double pp_absorbed(const pp_solution *s)
 {
     return s->absorbed;
+}
+
+int pp_blas_reserve(ppb_err *err)
+{
+    if (ppb_memory_need(PPB_BLAS_BUFFER_BYTES,
+                        "the linear-algebra library's (OpenBLAS) work buffer", err))
+        return -1;
+    /* dpotrf takes the buffer whatever the size (OpenBLAS's interface/lapack/potrf.c). */
+    double one = 1.0;
+    if (LAPACKE_dpotrf(LAPACK_ROW_MAJOR, 'L', 1, &one, 1) != 0)
+        return ppb_fail(err, "LAPACKE_dpotrf of [1] failed");
+    return 0;
 }
