@@ -170,6 +170,26 @@ static void test_csv_unclosed_quote_is_linear(void **state)
     alarm(0);
 }
 
+/* A NUL byte in a CSV record is refused at its line: the text after it was lost (the fields
+ * are C strings), so "x\0junk" read as "x". The expected message is csv_read.c's. */
+static void test_csv_nul_byte(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("csv_nul");
+    char path[1200];
+    snprintf(path, sizeof path, "%s/nul.csv", dir);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fwrite("a,b\nx\0junk,1\n", 1, 15, f);
+    fclose(f);
+    ppb_csv c;
+    ppb_err err = {{0}};
+    assert_int_equal(ppb_csv_open(&c, path, &err), 0);
+    assert_int_equal(ppb_csv_next(&c, &err), -1);
+    assert_non_null(strstr(err.msg, "nul.csv:2: a NUL byte"));
+    ppb_csv_close(&c);
+}
+
 /* Files that are not regular are refused at once, naming the file: a FIFO (open() would wait
  * for a writer for ever) and /dev/zero (never ends) (file_read.h). The alarm turns a reader
  * that blocks into a failure. */
@@ -399,6 +419,7 @@ int main(void)
         cmocka_unit_test(test_csv_long_line),
         cmocka_unit_test(test_csv_unclosed_quote_is_linear),
         cmocka_unit_test(test_read_only_regular_files),
+        cmocka_unit_test(test_csv_nul_byte),
         cmocka_unit_test(test_afile_commit_and_abort),
         cmocka_unit_test(test_apath_commit_and_abort),
         cmocka_unit_test(test_hash_xxh3_values),

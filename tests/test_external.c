@@ -308,6 +308,13 @@ static void test_external_refusals(void **state)
                    "radiance.csv: not a regular file (a character device)");
     expect_bad_copy("ext_fifo_tot", "", "mkfifo \"$1/totals.csv\"",
                     "totals.csv: not a regular file (a FIFO)");
+    /* A negative fraction in totals.csv (R = -0.25 in mp's row, copied): refused at its line. */
+    char after[2600];
+    snprintf(after, sizeof after,
+             "awk -F, -v OFS=, 'NR == 1 || $1 == \"mp\" { if (NR > 1) { $1 = \"bad\"; $2 = "
+             "-0.25 } print }' %s/totals.csv > \"$1/totals.csv\"",
+             ref_dir);
+    expect_bad_copy("ext_negtot", "", after, "totals.csv:2: R = '-0.25': a fraction of the power");
     char body[2600];
 
     /* Timeout: the command and its children are killed (the whole process group). */

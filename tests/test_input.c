@@ -162,6 +162,17 @@ static void test_binary_input(void **state)
     snprintf(args, sizeof args, "run --quiet --out /nonexistent/x '%s'", p);
     cli_expect(args, 2, p);
     assert_printable(cli_out);
+    /* A right-to-left override (U+202E, UTF-8 e2 80 ae) in a name or a method id: refused, shown
+     * escaped (it reversed the rest of the line on a terminal). */
+    p = LIT("rlo", "[experiment]\nname = a\xe2\x80\xae"
+                   "b\n");
+    assert_int_equal(ppb_config_load(&cfg, p, &err), -1);
+    assert_non_null(strstr(err.msg, ":2: [experiment] name: 'a\\xe2\\x80\\xaeb' may hold only"));
+    assert_printable(err.msg);
+    p = LIT("rlo_m", "[experiment]\nmethods = mp, x\xe2\x80\xae\n");
+    assert_int_equal(ppb_config_load(&cfg, p, &err), -1);
+    assert_non_null(strstr(err.msg, ":2: [experiment] methods: method id 'x\\xe2\\x80\\xae'"));
+    assert_printable(err.msg);
     /* A value given through --set is quoted escaped as well. */
     assert_int_equal(ppb_config_load(&cfg, LIT("plain", "[medium]\n"), &err), 0);
     assert_int_equal(ppb_config_set(&cfg, "medium", "g", "\x1b]0;title\x07", &err), -1);

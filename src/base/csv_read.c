@@ -16,6 +16,10 @@ static int append_line(ppb_csv *c, size_t *len, int *quoted)
     if (n < 0)
         return 1;
     c->bytes += (size_t)n;
+    if (memchr(c->ln, '\0', (size_t)n)) { /* the text after it would be lost */
+        c->why = "a NUL byte: not a text file";
+        return -1;
+    }
     if (c->bytes > PPB_READ_MAX) {
         c->why = "more than the bytes read from one file";
         return -1;

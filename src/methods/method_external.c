@@ -291,6 +291,10 @@ int ppb_external_totals(const char *path, const ppb_scene *sc, ppb_result *r, pp
                 ppb_fail(err, "%s:%ld: %s = '%s': not a finite number", path, c.line, names[k],
                          ppb_csv_get(&c, col[k]));
                 goto done;
+            } else if (*dst[k] < 0.0 && k != 3) { /* absorbed may be 1 - the rest */
+                ppb_fail(err, "%s:%ld: %s = '%s': a fraction of the power, must be >= 0", path,
+                         c.line, names[k], ppb_csv_get(&c, col[k]));
+                goto done;
             }
     }
     if (got < 0)
