@@ -303,22 +303,23 @@ static void test_robust_slab(void **state)
 }
 
 /* The thin, grazing, high-index corner, with rte2d at coarse settings (spacing 0.5 mfp, 16
- * directions): H {1e-3, 0.01} x theta_L {80, 89} x n {1.33, 2.5} x albedo {0, 0.95, 1} x g
- * {-0.95, 0.95} (48 points), every tube method (mp and mp+ss but at albedo 1, their documented
+ * directions): H {1e-3, 0.01} x theta_L 89 x n {1.33, 2.5} x albedo {0, 0.95, 1} x g
+ * {-0.95, 0.95} (24 points), every tube method (mp and mp+ss but at albedo 1, their documented
  * refusal). Near the critical angle F_b is near 1 (0.90 at 89 deg for both n) and a row of
  * images adds 0.01 mfp of depth: ss's image series ran to the march's d_cap, 3666 rows a leg
  * (hours at the study's bins; see test_image_series_cost). Asserted as in the grid, and that no
- * total (R, T, sides, ballistic) is negative: rte2d wrote sides = -4.7e-14 here. */
+ * total (R, T, sides, ballistic) is negative: rte2d wrote sides = -6.3e-13 here (result_check.h
+ * now sets a total negative within its round-off to 0). */
 static void test_robust_corner(void **state)
 {
     (void)state;
-    static const double hs[] = {1e-3, 0.01}, ths[] = {80, 89}, ns[] = {1.33, 2.5},
-                        as[] = {0, 0.95, 1}, gs[] = {-0.95, 0.95};
+    static const double hs[] = {1e-3, 0.01}, ths[] = {89}, ns[] = {1.33, 2.5}, as[] = {0, 0.95, 1},
+                        gs[] = {-0.95, 0.95};
     said s;
     memset(&s, 0, sizeof s);
     int points = 0;
     for (int ih = 0; ih < 2; ih++)
-        for (int it = 0; it < 2; it++)
+        for (int it = 0; it < 1; it++)
             for (int in = 0; in < 2; in++)
                 for (int ia = 0; ia < 3; ia++)
                     for (int ig = 0; ig < 2; ig++) {
@@ -361,7 +362,7 @@ static void test_robust_corner(void **state)
                     }
     if (s.other)
         fail_msg("%ld unexpected lines on stderr, the first: %s", s.other, s.other_line);
-    assert_int_equal(points, 48);
+    assert_int_equal(points, 24);
 }
 
 /* ss's image series is refused before any work when its estimated terms exceed

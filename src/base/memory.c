@@ -1,5 +1,9 @@
 /* memory.c: the memory limit of a run (memory.h). */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include "base/memory.h"
+
+#include <math.h>
+#include <sched.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,17 +39,34 @@ int ppb_memory_check(double bytes, double setting_gb, const char *what, const ch
                     setting_gb > 0.0 ? "" : " = 0: half the machine's memory");
 }
 
-void ppb_memory_blas_threads(char **argv)
+int ppb_memory_blas_threads(int have)
 {
     const char *mark = getenv("PPB_BLAS_THREADS_SET");
     if (mark) { /* the second run: the library has read it; children see what we were given */
         unsetenv("OPENBLAS_NUM_THREADS");
         unsetenv("PPB_BLAS_THREADS_SET");
-        return;
+        return have;
     }
-    if (getenv("OPENBLAS_NUM_THREADS"))
-        return; /* the user's count */
-    setenv("OPENBLAS_NUM_THREADS", "1", 1);
+    const char *user[] = {"OPENBLAS_NUM_THREADS", "GOTO_NUM_THREADS", "OMP_NUM_THREADS"};
+    for (int i = 0; i < 3; i++)
+        if (getenv(user[i]))
+            return have; /* the user's count */
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0)
+        cpus = CPU_COUNT(&set);
+    int want = cpus > 0 ? (int)cpus : 1;
+    double as = ppb_memory_as_limit();
+    if (as > 0.0) /* every thread's buffer within a quarter of the address space */
+        want = (int)fmax(1.0, fmin(want, floor(0.25 * as / PPB_BLAS_BUFFER_BYTES)));
+    return want;
+}
+
+void ppb_memory_blas_reexec(int want, char **argv)
+{
+    char n[32];
+    snprintf(n, sizeof n, "%d", want);
+    setenv("OPENBLAS_NUM_THREADS", n, 1);
     setenv("PPB_BLAS_THREADS_SET", "1", 1);
     execv("/proc/self/exe", argv);
     /* No /proc: the library's own count, as before. */

@@ -20,13 +20,19 @@ double ppb_memory_limit(double setting_gb);
 int ppb_memory_check(double bytes, double setting_gb, const char *what, const char *detail,
                      ppb_err *err);
 
-/* The linear-algebra library's threads (docs/reference.md: Keys, run.memory_limit): ppbench
- * runs OpenBLAS with OPENBLAS_NUM_THREADS = 1 unless that variable is set. OpenBLAS starts its
- * threads and reads the variable when it is loaded, before main, and a thread whose work buffer
- * cannot be had retries for ever (an exit then waits on it, deaf to SIGTERM); so when the
- * variable is not set, ppbench sets it and executes itself again (argv), and the second run
- * unsets it, so that the commands ppbench starts see the environment it was given. */
-void ppb_memory_blas_threads(char **argv);
+/* The linear-algebra library's threads (docs/reference.md: Keys, run.memory_limit). OpenBLAS
+ * starts its threads and reads OPENBLAS_NUM_THREADS when it is loaded, before main, and a
+ * thread whose 128 MiB work buffer cannot be had retries for ever (an exit then waits on it,
+ * deaf to SIGTERM). ppbench's count: the CPUs it may run on (OpenBLAS's own default, so results
+ * do not change), fewer under an address-space limit (ulimit -v) so that every thread's buffer
+ * fits in a quarter of it, at least 1; a count the user set (OPENBLAS_NUM_THREADS,
+ * GOTO_NUM_THREADS, OMP_NUM_THREADS) is theirs. ppb_memory_blas_threads returns the count
+ * wanted given `have`, the library's; when they differ the caller executes ppbench again with
+ * OPENBLAS_NUM_THREADS set (ppb_memory_blas_reexec, which returns only if it cannot), and the
+ * second run unsets it (and returns `have`), so that the commands ppbench starts see the
+ * environment it was given. */
+int ppb_memory_blas_threads(int have);
+void ppb_memory_blas_reexec(int want, char **argv);
 
 /* Whether `bytes` can be allocated now (malloc, touched nowhere, freed). */
 int ppb_memory_can_have(double bytes);

@@ -869,7 +869,7 @@ static const command *find_command(const char *name)
 
 int main(int argc, char **argv)
 {
-    ppb_memory_blas_threads(argv); /* may execute ppbench again: first (base/memory.h) */
+    pp_blas_threads(argv); /* may execute ppbench again: first (base/memory.h) */
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") ||
         !strcmp(argv[1], "help")) {
         /* `ppbench help CMD` is `ppbench CMD --help`. */

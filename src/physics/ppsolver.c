@@ -780,3 +780,11 @@ int pp_blas_reserve(ppb_err *err)
         return ppb_fail(err, "LAPACKE_dpotrf of [1] failed");
     return 0;
 }
+
+void pp_blas_threads(char **argv)
+{
+    int have = openblas_get_num_threads();
+    int want = ppb_memory_blas_threads(have);
+    if (want != have)
+        ppb_memory_blas_reexec(want, argv);
+}

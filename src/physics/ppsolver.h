@@ -140,6 +140,10 @@ double pp_absorbed(const pp_solution *s);
  * leaves through S1 (the beam reflected at S2); both 0 at n = 1. */
 void pp_boundary_totals(const pp_solution *s, double *specular, double *ballistic_top);
 
+/* Sets OpenBLAS's thread count (base/memory.h: ppb_memory_blas_threads), executing ppbench
+ * again (argv) when the library started with another; first thing in main. */
+void pp_blas_threads(char **argv);
+
 /* Has OpenBLAS allocate its work buffer now, while the memory is there (base/memory.h:
  * PPB_BLAS_BUFFER_BYTES): it keeps it for the process, and a later call never waits for one.
  * Fails "out of memory: ..." when the buffer cannot be had. */
