@@ -365,6 +365,36 @@ static void test_robust_corner(void **state)
     assert_int_equal(points, 24);
 }
 
+/* An albedo step whose range reaches 1 (0.95 -> 1): pp's albedo nodes then include the
+ * conservative slab, whose degenerate pair at lambda = 0 is one mode (m - 1 modes against m);
+ * the march tables refused the valid config ("the slab solutions disagree on the mode count").
+ * Expected: pp runs and its result passes the grid's checks. */
+static void test_albedo_step_to_one(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    coarse(&cfg, 0);
+    set(&cfg, "experiment", "methods", "pp");
+    set(&cfg, "medium", "step", "albedo");
+    set(&cfg, "medium", "albedo", "0.95");
+    set(&cfg, "medium", "albedo_right", "1");
+    ppb_err err;
+    assert_int_equal(ppb_methods_check(&cfg, &err), 0);
+    ppb_experiment ex;
+    said s;
+    memset(&s, 0, sizeof s);
+    capture_begin();
+    int rc = ppb_experiment_compute(&ex, &cfg, &g_ctx, &err);
+    capture_end(&s, "albedo step 0.95 -> 1");
+    if (rc)
+        fail_msg("%s", err.msg);
+    if (ex.nfailed)
+        fail_msg("%s failed: %s", ex.failed[0], ex.failed_why[0]);
+    assert_int_equal(ex.n, 1);
+    check_result(&ex.res[0], "albedo step 0.95 -> 1");
+    ppb_experiment_free(&ex);
+}
+
 /* ss's image series is refused before any work when its estimated terms exceed
  * PPB_WORK_IMAGE_TERMS_MAX (work_estimate.h): the study's bins on a 0.01-mfp tube at 89 deg and
  * n = 2.5 need up to 7.6e12 terms (1.34e6 rays x 4000 legs x 353 rows x 4 tiles, from the
@@ -426,7 +456,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_robust_tube),           cmocka_unit_test(test_robust_slab),
         cmocka_unit_test(test_result_memory_checked), cmocka_unit_test(test_image_series_cost),
-        cmocka_unit_test(test_robust_corner),
+        cmocka_unit_test(test_albedo_step_to_one),    cmocka_unit_test(test_robust_corner),
     };
     if (getenv("PPB_TEST_FILTER")) /* one test by name, e.g. when checking a fix */
         cmocka_set_test_filter(getenv("PPB_TEST_FILTER"));

@@ -329,12 +329,15 @@ static int build_end(pp_build *b, int rc)
     return rc;
 }
 
-/* Every block must have the first solution's mode count, since the scratch is sized by it. */
+/* The scratch is sized for the most modes a block of these directions can have (cap:
+ * pp_mode_capacity), not the first block's count: an albedo range that reaches 1 holds a
+ * conservative block with one mode fewer (the degenerate pair at lambda = 0 is one mode), and
+ * each block uses its own count. Every block must have the same capacity. */
 static int adopt_mode_count(pp_build *b, int nm, ppb_err *err)
 {
     ppb_march_tables *t = b->t;
     if (b->A && nm != t->nmodes)
-        return ppb_fail(err, "march tables: the slab solutions disagree on the mode count");
+        return ppb_fail(err, "march tables: the slab solutions disagree on the mode capacity");
     t->nmodes = nm;
     if (b->A)
         return 0;
@@ -410,7 +413,7 @@ static int build_block(pp_build *b, int c, int node, ppb_err *err)
     int nm = pp_nmodes(sol);
     int ne = b->pp->modes > 0 && b->pp->modes < nm ? b->pp->modes : nm;
     t->modes_kept = ne;
-    if (adopt_mode_count(b, nm, err)) {
+    if (adopt_mode_count(b, pp_mode_capacity(sol), err)) {
         if (sol != b->first)
             pp_free(sol);
         return -1;

@@ -747,6 +747,11 @@ int pp_nmodes(const pp_solution *s)
     return s->nmodes;
 }
 
+int pp_mode_capacity(const pp_solution *s)
+{
+    return s->m;
+}
+
 void pp_modes(const pp_solution *s, double *lambda, double *tau_ref)
 {
     memcpy(lambda, s->lambda, (size_t)s->nmodes * sizeof(double));

@@ -100,6 +100,10 @@ double pp_mu0(const pp_solution *s);
 /* Homogeneous modes (M of them: 2N, or 2N - 1 at alpha = 1), sorted by |lambda| ascending;
  * e_k(tau) = exp(lambda_k (tau - tau_ref_k)), tau_ref_k = 0 if lambda_k < 0 else tau0. */
 int pp_nmodes(const pp_solution *s);
+/* The most modes a solution of these directions has: m, the cell count (2n). At albedo 1 (1 -
+ * albedo < 1e-13) the eigenvalue pair +-lambda_0 is degenerate at 0 and becomes the constant
+ * and linear (diffusion) mode, stored as one: m - 1 modes; every other albedo has m. */
+int pp_mode_capacity(const pp_solution *s);
 void pp_modes(const pp_solution *s, double *lambda, double *tau_ref);
 
 /* Source function for scattering into the continuous direction w (unit vector, tube frame),
