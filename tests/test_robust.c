@@ -396,9 +396,9 @@ static void test_albedo_step_to_one(void **state)
 }
 
 /* ss's image series is refused before any work when its estimated terms exceed
- * PPB_WORK_IMAGE_TERMS_MAX (work_estimate.h): the study's bins on a 0.01-mfp tube at 89 deg and
+ * PPB_WORK_IMAGE_TERMS_MAX (method_ss.h): the study's bins on a 0.01-mfp tube at 89 deg and
  * n = 2.5 need up to 7.6e12 terms (1.34e6 rays x 4000 legs x 353 rows x 4 tiles, from the
- * formulas of work_estimate.h); ss ran there for over 5 minutes, deaf to SIGTERM. pp, which does
+ * formulas of method_ss.h); ss ran there for over 5 minutes, deaf to SIGTERM. pp, which does
  * not sum the images, is not refused; nor is the study's oblique n = 1.4 case (6e8 terms). */
 static void test_image_series_cost(void **state)
 {

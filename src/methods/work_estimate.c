@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "kernels/mc_params.h"
-#include "kernels/ppb_fresnel.h"
+#include "methods/method_ss.h"
 #include "methods/registry.h"
 #include "model/scene.h"
 
@@ -35,33 +35,6 @@ void ppb_work_march(const ppb_config *cfg, double *rays, double *steps)
                      ? sc->height / mu
                      : sqrt(sc->width * sc->width + sc->height * sc->height);
     *steps = ceil(len / cfg->pp.step);
-}
-
-int ppb_work_images(const ppb_config *cfg, ppb_work_img *w)
-{
-    const ppb_scene *sc = &cfg->scene;
-    memset(w, 0, sizeof *w);
-    if (sc->geometry != PPB_GEOM_TUBE || !(sc->n > 1.0))
-        return 0;
-    ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
-    if (!(b.sin_t > 0.0))
-        return 0;
-    const double d_cap = 40.0, tol = 0x1p-60; /* march.c's d_cap, ppb_beam_images.h's tolerance */
-    double W = sc->width, H = sc->height, tn = b.sin_t / b.cos_t;
-    double sig = sc->step == PPB_STEP_DENSITY ? fmin(sc->sigma_t, sc->sigma_t_right) : sc->sigma_t;
-    double jmax = ceil(d_cap * b.cos_t / (sig * H));
-    double r = b.f_inside * exp(-sig * H / b.cos_t);
-    double jtol = r > 0.0 ? ceil(log(tol) / log(r)) : 1.0;
-    w->rows = fmin(jmax, jtol) + 1.0;
-    w->per_row = floor(1.0 + H * tn / W) + 3.0;
-    /* A viewing-ray leg spans at least the smaller side's optical size; legs stop at d_cap or
-     * after 4096 (march.cl). */
-    double smin = sc->step == PPB_STEP_DENSITY ? fmin(sc->sigma_t, sc->sigma_t_right) : sc->sigma_t;
-    w->legs = fmin(4096.0, ceil(d_cap / (smin * fmin(W, H))));
-    double steps;
-    ppb_work_march(cfg, &w->rays, &steps);
-    w->terms = w->rays * w->legs * w->rows * w->per_row;
-    return 1;
 }
 
 double ppb_work_results_bytes(const ppb_config *cfg)
