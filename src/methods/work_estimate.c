@@ -6,7 +6,9 @@
 
 #include "kernels/mc_params.h"
 #include "methods/method_ss.h"
+#include "methods/march.h"
 #include "methods/registry.h"
+#include "physics/march_tables.h"
 #include "model/scene.h"
 
 double ppb_work_mc_events(const ppb_config *cfg)
@@ -60,6 +62,15 @@ void ppb_work_print(FILE *f, const ppb_config *cfg)
             ppb_work_march(cfg, &rays, &steps);
             fprintf(f, "%s: %s: work: %.3g rays x up to %.3g steps = %.3g steps\n", cfg->name, id,
                     rays, steps, rays * steps);
+            if (strcmp(id, "pp") == 0) {
+                double solves, ndir;
+                double w = ppb_march_tables_work(&cfg->scene, &cfg->pp, cfg->samples_dir,
+                                                 PPB_MARCH_TAU_PER_MFP, &solves, &ndir);
+                fprintf(f,
+                        "%s: pp: work: tables: %.3g slab solves of %d directions, %.3g "
+                        "table directions = about %.3g multiply-adds\n",
+                        cfg->name, solves, cfg->pp.directions, ndir, w);
+            }
             ppb_work_img w;
             if (strcmp(id, "pp") != 0 && ppb_work_images(cfg, &w))
                 fprintf(f,

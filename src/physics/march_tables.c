@@ -163,6 +163,25 @@ double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, in
     return tab + coef + scratch + 24.0 * n * n * d;
 }
 
+double ppb_march_tables_work(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
+                             int tau_per_mfp, double *solves, double *ndir)
+{
+    table_key k = plan(sc, pp, nsamp, tau_per_mfp, 1);
+    *ndir = table_variants(sc) *
+            (double)ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                   ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
+    double m = 2.0 * pp->directions, work = 0.0;
+    *solves = 0.0;
+    for (int c = 0; c < k.ncols; c++) {
+        /* a block: its slab solve (eigenproblem and boundary systems, about 10 m^3), the mode
+         * coefficients of every direction (m^2 each), R and S (ndir x ntau x m each) */
+        work += k.nalb *
+                (10.0 * m * m * m + *ndir * m * m + (k.want_s ? 3.0 : 1.0) * *ndir * k.ntau[c] * m);
+        *solves += k.nalb;
+    }
+    return work;
+}
+
 int ppb_march_tables_ss(const ppb_scene *sc, int nsamp, ppb_march_tables *t, ppb_err *err)
 {
     table_key k = plan(sc, NULL, nsamp, 0, 0);
