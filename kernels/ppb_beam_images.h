@@ -126,8 +126,8 @@ inline double ppb_beam_images(const ppb_beam_tube *B, const double *cb, double p
     double r = B->beam_fb * exp(-sig_beam * H / ct);
     double nk = floor(1.0 + H * tn / W) + 3.0;
     double cmax = fmax(fmax(cb[0], cb[1]), fmax(cb[2], cb[3]));
-    double tail = r < 1.0 ? B->beam_in * cmax * sigma_t * (lb - la) * exp(-d0) * nk / (1.0 - r)
-                          : INFINITY;
+    double tail =
+        r < 1.0 ? B->beam_in * cmax * sigma_t * (lb - la) * exp(-d0) * nk / (1.0 - r) : INFINITY;
     double sum = 0.0, fj = 1.0;
     for (int j = 0; j <= jmax; j++, fj *= B->beam_fb, tail *= r) {
         if (sum > 0.0 && tail <= PPB_IMAGE_TOL * sum)
