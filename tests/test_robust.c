@@ -21,7 +21,9 @@
  *     prints a few lines instead of hundreds.
  * rte2d is not in the grid: one tube point at H = 1e3 takes 3 s of CPU at spacing 1 and 4
  * directions (a grid of W H / spacing^2 nodes, GMRES to convergence; measured with ppbench run),
- * so the grid would take over an hour; tests/test_rte2d.c covers it. */
+ * so the grid would take over an hour; tests/test_rte2d.c covers it. It runs, at spacing 0.5
+ * and 16 directions, in the thin, grazing, n > 1 corner (test_robust_corner), with every other
+ * tube method. Also here: ss's image-series cost refusal and pp on an albedo step reaching 1. */
 #include "testutil.h"
 
 #include "drivers/experiment.h"
