@@ -126,6 +126,7 @@ FUZZ_TARGETS := config csv radiance
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 FUZZ_OBJ     := $(SRC:src/%.c=build-fuzz/obj/%.o)
 .PHONY: fuzz
+.SECONDARY: $(FUZZ_OBJ)
 build-fuzz/obj/%.o: src/%.c | $(BUILD)/deps.mk
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(CPPFLAGS) $(PKG_CFLAGS) -std=c11 -O1 -g -fsanitize=fuzzer-no-link $(FUZZ_SAN) \
