@@ -28,6 +28,7 @@
 
 #include "drivers/experiment.h"
 #include "methods/registry.h"
+#include "methods/work_estimate.h"
 #include "physics/march_tables.h"
 
 #include <time.h>
@@ -397,6 +398,41 @@ static void test_albedo_step_to_one(void **state)
     ppb_experiment_free(&ex);
 }
 
+/* The work lines say what pp's tables cost (methods/work_estimate.h): an albedo step at n = 1.5
+ * and 45 deg builds pp.albedos = 9 slab solutions (one for one albedo) and 4 direction variants
+ * (the tube at n > 1) of the 4096 table directions of the default bins (4 surfaces x 64 bins x
+ * 4^2 samples: 16384 in all); one albedo at n = 1 builds one solution of 4096. The line was not
+ * printed: a run that took 17 minutes said only its march steps. */
+static void test_pp_table_work(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    ppb_err err;
+    assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
+    snprintf(cfg.name, sizeof cfg.name, "w");
+    set(&cfg, "experiment", "methods", "pp");
+    set(&cfg, "medium", "step", "albedo");
+    set(&cfg, "medium", "albedo_right", "0.475");
+    set(&cfg, "medium", "n", "1.5");
+    set(&cfg, "light", "theta_deg", "45");
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    ppb_work_print(f, &cfg);
+    fclose(f);
+    if (!strstr(text, "w: pp: work: tables: 9 slab solves of 334 directions, 1.64e+04 table "
+                      "directions"))
+        fail_msg("work lines:\n%s", text);
+    free(text);
+    set(&cfg, "medium", "step", "none");
+    set(&cfg, "medium", "n", "1");
+    double solves, ndir;
+    ppb_march_tables_work(&cfg.scene, &cfg.pp, cfg.samples_dir, 64, &solves, &ndir);
+    if (!(solves == 1.0 && ndir == 4096.0))
+        fail_msg("uniform n = 1: %g solves, %g directions", solves, ndir);
+}
+
 /* ss's image series is refused before any work when its estimated terms exceed
  * PPB_WORK_IMAGE_TERMS_MAX (method_ss.h): the study's bins on a 0.01-mfp tube at 89 deg and
  * n = 2.5 need up to 7.6e12 terms (1.34e6 rays x 4000 legs x 353 rows x 4 tiles, from the
@@ -458,7 +494,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_robust_tube),           cmocka_unit_test(test_robust_slab),
         cmocka_unit_test(test_result_memory_checked), cmocka_unit_test(test_image_series_cost),
-        cmocka_unit_test(test_albedo_step_to_one),    cmocka_unit_test(test_robust_corner),
+        cmocka_unit_test(test_albedo_step_to_one),    cmocka_unit_test(test_pp_table_work),
+        cmocka_unit_test(test_robust_corner),
     };
     if (getenv("PPB_TEST_FILTER")) /* one test by name, e.g. when checking a fix */
         cmocka_set_test_filter(getenv("PPB_TEST_FILTER"));
