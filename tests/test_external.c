@@ -423,6 +423,15 @@ static void test_orphans(void **state)
     expect_refused("ext_orphan_bg", body, "", "its command exited with status 3");
     assert_gone(read_pid(p1), 2, "the command's background job");
     assert_gone(read_pid(p2), 2, "the command's setsid job");
+    /* The same past the timeout, where the process group is killed: setsid left it. */
+    snprintf(script, sizeof script, "%s/to.sh", dir);
+    f = fopen(script, "w");
+    assert_non_null(f);
+    fprintf(f, "setsid sleep 300 > /dev/null 2>&1 & echo $! > %s\nsleep 30\n", p2);
+    fclose(f);
+    snprintf(body, sizeof body, "sh %s {out}", script);
+    expect_refused("ext_orphan_to", body, "timeout = 1\n", "ran past its timeout of 1 s");
+    assert_gone(read_pid(p2), 2, "the timed-out command's setsid job");
 
     /* ppbench killed with SIGKILL while its command runs. */
     for (int both = 0; both < 2; both++) {

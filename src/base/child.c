@@ -141,9 +141,18 @@ static void run_guard(const char *path, char *const argv[], pid_t owner)
         if (r == cmd || (r < 0 && errno != EINTR))
             break;
         if ((stop = guard_stop)) {
-            kill(cmd, SIGKILL);
-            while (waitpid(cmd, &st, 0) < 0 && errno == EINTR)
-                ;
+            /* SIGTERM first, SIGKILL after 1.5 s: within the 2 s the caller gives the whole
+             * group before its own SIGKILL (method_external.c), so the guard is still there to
+             * kill the descendants that left the group. */
+            kill(cmd, SIGTERM);
+            pid_t r = 0;
+            for (int i = 0; i < 75 && (r = waitpid(cmd, &st, WNOHANG)) == 0; i++)
+                sleep_ms(20);
+            if (r != cmd) {
+                kill(cmd, SIGKILL);
+                while (waitpid(cmd, &st, 0) < 0 && errno == EINTR)
+                    ;
+            }
             break;
         }
         sleep_ms(20);
