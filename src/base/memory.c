@@ -1,9 +1,7 @@
 /* memory.c: the memory limit of a run (memory.h). */
-#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include "base/memory.h"
 
 #include <math.h>
-#include <sched.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -51,11 +49,9 @@ int ppb_memory_blas_threads(int have)
     for (int i = 0; i < 3; i++)
         if (getenv(user[i]))
             return have; /* the user's count */
-    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    cpu_set_t set;
-    if (sched_getaffinity(0, sizeof set, &set) == 0)
-        cpus = CPU_COUNT(&set);
-    int want = cpus > 0 ? (int)cpus : 1;
+    /* The library's own count (the CPUs ppbench may run on: results unchanged), fewer under an
+     * address-space limit; executing ppbench again only then. */
+    int want = have;
     double as = ppb_memory_as_limit();
     if (as > 0.0) /* every thread's buffer within a quarter of the address space */
         want = (int)fmax(1.0, fmin(want, floor(0.25 * as / PPB_BLAS_BUFFER_BYTES)));
