@@ -139,6 +139,31 @@ test-cluster: $(BIN)
 
 FORMATTED = $(wildcard src/*/*.[ch] src/methods/*/*.[ch] src/methods/*/*.cl tests/*.[ch] \
               tests/kernels/*.cl kernels/*.h)
+# Fuzzing (tests/fuzz/; CI runs it after the tests, .ci/run): the INI reader, the CSV reader
+# and the external radiance validator,
+# built with clang's libFuzzer, AddressSanitizer and UBSan, each run for FUZZ_SECONDS from its
+# seed corpus (tests/fuzz/corpus/<target>, read only; what it finds goes to build-fuzz/).
+FUZZ_CC      ?= clang
+FUZZ_SECONDS ?= 20
+FUZZ_TARGETS := config csv radiance
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+FUZZ_OBJ     := $(SRC:src/%.c=build-fuzz/obj/%.o)
+.PHONY: fuzz
+.SECONDARY: $(FUZZ_OBJ)
+build-fuzz/obj/%.o: src/%.c | $(BUILD)/deps.mk
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(CPPFLAGS) $(PKG_CFLAGS) -std=c11 -O1 -g -fsanitize=fuzzer-no-link $(FUZZ_SAN) \
+	  -c $< -o $@
+build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(FUZZ_OBJ)
+	$(FUZZ_CC) $(CPPFLAGS) $(PKG_CFLAGS) -std=c11 -O1 -g -fsanitize=fuzzer $(FUZZ_SAN) -o $@ \
+	  $< $(FUZZ_OBJ) $(PKG_LIBS)
+fuzz: $(FUZZ_TARGETS:%=build-fuzz/fuzz_%)
+	@for t in $(FUZZ_TARGETS); do mkdir -p build-fuzz/found/$$t && \
+	  echo "== fuzz $$t ($(FUZZ_SECONDS) s)" && TMPDIR=$(CURDIR)/build-fuzz \
+	  build-fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=10 \
+	    -artifact_prefix=build-fuzz/found/$$t- build-fuzz/found/$$t tests/fuzz/corpus/$$t \
+	    2>build-fuzz/$$t.log || { tail -40 build-fuzz/$$t.log; exit 1; }; done
+
 format:
 	clang-format -i $(FORMATTED)
 
@@ -146,6 +171,6 @@ format-check:
 	clang-format --dry-run --Werror $(FORMATTED)
 
 clean:
-	rm -rf build build-asan ppbench
+	rm -rf build build-asan build-fuzz ppbench
 
 -include $(OBJ:.o=.d) $(BUILD)/obj/drivers/main.d

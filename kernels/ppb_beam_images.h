@@ -17,6 +17,10 @@
 
 #include "ppb_conventions.h"
 
+/* The image series' stopping tolerance, relative to what has been summed: 2^-60, 64 times below
+ * the half ulp (2^-54 of the sum at least) under which a term leaves a double sum unchanged. */
+#define PPB_IMAGE_TOL 0x1p-60
+
 /* (e^z - 1) / z, stable at z = 0. */
 inline double ppb_phi1(double z)
 {
@@ -113,8 +117,21 @@ inline double ppb_beam_images(const ppb_beam_tube *B, const double *cb, double p
     int step = B->step_kind == PPB_STEP_DENSITY && B->sigma_t_right != B->sigma_t;
     double sig_beam = step ? fmin(B->sigma_t, B->sigma_t_right) : sigma_t;
     int jmax = (int)ceil((B->d_cap - d0) * ct / (sig_beam * H));
+    /* The contribution bound (docs/reference.md: Methods, ss at n > 1): term (k, j) is at
+     * most beam_in F_b^j F_s^k c_max sigma_t (lb - la) e^{-d0} e^{-j a}, a = sig_beam H / cos
+     * theta_t (its beam has come at least j H / cos theta_t), and a depth row j holds at most
+     * nk tiles, so the terms of rows j and beyond sum to at most tail r^j, r = F_b e^{-a} < 1.
+     * Once that is below PPB_IMAGE_TOL times the sum, every one of them is below half an ulp
+     * of the sum and adding it would not change a bit: the series stops there. */
+    double r = B->beam_fb * exp(-sig_beam * H / ct);
+    double nk = floor(1.0 + H * tn / W) + 3.0;
+    double cmax = fmax(fmax(cb[0], cb[1]), fmax(cb[2], cb[3]));
+    double tail =
+        r < 1.0 ? B->beam_in * cmax * sigma_t * (lb - la) * exp(-d0) * nk / (1.0 - r) : INFINITY;
     double sum = 0.0, fj = 1.0;
-    for (int j = 0; j <= jmax; j++, fj *= B->beam_fb) {
+    for (int j = 0; j <= jmax; j++, fj *= B->beam_fb, tail *= r) {
+        if (sum > 0.0 && tail <= PPB_IMAGE_TOL * sum)
+            break;
         int jodd = j & 1;
         /* depth'(l) = dp0 + l dpl */
         double dp0 = jodd ? (j + 1) * H + py : j * H - py, dpl = jodd ? my : -my;

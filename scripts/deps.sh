@@ -17,7 +17,8 @@ declare -A FILES=(
   [/usr/include/Random123/philox.h]=librandom123-dev
   [/etc/OpenCL/vendors/pocl.icd]=pocl-opencl-icd
 )
-declare -A CMDS=([pkg-config]=pkg-config [gnuplot]=gnuplot-nox [parallel]=parallel [clinfo]=clinfo)
+declare -A CMDS=([pkg-config]=pkg-config [gnuplot]=gnuplot-nox [parallel]=parallel [clinfo]=clinfo
+  [clang]=clang) # clang: `make fuzz` (libFuzzer)
 if [ "${1:-}" = --cluster ]; then
   declare -A PC=() FILES=()
   declare -A CMDS=([slurmctld]=slurm-wlm [slurmd]=slurm-wlm [sbatch]=slurm-wlm [munged]=munge)

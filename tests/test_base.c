@@ -5,7 +5,9 @@
  * the monotonic clock. */
 #include "testutil.h"
 
+#include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "base/atomic_file.h"
 #include "base/clock.h"
@@ -139,6 +141,81 @@ static void test_csv_long_line(void **state)
     assert_true(ppb_csv_double(&c, last, &v));
     assert_close(v, 4999.5, 0);
     ppb_csv_close(&c);
+}
+
+/* A quote opened on line 2 and never closed, then 400,000 short lines: the reader must report the
+ * open quote at line 2 having read the input once (file_read.h, csv_read.h: linear in the input).
+ * The expected error is csv_read.h's own. A reader that rescans the record at every line takes
+ * hours here; the alarm turns that into a failure (it is a watchdog, not a timing assertion: the
+ * linear reader needs well under a second). */
+static void test_csv_unclosed_quote_is_linear(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("csv_unclosed");
+    char path[1200];
+    snprintf(path, sizeof path, "%s/open.csv", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("a,b\n\"x,1\n", f);
+    for (int i = 0; i < 400000; i++)
+        fputs("y,2\n", f);
+    fclose(f);
+    alarm(120);
+    ppb_csv c;
+    ppb_err err = {{0}};
+    assert_int_equal(ppb_csv_open(&c, path, &err), 0);
+    assert_int_equal(ppb_csv_next(&c, &err), -1);
+    assert_non_null(strstr(err.msg, "open.csv:2: a quoted field is not closed"));
+    ppb_csv_close(&c);
+    alarm(0);
+}
+
+/* A NUL byte in a CSV record is refused at its line: the text after it was lost (the fields
+ * are C strings), so "x\0junk" read as "x". The expected message is csv_read.c's. */
+static void test_csv_nul_byte(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("csv_nul");
+    char path[1200];
+    snprintf(path, sizeof path, "%s/nul.csv", dir);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fwrite("a,b\nx\0junk,1\n", 1, 15, f);
+    fclose(f);
+    ppb_csv c;
+    ppb_err err = {{0}};
+    assert_int_equal(ppb_csv_open(&c, path, &err), 0);
+    assert_int_equal(ppb_csv_next(&c, &err), -1);
+    assert_non_null(strstr(err.msg, "nul.csv:2: a NUL byte"));
+    ppb_csv_close(&c);
+}
+
+/* Files that are not regular are refused at once, naming the file: a FIFO (open() would wait
+ * for a writer for ever) and /dev/zero (never ends) (file_read.h). The alarm turns a reader
+ * that blocks into a failure. */
+static void test_read_only_regular_files(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("read_fifo");
+    char fifo[1200];
+    snprintf(fifo, sizeof fifo, "%s/fifo.csv", dir);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    alarm(60);
+    ppb_csv c;
+    ppb_err err = {{0}};
+    assert_int_equal(ppb_csv_open(&c, fifo, &err), -1);
+    assert_non_null(strstr(err.msg, "fifo.csv: not a regular file (a FIFO)"));
+    assert_null(ppb_read_file(fifo, NULL));
+    assert_int_equal(ppb_csv_open(&c, "/dev/zero", &err), -1);
+    assert_non_null(strstr(err.msg, "/dev/zero: not a regular file (a character device)"));
+    assert_null(ppb_read_file("/dev/zero", NULL));
+    assert_int_equal(ppb_open_regular(dir, PPB_READ_MAX, &err), -1);
+    assert_non_null(strstr(err.msg, "not a regular file (a directory)"));
+    /* The size bound: a 10-byte file against a 4-byte bound. */
+    const char *small = write_text(dir, "ten.txt", "0123456789");
+    assert_int_equal(ppb_open_regular(small, 4, &err), -1);
+    assert_non_null(strstr(err.msg, "ten.txt: 10 bytes, more than the 4 bytes"));
+    alarm(0);
 }
 
 /* ppb_afile: the file appears complete on commit, and nothing (not even the temporary) after an
@@ -340,6 +417,9 @@ int main(void)
         cmocka_unit_test(test_csv_missing_column_is_an_error),
         cmocka_unit_test(test_csv_quoted_fields),
         cmocka_unit_test(test_csv_long_line),
+        cmocka_unit_test(test_csv_unclosed_quote_is_linear),
+        cmocka_unit_test(test_read_only_regular_files),
+        cmocka_unit_test(test_csv_nul_byte),
         cmocka_unit_test(test_afile_commit_and_abort),
         cmocka_unit_test(test_apath_commit_and_abort),
         cmocka_unit_test(test_hash_xxh3_values),

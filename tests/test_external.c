@@ -262,7 +262,8 @@ static void expect_refused(const char *name, const char *body, const char *extra
              "command = %s\n%s",
              tiny, out, body, extra);
     snprintf(args, sizeof args, "run %s", cli_config(name, text));
-    int rc = cli_run_env("", args, cli_out, sizeof cli_out);
+    /* timeout: a run that blocks (on a FIFO left as an output) fails instead of hanging */
+    int rc = cli_run_env("timeout 120", args, cli_out, sizeof cli_out);
     if (!strstr(cli_out, needle) || !strstr(cli_out, "bad failed"))
         fail_msg("%s: exit %d, output lacks '%s':\n%s", name, rc, needle, cli_out);
     char *rows = rows_of(out, "radiance.csv", "bad");
@@ -299,6 +300,21 @@ static void test_external_refusals(void **state)
                     "radiance.csv:1: the columns must begin");
     expect_bad_copy("ext_exit", "", "exit 3", "its command exited with status 3");
     expect_refused("ext_none", "true {out}", "", "its command wrote no");
+    /* Outputs that are not regular files (file_read.h): a FIFO would block open() after the
+     * command exited, a link to /dev/zero never ends; each is refused naming the file. */
+    expect_refused("ext_fifo", "mkfifo {out}/radiance.csv", "",
+                   "radiance.csv: not a regular file (a FIFO)");
+    expect_refused("ext_zero", "ln -s /dev/zero {out}/radiance.csv", "",
+                   "radiance.csv: not a regular file (a character device)");
+    expect_bad_copy("ext_fifo_tot", "", "mkfifo \"$1/totals.csv\"",
+                    "totals.csv: not a regular file (a FIFO)");
+    /* A negative fraction in totals.csv (R = -0.25 in mp's row, copied): refused at its line. */
+    char after[2600];
+    snprintf(after, sizeof after,
+             "awk -F, -v OFS=, 'NR == 1 || $1 == \"mp\" { if (NR > 1) { $1 = \"bad\"; $2 = "
+             "-0.25 } print }' %s/totals.csv > \"$1/totals.csv\"",
+             ref_dir);
+    expect_bad_copy("ext_negtot", "", after, "totals.csv:2: R = '-0.25': a fraction of the power");
     char body[2600];
 
     /* Timeout: the command and its children are killed (the whole process group). */
@@ -335,6 +351,126 @@ static void test_external_refusals(void **state)
     snprintf(text, sizeof text, "[experiment]\nmethods = mp\n[method.y]\ncolor = 1\n");
     snprintf(args, sizeof args, "run %s", cli_config("ext_key", text));
     cli_expect(args, 2, ":4: [method.y] color: unknown key");
+}
+
+/* The pid written in path (0 when there is none yet). */
+static int read_pid(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    int pid = 0;
+    if (f) {
+        if (fscanf(f, "%d", &pid) != 1)
+            pid = 0;
+        fclose(f);
+    }
+    return pid;
+}
+
+/* Waits up to `seconds` for process pid to be gone (a zombie counts as gone: it runs nothing);
+ * on failure kills it, so that a failed check leaves nothing running. */
+static void assert_gone(int pid, double seconds, const char *what)
+{
+    char path[64], st[512];
+    snprintf(path, sizeof path, "/proc/%d/stat", pid);
+    for (int i = 0; i < seconds * 50; i++) {
+        FILE *f = fopen(path, "r");
+        int gone = !f || !fgets(st, sizeof st, f) || strstr(st, ") Z ");
+        if (f)
+            fclose(f);
+        if (gone)
+            return;
+        nanosleep(&(struct timespec){0, 20000000L}, NULL);
+    }
+    kill(pid, SIGKILL);
+    fail_msg("%s (pid %d) still runs", what, pid);
+}
+
+/* Waits up to 120 s for path to hold a pid. */
+static int wait_pid_file(const char *path)
+{
+    for (int i = 0; i < 6000; i++) {
+        int pid = read_pid(path);
+        if (pid > 0)
+            return pid;
+        nanosleep(&(struct timespec){0, 20000000L}, NULL);
+    }
+    fail_msg("no pid in %s after 120 s", path);
+    return 0;
+}
+
+/* What an external command starts dies with it (base/child.h): a background job and one that
+ * left the process group (setsid) are gone once ppbench has finished; with ppbench killed by
+ * SIGKILL mid-command the command and its children die at once; with ppbench and the command's
+ * guard both killed by SIGKILL, the next ppbench (any command) kills what they left. Before,
+ * each of these processes ran on (sleep 300: five minutes). */
+static void test_orphans(void **state)
+{
+    (void)state;
+    char dir[1024], body[1400], p1[1100], p2[1100], script[1100];
+    snprintf(dir, sizeof dir, "%s", tu_scratch("ext_orphans"));
+    snprintf(p1, sizeof p1, "%s/bg.pid", dir);
+    snprintf(p2, sizeof p2, "%s/setsid.pid", dir);
+    /* The commands are scripts: a config line holds at most 198 characters. */
+    snprintf(script, sizeof script, "%s/bg.sh", dir);
+    FILE *f = fopen(script, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "sleep 300 > /dev/null 2>&1 & echo $! > %s\n"
+            "setsid sleep 300 > /dev/null 2>&1 & echo $! > %s\nexit 3\n",
+            p1, p2);
+    fclose(f);
+    snprintf(body, sizeof body, "sh %s {out}", script);
+    expect_refused("ext_orphan_bg", body, "", "its command exited with status 3");
+    assert_gone(read_pid(p1), 2, "the command's background job");
+    assert_gone(read_pid(p2), 2, "the command's setsid job");
+    /* The same past the timeout, where the process group is killed: setsid left it. */
+    snprintf(script, sizeof script, "%s/to.sh", dir);
+    f = fopen(script, "w");
+    assert_non_null(f);
+    fprintf(f, "setsid sleep 300 > /dev/null 2>&1 & echo $! > %s\nsleep 30\n", p2);
+    fclose(f);
+    snprintf(body, sizeof body, "sh %s {out}", script);
+    expect_refused("ext_orphan_to", body, "timeout = 1\n", "ran past its timeout of 1 s");
+    assert_gone(read_pid(p2), 2, "the timed-out command's setsid job");
+
+    /* ppbench killed with SIGKILL while its command runs. */
+    for (int both = 0; both < 2; both++) {
+        char sh[1100], py[1100], ppb[1100], text[8192], cmd[12000];
+        snprintf(sh, sizeof sh, "%s/sh%d.pid", dir, both);
+        snprintf(py, sizeof py, "%s/py%d.pid", dir, both);
+        snprintf(ppb, sizeof ppb, "%s/ppbench%d.pid", dir, both);
+        snprintf(script, sizeof script, "%s/slow%d.sh", dir, both);
+        f = fopen(script, "w");
+        assert_non_null(f);
+        fprintf(f, "python3 -c 'import time; time.sleep(300)' & echo $! > %s\necho $$ > %s\nwait\n",
+                py, sh);
+        fclose(f);
+        snprintf(text, sizeof text,
+                 "[experiment]\nmethods = slow\n%s[output]\ndir = %s/out%d\n[method.slow]\n"
+                 "command = sh %s {out}\n",
+                 tiny, dir, both, script);
+        snprintf(cmd, sizeof cmd, "%s run --quiet %s > %s/log%d 2>&1 & echo $! > %s", tu_bin(),
+                 cli_config("ext_orphan_kill", text), dir, both, ppb);
+        assert_int_equal(system(cmd), 0);
+        int pid_py = wait_pid_file(py), pid_sh = wait_pid_file(sh), pid_ppb = read_pid(ppb);
+        if (both) { /* the guard first: nothing is left to kill the command's processes */
+            char kids[128], line[256] = "";
+            snprintf(kids, sizeof kids, "/proc/%d/task/%d/children", pid_ppb, pid_ppb);
+            f = fopen(kids, "r");
+            assert_non_null(f);
+            assert_non_null(fgets(line, sizeof line, f));
+            fclose(f);
+            assert_int_equal(kill(atoi(line), SIGKILL), 0);
+        }
+        assert_int_equal(kill(pid_ppb, SIGKILL), 0);
+        if (both) {
+            nanosleep(&(struct timespec){0, 300000000L}, NULL);
+            cli_expect("--version", 0, "");
+        }
+        assert_gone(pid_sh, 5, both ? "the command's shell (guard killed)" : "the command's shell");
+        assert_gone(pid_py, 5,
+                    both ? "the command's python3 (guard killed)" : "the command's python3");
+    }
 }
 
 /* `score` on the run's own radiance.csv reproduces its summary, rms and regions byte for byte
@@ -502,6 +638,15 @@ static void test_ref_cache(void **state)
                                       "photons = 20000\n"));
     cli_expect(args, 0, "");
     assert_true(file_has(c, "provenance.txt", "mc.photons_traced = 20000\n"));
+    /* A FIFO in place of a cache entry is not read (open would block) and the reference is
+     * traced again. */
+    snprintf(cmd, sizeof cmd, "for f in %s/mc-*.bin; do rm \"$f\" && mkfifo \"$f\"; done", cache);
+    assert_int_equal(system(cmd), 0);
+    snprintf(args, sizeof args, "run --set mc.seed=2 --ref-cache %s --out %s/d %s", cache, dir,
+             cli_config("ext_cache1", "[experiment]\nmethods = mc\n[tube]\nsegments_top = 8\n"
+                                      "segments_side = 3\n[bins]\ntheta = 2\nphi = 2\n[mc]\n"
+                                      "photons = 20000\n"));
+    cli_expect_env("timeout 120", args, 0, ".bin: not a regular file (a FIFO)");
 }
 
 /* [method.NAME] keys through --set: a config without the section gets one (and the method
@@ -693,6 +838,7 @@ int main(void)
         cmocka_unit_test(test_scene_json),
         cmocka_unit_test(test_external_end_to_end),
         cmocka_unit_test(test_external_refusals),
+        cmocka_unit_test(test_orphans),
         cmocka_unit_test(test_score),
         cmocka_unit_test(test_python),
         cmocka_unit_test(test_ref_cache),
@@ -700,5 +846,7 @@ int main(void)
         cmocka_unit_test(test_default_cache),
         cmocka_unit_test(test_cache_kernel_change),
     };
+    if (getenv("PPB_TEST_FILTER")) /* one test by name, e.g. when checking a fix */
+        cmocka_set_test_filter(getenv("PPB_TEST_FILTER"));
     return cmocka_run_group_tests(tests, make_ref, NULL);
 }

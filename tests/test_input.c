@@ -162,11 +162,42 @@ static void test_binary_input(void **state)
     snprintf(args, sizeof args, "run --quiet --out /nonexistent/x '%s'", p);
     cli_expect(args, 2, p);
     assert_printable(cli_out);
+    /* A right-to-left override (U+202E, UTF-8 e2 80 ae) in a name or a method id: refused, shown
+     * escaped (it reversed the rest of the line on a terminal). */
+    p = LIT("rlo", "[experiment]\nname = a\xe2\x80\xae"
+                   "b\n");
+    assert_int_equal(ppb_config_load(&cfg, p, &err), -1);
+    assert_non_null(strstr(err.msg, ":2: [experiment] name: 'a\\xe2\\x80\\xaeb' may hold only"));
+    assert_printable(err.msg);
+    p = LIT("rlo_m", "[experiment]\nmethods = mp, x\xe2\x80\xae\n");
+    assert_int_equal(ppb_config_load(&cfg, p, &err), -1);
+    assert_non_null(strstr(err.msg, ":2: [experiment] methods: method id 'x\\xe2\\x80\\xae'"));
+    assert_printable(err.msg);
     /* A value given through --set is quoted escaped as well. */
     assert_int_equal(ppb_config_load(&cfg, LIT("plain", "[medium]\n"), &err), 0);
     assert_int_equal(ppb_config_set(&cfg, "medium", "g", "\x1b]0;title\x07", &err), -1);
     assert_non_null(strstr(err.msg, "'\\x1b]0;title\\x07' is not a number"));
     assert_printable(err.msg);
+}
+
+/* Memory that cannot be had (base/memory.h) is an error that names it, exit 1, within moments:
+ * under ulimit -v 100000 (100 MB) the earlier code spun in OpenBLAS's allocator for ever, deaf
+ * to SIGTERM (killed by the timeout: exit 137), and under 300 MB it said "OpenCL: no platform
+ * found". The limits are below what the run needs on any machine (OpenBLAS's buffer alone is
+ * 134 MB); the message is base/memory.h's. */
+static void test_memory_exhaustion(void **state)
+{
+    (void)state;
+    const char *p = LIT("mem", "[experiment]\nmethods = pp\n[tube]\nsegments_top = 8\n"
+                               "segments_side = 3\n[bins]\ntheta = 2\nphi = 2\n");
+    char args[3000], out[1200];
+    snprintf(out, sizeof out, "%s/out", tu_scratch("mem_out"));
+    snprintf(args, sizeof args, "run --out %s %s", out, p);
+    cli_expect_env("ulimit -v 100000; timeout -k 5 120", args, 1,
+                   "out of memory: the linear-algebra library's (OpenBLAS) work buffer needs");
+    int rc = cli_run_env("ulimit -v 300000; timeout -k 5 120", args, cli_out, sizeof cli_out);
+    if (strstr(cli_out, "no platform found") || (rc != 0 && !strstr(cli_out, "out of memory")))
+        fail_msg("under 300 MB: exit %d:\n%s", rc, cli_out);
 }
 
 /* 3. The point count: a grid over PPB_GRID_MAX_POINTS is refused at load, --yes or not (at the
@@ -353,6 +384,7 @@ int main(void)
         cmocka_unit_test(test_not_a_regular_file),
         cmocka_unit_test(test_long_lines),
         cmocka_unit_test(test_binary_input),
+        cmocka_unit_test(test_memory_exhaustion),
         cmocka_unit_test(test_grid_point_limit),
         cmocka_unit_test(test_ranges),
         cmocka_unit_test(test_set_overrides),

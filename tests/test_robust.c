@@ -21,11 +21,14 @@
  *     prints a few lines instead of hundreds.
  * rte2d is not in the grid: one tube point at H = 1e3 takes 3 s of CPU at spacing 1 and 4
  * directions (a grid of W H / spacing^2 nodes, GMRES to convergence; measured with ppbench run),
- * so the grid would take over an hour; tests/test_rte2d.c covers it. */
+ * so the grid would take over an hour; tests/test_rte2d.c covers it. It runs, at spacing 0.5
+ * and 16 directions, in the thin, grazing, n > 1 corner (test_robust_corner), with every other
+ * tube method. Also here: ss's image-series cost refusal and pp on an albedo step reaching 1. */
 #include "testutil.h"
 
 #include "drivers/experiment.h"
 #include "methods/registry.h"
+#include "methods/work_estimate.h"
 #include "physics/march_tables.h"
 
 #include <time.h>
@@ -184,7 +187,7 @@ static void check_result(const ppb_result *r, const char *where)
     if (strcmp(r->method, "mc") == 0 || strcmp(r->method, "ppslab") == 0) {
         if (!r->totals.absorbed_tracked)
             fail_msg("%s: %s does not track absorption", where, r->method);
-        double sum = t.R + t.T + t.sides + t.absorbed + t.ballistic;
+        double sum = t.R + t.T + t.sides + t.absorbed + t.ballistic + t.specular; /* n > 1 */
         if (!(fabs(sum - 1.0) <= BALANCE_TOL))
             fail_msg("%s: %s energy sum %.12g, expected 1 (tol %g)", where, r->method, sum,
                      BALANCE_TOL);
@@ -302,6 +305,163 @@ static void test_robust_slab(void **state)
     run_grid(1);
 }
 
+/* The thin, grazing, high-index corner, with rte2d at coarse settings (spacing 0.5 mfp, 16
+ * directions): H {1e-3, 0.01} x theta_L 89 x n {1.33, 2.5} x albedo {0, 0.95, 1} x g
+ * {-0.95, 0.95} (24 points), every tube method (mp and mp+ss but at albedo 1, their documented
+ * refusal). Near the critical angle F_b is near 1 (0.90 at 89 deg for both n) and a row of
+ * images adds 0.01 mfp of depth: ss's image series ran to the march's d_cap, 3666 rows a leg
+ * (hours at the study's bins; see test_image_series_cost). Asserted as in the grid, and that no
+ * total (R, T, sides, ballistic) is negative: rte2d wrote sides = -6.3e-13 here (result_check.h
+ * now sets a total negative within its round-off to 0). */
+static void test_robust_corner(void **state)
+{
+    (void)state;
+    static const double hs[] = {1e-3, 0.01}, ths[] = {89}, ns[] = {1.33, 2.5}, as[] = {0, 0.95, 1},
+                        gs[] = {-0.95, 0.95};
+    said s;
+    memset(&s, 0, sizeof s);
+    int points = 0;
+    for (int ih = 0; ih < 2; ih++)
+        for (int it = 0; it < 1; it++)
+            for (int in = 0; in < 2; in++)
+                for (int ia = 0; ia < 3; ia++)
+                    for (int ig = 0; ig < 2; ig++) {
+                        ppb_config cfg;
+                        coarse(&cfg, 0);
+                        set(&cfg, "rte2d", "spacing", "0.5");
+                        set(&cfg, "rte2d", "directions", "16");
+                        setf(&cfg, "tube", "height", hs[ih]);
+                        setf(&cfg, "light", "theta_deg", ths[it]);
+                        setf(&cfg, "medium", "n", ns[in]);
+                        setf(&cfg, "medium", "albedo", as[ia]);
+                        setf(&cfg, "medium", "g", gs[ig]);
+                        set(&cfg, "experiment", "methods",
+                            as[ia] < 1 ? "mc, pp, ss, mp, mp+ss, rte2d" : "mc, pp, ss, rte2d");
+                        char where[160];
+                        snprintf(where, sizeof where, "tube H %g theta_L %g n %g albedo %g g %g",
+                                 hs[ih], ths[it], ns[in], as[ia], gs[ig]);
+                        ppb_err err;
+                        if (ppb_methods_check(&cfg, &err))
+                            fail_msg("%s: refused: %s", where, err.msg);
+                        ppb_experiment ex;
+                        capture_begin();
+                        int rc = ppb_experiment_compute(&ex, &cfg, &g_ctx, &err);
+                        capture_end(&s, where);
+                        if (rc)
+                            fail_msg("%s: %s", where, err.msg);
+                        if (ex.nfailed)
+                            fail_msg("%s: %s failed: %s", where, ex.failed[0], ex.failed_why[0]);
+                        for (int m = 0; m < ex.n; m++) {
+                            const ppb_result *r = &ex.res[m];
+                            check_result(r, where);
+                            const ppb_totals *t = &r->totals;
+                            if (t->R < 0 || t->T < 0 || t->sides < 0 || t->ballistic < 0)
+                                fail_msg("%s: %s: a negative total: R %g T %g sides %g "
+                                         "ballistic %g",
+                                         where, r->method, t->R, t->T, t->sides, t->ballistic);
+                        }
+                        ppb_experiment_free(&ex);
+                        points++;
+                    }
+    if (s.other)
+        fail_msg("%ld unexpected lines on stderr, the first: %s", s.other, s.other_line);
+    assert_int_equal(points, 24);
+}
+
+/* An albedo step whose range reaches 1 (0.95 -> 1): pp's albedo nodes then include the
+ * conservative slab, whose degenerate pair at lambda = 0 is one mode (m - 1 modes against m);
+ * the march tables refused the valid config ("the slab solutions disagree on the mode count").
+ * Expected: pp runs and its result passes the grid's checks. */
+static void test_albedo_step_to_one(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    coarse(&cfg, 0);
+    set(&cfg, "experiment", "methods", "pp");
+    set(&cfg, "medium", "step", "albedo");
+    set(&cfg, "medium", "albedo", "0.95");
+    set(&cfg, "medium", "albedo_right", "1");
+    ppb_err err;
+    assert_int_equal(ppb_methods_check(&cfg, &err), 0);
+    ppb_experiment ex;
+    said s;
+    memset(&s, 0, sizeof s);
+    capture_begin();
+    int rc = ppb_experiment_compute(&ex, &cfg, &g_ctx, &err);
+    capture_end(&s, "albedo step 0.95 -> 1");
+    if (rc)
+        fail_msg("%s", err.msg);
+    if (ex.nfailed)
+        fail_msg("%s failed: %s", ex.failed[0], ex.failed_why[0]);
+    assert_int_equal(ex.n, 1);
+    check_result(&ex.res[0], "albedo step 0.95 -> 1");
+    ppb_experiment_free(&ex);
+}
+
+/* The work lines say what pp's tables cost (methods/work_estimate.h): an albedo step at n = 1.5
+ * and 45 deg builds pp.albedos = 9 slab solutions (one for one albedo) and 4 direction variants
+ * (the tube at n > 1) of the 4096 table directions of the default bins (4 surfaces x 64 bins x
+ * 4^2 samples: 16384 in all); one albedo at n = 1 builds one solution of 4096. The line was not
+ * printed: a run that took 17 minutes said only its march steps. */
+static void test_pp_table_work(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    ppb_err err;
+    assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
+    snprintf(cfg.name, sizeof cfg.name, "w");
+    set(&cfg, "experiment", "methods", "pp");
+    set(&cfg, "medium", "step", "albedo");
+    set(&cfg, "medium", "albedo_right", "0.475");
+    set(&cfg, "medium", "n", "1.5");
+    set(&cfg, "light", "theta_deg", "45");
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    assert_non_null(f);
+    ppb_work_print(f, &cfg);
+    fclose(f);
+    if (!strstr(text, "w: pp: work: tables: 9 slab solves of 334 directions, 1.64e+04 table "
+                      "directions"))
+        fail_msg("work lines:\n%s", text);
+    free(text);
+    set(&cfg, "medium", "step", "none");
+    set(&cfg, "medium", "n", "1");
+    double solves, ndir;
+    ppb_march_tables_work(&cfg.scene, &cfg.pp, cfg.samples_dir, 64, &solves, &ndir);
+    if (!(solves == 1.0 && ndir == 4096.0))
+        fail_msg("uniform n = 1: %g solves, %g directions", solves, ndir);
+}
+
+/* ss's image series is refused before any work when its estimated terms exceed
+ * PPB_WORK_IMAGE_TERMS_MAX (method_ss.h): the study's bins on a 0.01-mfp tube at 89 deg and
+ * n = 2.5 need up to 7.6e12 terms (1.34e6 rays x 4000 legs x 353 rows x 4 tiles, from the
+ * formulas of method_ss.h); ss ran there for over 5 minutes, deaf to SIGTERM. pp, which does
+ * not sum the images, is not refused; nor is the study's oblique n = 1.4 case (6e8 terms). */
+static void test_image_series_cost(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    ppb_err err;
+    assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
+    set(&cfg, "experiment", "methods", "ss");
+    set(&cfg, "tube", "height", "0.01");
+    set(&cfg, "light", "theta_deg", "89");
+    set(&cfg, "medium", "n", "2.5");
+    set(&cfg, "medium", "g", "-0.95");
+    set(&cfg, "medium", "albedo", "0");
+    assert_int_equal(ppb_methods_check(&cfg, &err), -1);
+    if (!strstr(err.msg, "ss: the beam's images need up to 7.59e+12 terms"))
+        fail_msg("unexpected: %s", err.msg);
+    set(&cfg, "experiment", "methods", "pp");
+    assert_int_equal(ppb_methods_check(&cfg, &err), 0);
+    assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
+    set(&cfg, "experiment", "methods", "ss");
+    set(&cfg, "light", "theta_deg", "45");
+    set(&cfg, "medium", "n", "1.4");
+    assert_int_equal(ppb_methods_check(&cfg, &err), 0);
+}
+
 /* The experiment's result arrays are checked against [run] memory_limit before any is allocated
  * (issue 15): mp alone on the coarse tube holds one result of ncells radiances and standard
  * errors, 16 ncells bytes (expected value from the layout); a limit 1 % below that refuses the
@@ -331,10 +491,13 @@ int main(void)
 {
     g_ctx.quiet = 1;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_robust_tube),
-        cmocka_unit_test(test_robust_slab),
-        cmocka_unit_test(test_result_memory_checked),
+        cmocka_unit_test(test_robust_tube),           cmocka_unit_test(test_robust_slab),
+        cmocka_unit_test(test_result_memory_checked), cmocka_unit_test(test_image_series_cost),
+        cmocka_unit_test(test_albedo_step_to_one),    cmocka_unit_test(test_pp_table_work),
+        cmocka_unit_test(test_robust_corner),
     };
+    if (getenv("PPB_TEST_FILTER")) /* one test by name, e.g. when checking a fix */
+        cmocka_set_test_filter(getenv("PPB_TEST_FILTER"));
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     long hits = 0, builds = 0;
     const ppb_march_cache *kept = ppb_ctx_state(&g_ctx, "pp.march_tables");

@@ -1,35 +1,45 @@
 #include "base/csv_read.h"
 
+#include "base/file_read.h"
+
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Appends one line to the record buffer; -1 at the end of the stream. */
-static int append_line(ppb_csv *c, size_t *len)
+/* Appends one line to the record buffer and toggles *quoted for each '"' in it: 0, or 1 at the
+ * end of the stream, or -1 (out of memory, or more than PPB_READ_MAX bytes: a stream that never
+ * ends). Only the new line is scanned, so a record of any number of lines (a quote left open)
+ * costs time linear in its length (docs/reference.md: Exit codes). */
+static int append_line(ppb_csv *c, size_t *len, int *quoted)
 {
     ssize_t n = getline(&c->ln, &c->ln_cap, c->f);
     if (n < 0)
+        return 1;
+    c->bytes += (size_t)n;
+    if (memchr(c->ln, '\0', (size_t)n)) { /* the text after it would be lost */
+        c->why = "a NUL byte: not a text file";
         return -1;
+    }
+    if (c->bytes > PPB_READ_MAX) {
+        c->why = "more than the bytes read from one file";
+        return -1;
+    }
     if (*len + (size_t)n + 1 > c->rec_cap) {
         size_t want = 2 * (*len + (size_t)n + 1);
         char *p = realloc(c->rec, want);
-        if (!p)
+        if (!p) {
+            c->why = "out of memory";
             return -1;
+        }
         c->rec = p;
         c->rec_cap = want;
     }
     memcpy(c->rec + *len, c->ln, (size_t)n + 1);
+    for (const char *q = c->rec + *len; (q = memchr(q, '"', (size_t)(c->rec + *len + n - q))); q++)
+        *quoted ^= 1;
     *len += (size_t)n;
     c->nread++;
     return 0;
-}
-
-static int quote_open(const char *s, size_t len)
-{
-    int open = 0;
-    for (size_t i = 0; i < len; i++)
-        open ^= s[i] == '"';
-    return open;
 }
 
 static int push_field(ppb_csv *c, char *f)
@@ -82,12 +92,15 @@ int ppb_csv_next(ppb_csv *c, ppb_err *err)
 {
     for (;;) {
         size_t len = 0;
+        int quoted = 0, got;
         c->line = c->nread + 1;
-        if (append_line(c, &len))
+        if ((got = append_line(c, &len, &quoted)) == 1)
             return 0;
-        while (quote_open(c->rec, len))
-            if (append_line(c, &len))
+        while (got == 0 && quoted)
+            if ((got = append_line(c, &len, &quoted)) == 1)
                 return ppb_fail(err, "%s:%ld: a quoted field is not closed", c->name, c->line);
+        if (got < 0)
+            return ppb_fail(err, "%s:%ld: %s", c->name, c->line, c->why);
         while (len > 0 && (c->rec[len - 1] == '\n' || c->rec[len - 1] == '\r'))
             c->rec[--len] = '\0';
         if (len == 0)
@@ -120,10 +133,10 @@ int ppb_csv_open_stream(ppb_csv *c, FILE *f, const char *name, ppb_err *err)
 
 int ppb_csv_open(ppb_csv *c, const char *path, ppb_err *err)
 {
-    FILE *f = fopen(path, "r");
+    FILE *f = ppb_fopen_regular(path, PPB_READ_MAX, err);
     if (!f) {
         memset(c, 0, sizeof *c);
-        return ppb_fail(err, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
     }
     if (ppb_csv_open_stream(c, f, path, err)) {
         fclose(f);

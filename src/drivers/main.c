@@ -13,6 +13,8 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/child.h"
+#include "base/memory.h"
 #include "base/progress.h"
 #include "drivers/experiment.h"
 #include "drivers/mc_shard.h"
@@ -23,6 +25,7 @@
 #include "drivers/sweep.h"
 #include "io/scene_json.h"
 #include "methods/registry.h"
+#include "physics/ppsolver.h"
 #include "model/config.h"
 #include "model/grid.h"
 #include "runtime/ocl.h"
@@ -344,6 +347,13 @@ static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_grid
     if (c->out)
         snprintf(cfg->out_dir, sizeof cfg->out_dir, "%s", c->out);
     return 0;
+}
+
+/* Commands whose methods call OpenBLAS (the slab solver, the march tables, rte2d). */
+static int needs_blas(const command *cmd)
+{
+    return !strcmp(cmd->name, "run") || !strcmp(cmd->name, "sweep") || !strcmp(cmd->name, "perf") ||
+           !strcmp(cmd->name, "mc-shard");
 }
 
 /* A config or option the user must fix: printed once, exit code 2. */
@@ -929,6 +939,7 @@ static const command *find_command(const char *name)
 
 int main(int argc, char **argv)
 {
+    pp_blas_threads(argv); /* may execute ppbench again: first (base/memory.h) */
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") ||
         !strcmp(argv[1], "help")) {
         /* `ppbench help CMD` is `ppbench CMD --help`. */
@@ -952,6 +963,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "ppbench: %s: unknown command (see --help)\n", argv[1]);
         return EXIT_USAGE;
     }
+    /* What a ppbench killed with SIGKILL left running (its commands' descendants) goes first
+     * (base/child.h). */
+    ppb_child_clean_dead();
     cli c;
     int rc = parse_cli(argc, argv, cmd, &c);
     if (rc == PARSE_HELP) {
@@ -961,6 +975,15 @@ int main(int argc, char **argv)
     }
     if (rc == 0 && (cmd->opts & OPT_DEVICE))
         rc = check_device(&c);
+    if (rc == 0 && needs_blas(cmd)) {
+        /* OpenBLAS retries its buffer's allocation for ever: it is had here, before any work,
+         * or its lack is an error (base/memory.h). */
+        ppb_err err = {{0}};
+        if (pp_blas_reserve(&err)) {
+            fprintf(stderr, "ppbench: %s\n", err.msg);
+            rc = EXIT_RUN;
+        }
+    }
     if (rc == 0) {
         ppb_progress_install_signals();
         rc = cmd->run(&c);

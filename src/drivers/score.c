@@ -37,8 +37,13 @@ static int load_provenance(const char *dir, ppb_config *cfg, ppb_err *err)
     char *line = NULL, **sets = NULL;
     size_t cap = 0;
     int nsets = 0, on = 0, rc = -1, lineno = 0;
-    while (getline(&line, &cap, f) > 0) {
+    ssize_t got;
+    while ((got = getline(&line, &cap, f)) > 0) {
         lineno++;
+        if (memchr(line, '\0', (size_t)got)) { /* the text after it would be lost */
+            ppb_fail(err, "%s:%d: a NUL byte: not a text file", path, lineno);
+            goto done;
+        }
         if (lineno == 1 && strncmp(line, "# ppbench provenance", 20) != 0) {
             ppb_fail(err, "%s:1: not a ppbench provenance record", path);
             goto done;

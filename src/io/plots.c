@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/child.h"
 
 #ifndef PPB_SCRIPT_DIR
 #define PPB_SCRIPT_DIR "scripts"
@@ -201,19 +202,21 @@ void ppb_plots_write(const char *dir, const char *ref, ppb_figures *fig)
         ppb_figures_fail(fig, "plots", why);
         return;
     }
+    /* stdout: the figures left out, for read_failures; the script's other messages go to
+     * stderr. Under a guard: the script and what it starts die with ppbench (base/child.h).
+     * The reference's id reaches it as data, in its environment, never as script text. */
     fflush(NULL); /* the child must not repeat buffered output */
-    pid_t pid = fork();
-    if (pid == 0) {
-        /* stdout: the figures left out, for read_failures; the rest goes to stderr. */
-        dup2(out[1], STDOUT_FILENO);
-        close(out[0]);
-        close(out[1]);
-        /* The reference's id as data: an environment variable, never script text. */
-        if (ref)
-            setenv("PPB_REFERENCE", ref, 1);
-        execlp("bash", "bash", script, dir, (char *)NULL);
-        _exit(127);
+    int saved = dup(STDOUT_FILENO);
+    if (ref)
+        setenv("PPB_REFERENCE", ref, 1);
+    char *argv[] = {"bash", script, (char *)dir, NULL};
+    pid_t pid =
+        saved < 0 || dup2(out[1], STDOUT_FILENO) < 0 ? -1 : ppb_child_spawn("bash", argv, 0, 0);
+    if (saved >= 0) {
+        dup2(saved, STDOUT_FILENO);
+        close(saved);
     }
+    unsetenv("PPB_REFERENCE");
     close(out[1]);
     FILE *f = pid > 0 ? fdopen(out[0], "r") : NULL;
     if (f) {

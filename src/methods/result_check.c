@@ -34,16 +34,28 @@ int ppb_radiance_check(const char *name, ppb_result *r, long *clamped, ppb_err *
     return 0;
 }
 
-int ppb_totals_check(const char *name, const ppb_result *r, ppb_err *err)
+int ppb_totals_check(const char *name, ppb_result *r, ppb_err *err)
 {
-    const ppb_totals *t = &r->totals;
-    double v[5] = {t->R, t->T, t->sides, t->absorbed, t->ballistic};
+    ppb_totals *t = &r->totals;
+    double v[5] = {t->R, t->T, t->sides, t->absorbed, t->ballistic}, scale = 0.0;
     for (int i = 0; i < 5; i++)
         if (!isfinite(v[i]))
             return ppb_fail(err,
                             "%s: non-finite totals (R %g, T %g, sides %g, absorbed %g): not "
                             "written",
                             r->method, t->R, t->T, t->sides, t->absorbed);
+        else
+            scale += fabs(v[i]);
+    static const char *const names[] = {"R", "T", "sides", "ballistic"};
+    double *own[] = {&t->R, &t->T, &t->sides, &t->ballistic};
+    for (int i = 0; i < 4; i++)
+        if (*own[i] < 0.0 && -*own[i] <= PPB_TOTAL_ROUNDOFF * scale)
+            *own[i] = 0.0;
+        else if (*own[i] < 0.0)
+            return ppb_fail(err,
+                            "%s: %s = %.6g is negative beyond round-off (%g of the totals' sum "
+                            "%.6g): not written",
+                            r->method, names[i], *own[i], PPB_TOTAL_ROUNDOFF, scale);
     double sum = t->R + t->T + t->sides + t->ballistic;
     if (sum > 1.0 + PPB_ENERGY_TOL)
         fprintf(stderr,

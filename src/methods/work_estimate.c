@@ -2,6 +2,7 @@
 #include "methods/work_estimate.h"
 
 #include "methods/registry.h"
+#include "physics/march_tables.h"
 #include "model/scene.h"
 
 double ppb_work_results_bytes(const ppb_config *cfg)

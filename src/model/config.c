@@ -496,9 +496,9 @@ static int parse_enum(const key_def *k, const char *text, int *out, char *why, s
             *out = k->enums[j].value;
             return 0;
         }
-    char names[256];
+    char names[256], q[96];
     enum_list(k->enums, names, sizeof names);
-    snprintf(why, n, "'%s' is not one of %s", text, names);
+    snprintf(why, n, "'%s' is not one of %s", shown(text, q, sizeof q), names);
     return -1;
 }
 
@@ -513,13 +513,24 @@ static int parse_methods(ppb_config *cfg, const char *text, char *why, size_t n)
          tok = strtok_r(NULL, ",", &save)) {
         tok = trim(tok);
         if (strlen(tok) >= sizeof cfg->methods[0]) {
-            snprintf(why, n, "method id '%s' is longer than %zu characters", tok,
-                     sizeof cfg->methods[0] - 1);
+            char q[96];
+            snprintf(why, n, "method id '%s' is longer than %zu characters",
+                     shown(tok, q, sizeof q), sizeof cfg->methods[0] - 1);
             return -1;
         }
+        /* Ids are names (built-in or [method.NAME]): any other byte is refused here, shown
+         * escaped, so no later message echoes a control or bidirectional character. */
+        for (const char *c = tok; *c; c++)
+            if (!isalnum((unsigned char)*c) && !strchr("_-.+", *c)) {
+                char q[96];
+                snprintf(why, n, "method id '%s' may hold only letters, digits and _-.+",
+                         shown(tok, q, sizeof q));
+                return -1;
+            }
         for (int i = 0; i < cfg->nmethods; i++)
             if (strcmp(cfg->methods[i], tok) == 0) {
-                snprintf(why, n, "method '%s' listed twice", tok);
+                char q[96];
+                snprintf(why, n, "method '%s' listed twice", shown(tok, q, sizeof q));
                 return -1;
             }
         if (cfg->nmethods == PPB_MAX_METHODS) {
@@ -544,7 +555,9 @@ static int parse_string(const key_def *k, char *dst, size_t cap, const char *tex
     }
     for (const char *c = text; k->type == K_NAME && *c; c++)
         if (!isalnum((unsigned char)*c) && !strchr("_-.+", *c)) {
-            snprintf(why, n, "'%s' may hold only letters, digits and _-.+", text);
+            char q[96]; /* a control or bidirectional character is shown escaped */
+            snprintf(why, n, "'%s' may hold only letters, digits and _-.+",
+                     shown(text, q, sizeof q));
             return -1;
         }
     snprintf(dst, cap, "%s", text);

@@ -163,6 +163,25 @@ double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, in
     return tab + coef + scratch + 24.0 * n * n * d;
 }
 
+double ppb_march_tables_work(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
+                             int tau_per_mfp, double *solves, double *ndir)
+{
+    table_key k = plan(sc, pp, nsamp, tau_per_mfp, 1);
+    *ndir = table_variants(sc) *
+            (double)ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                   ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
+    double m = 2.0 * pp->directions, work = 0.0;
+    *solves = 0.0;
+    for (int c = 0; c < k.ncols; c++) {
+        /* a block: its slab solve (eigenproblem and boundary systems, about 10 m^3), the mode
+         * coefficients of every direction (m^2 each), R and S (ndir x ntau x m each) */
+        work += k.nalb *
+                (10.0 * m * m * m + *ndir * m * m + (k.want_s ? 3.0 : 1.0) * *ndir * k.ntau[c] * m);
+        *solves += k.nalb;
+    }
+    return work;
+}
+
 int ppb_march_tables_ss(const ppb_scene *sc, int nsamp, ppb_march_tables *t, ppb_err *err)
 {
     table_key k = plan(sc, NULL, nsamp, 0, 0);
@@ -211,6 +230,7 @@ typedef struct pp_build {
     double *A, *A2;     /* [ndir][ne]: A_k(w), and A_k / (lambda_k r0 - 1) for S (NULL without) */
     double *E;          /* [ntau_max][ne]: e_k at the tau nodes of the current column */
     double *lambda, *tau_ref, *a; /* [nmodes]: the modes, and pp_source_coeffs' output */
+    int *pole;                    /* [nmodes]: s_row's modes near the pole */
 } pp_build;
 
 /* E[i][k] = e_k(tau_i) at the column's tau nodes: the factor both matrix products share. */
@@ -256,17 +276,23 @@ static void s_row(const pp_build *b, const ppb_march_col *col, int dir, int ne, 
     double tau_star = r > 0.0 ? col->tau0 : 0.0;
     int i_star = r > 0.0 ? ntau - 1 : 0;
     double c_far = 0.0;
-    for (int k = 0; k < ne; k++)
+    /* The modes near the pole, found once per direction (in mode order, as the sum takes
+     * them): scanning all ne modes at every tau node cost ndir x ntau x ne tests a block, as
+     * much as the matrix products themselves. */
+    int npole = 0, *pole = b->pole;
+    for (int k = 0; k < ne; k++) {
         c_far += A2[k] * E[(size_t)i_star * ne + k];
+        if (fabs(b->lambda[k] * r - 1.0) < S_NEAR_POLE)
+            pole[npole++] = k;
+    }
     for (int i = 0; i < ntau; i++) {
         double tau = i * col->tau_h, delta = tau_star - tau;
         double att = exp(-delta / r);
         /* The linear part's S solves r0 S' - S = lin tau: -lin (tau + r0), plus the
          * homogeneous term that zeroes it at tau*. */
         row[i] += -c_far * att - lin * (tau + r) + lin * (tau_star + r) * att;
-        for (int k = 0; k < ne; k++) {
-            if (fabs(b->lambda[k] * r - 1.0) >= S_NEAR_POLE)
-                continue;
+        for (int q = 0; q < npole; q++) {
+            int k = pole[q];
             double e_tau = E[(size_t)i * ne + k], e_far = E[(size_t)i_star * ne + k];
             row[i] += A[k] * s_term(b->lambda[k], r, delta, e_tau, e_far * att);
         }
@@ -324,17 +350,21 @@ static int build_end(pp_build *b, int rc)
     double *bufs[] = {b->A, b->A2, b->E, b->lambda, b->tau_ref, b->a, b->r0, b->wdir};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         free(bufs[i]);
+    free(b->pole);
     if (rc)
         ppb_march_tables_free(b->t);
     return rc;
 }
 
-/* Every block must have the first solution's mode count, since the scratch is sized by it. */
+/* The scratch is sized for the most modes a block of these directions can have (cap:
+ * pp_mode_capacity), not the first block's count: an albedo range that reaches 1 holds a
+ * conservative block with one mode fewer (the degenerate pair at lambda = 0 is one mode), and
+ * each block uses its own count. Every block must have the same capacity. */
 static int adopt_mode_count(pp_build *b, int nm, ppb_err *err)
 {
     ppb_march_tables *t = b->t;
     if (b->A && nm != t->nmodes)
-        return ppb_fail(err, "march tables: the slab solutions disagree on the mode count");
+        return ppb_fail(err, "march tables: the slab solutions disagree on the mode capacity");
     t->nmodes = nm;
     if (b->A)
         return 0;
@@ -344,7 +374,8 @@ static int adopt_mode_count(pp_build *b, int nm, ppb_err *err)
     b->lambda = malloc((size_t)nm * sizeof *b->lambda);
     b->tau_ref = malloc((size_t)nm * sizeof *b->tau_ref);
     b->a = malloc((size_t)nm * sizeof *b->a);
-    if (!b->A || (b->want_s && !b->A2) || !b->E || !b->lambda || !b->tau_ref || !b->a)
+    b->pole = malloc((size_t)nm * sizeof *b->pole);
+    if (!b->A || (b->want_s && !b->A2) || !b->E || !b->lambda || !b->tau_ref || !b->a || !b->pole)
         return ppb_fail(err, "march tables: out of memory for %d modes", nm);
     return 0;
 }
@@ -410,13 +441,20 @@ static int build_block(pp_build *b, int c, int node, ppb_err *err)
     int nm = pp_nmodes(sol);
     int ne = b->pp->modes > 0 && b->pp->modes < nm ? b->pp->modes : nm;
     t->modes_kept = ne;
-    if (adopt_mode_count(b, nm, err)) {
+    if (adopt_mode_count(b, pp_mode_capacity(sol), err)) {
         if (sol != b->first)
             pp_free(sol);
         return -1;
     }
     pp_modes(sol, b->lambda, b->tau_ref);
+    /* One BLAS thread for the coefficients: a matrix-vector product per table direction (16400
+     * a block at n > 1 in the tube), each too small to share, where every call woke and then
+     * waited on OpenBLAS's other threads (sched_yield: on a loaded machine, minutes a build).
+     * A product's elements are each one thread's dot product either way: the same bits. */
+    int threads = openblas_get_num_threads();
+    openblas_set_num_threads(1);
     block_coeffs(b, sol, alb, ne, C, Cup);
+    openblas_set_num_threads(threads);
     double lin = pp_source_linear(sol) / alb;
     if (!b->first)
         b->first = sol;

@@ -77,6 +77,15 @@ void ppb_march_tables_free(ppb_march_tables *t);
  * before anything is allocated: the tables themselves (*tables, what the march uploads) plus
  * the build's scratch and the slab solver's matrices (about 24 of M/2 x M/2 doubles: phase
  * blocks, eigenproblem, boundary system, and the first solution kept for sharing). */
+/* pp's table build in multiply-adds, estimated as the build does it: per column and albedo node
+ * (pp.albedos nodes over an albedo step's range, one for one albedo) a slab solve of m = 2
+ * directions cells (about 10 m^3), the mode coefficients of every table direction (ndir m^2) and
+ * the R and S rows (ndir x ntau x m each); ndir counts the direction variants (4 in the tube at
+ * n > 1, 2 in the slab). *solves gets the slab solves, *ndir the table directions. An albedo
+ * step at n > 1 builds 9 x 4 = 36 times the tables of one albedo at n = 1. */
+double ppb_march_tables_work(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
+                             int tau_per_mfp, double *solves, double *ndir);
+
 double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
                               int tau_per_mfp, int with_modes, double *tables);
 

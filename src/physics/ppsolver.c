@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "base/clock.h"
+#include "base/memory.h"
 #include "base/progress.h"
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
@@ -746,6 +747,11 @@ int pp_nmodes(const pp_solution *s)
     return s->nmodes;
 }
 
+int pp_mode_capacity(const pp_solution *s)
+{
+    return s->m;
+}
+
 void pp_modes(const pp_solution *s, double *lambda, double *tau_ref)
 {
     memcpy(lambda, s->lambda, (size_t)s->nmodes * sizeof(double));
@@ -766,4 +772,24 @@ void pp_boundary_totals(const pp_solution *s, double *specular, double *ballisti
 double pp_absorbed(const pp_solution *s)
 {
     return s->absorbed;
+}
+
+int pp_blas_reserve(ppb_err *err)
+{
+    if (ppb_memory_need(PPB_BLAS_BUFFER_BYTES,
+                        "the linear-algebra library's (OpenBLAS) work buffer", err))
+        return -1;
+    /* dpotrf takes the buffer whatever the size (OpenBLAS's interface/lapack/potrf.c). */
+    double one = 1.0;
+    if (LAPACKE_dpotrf(LAPACK_ROW_MAJOR, 'L', 1, &one, 1) != 0)
+        return ppb_fail(err, "LAPACKE_dpotrf of [1] failed");
+    return 0;
+}
+
+void pp_blas_threads(char **argv)
+{
+    int have = openblas_get_num_threads();
+    int want = ppb_memory_blas_threads(have);
+    if (want != have)
+        ppb_memory_blas_reexec(want, argv);
 }

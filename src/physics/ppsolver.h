@@ -100,6 +100,10 @@ double pp_mu0(const pp_solution *s);
 /* Homogeneous modes (M of them: 2N, or 2N - 1 at alpha = 1), sorted by |lambda| ascending;
  * e_k(tau) = exp(lambda_k (tau - tau_ref_k)), tau_ref_k = 0 if lambda_k < 0 else tau0. */
 int pp_nmodes(const pp_solution *s);
+/* The most modes a solution of these directions has: m, the cell count (2n). At albedo 1 (1 -
+ * albedo < 1e-13) the eigenvalue pair +-lambda_0 is degenerate at 0 and becomes the constant
+ * and linear (diffusion) mode, stored as one: m - 1 modes; every other albedo has m. */
+int pp_mode_capacity(const pp_solution *s);
 void pp_modes(const pp_solution *s, double *lambda, double *tau_ref);
 
 /* Source function for scattering into the continuous direction w (unit vector, tube frame),
@@ -139,5 +143,14 @@ double pp_absorbed(const pp_solution *s);
 /* n > 1: the entry's specular reflection F(theta_L), and the part of pp_totals' ballistic that
  * leaves through S1 (the beam reflected at S2); both 0 at n = 1. */
 void pp_boundary_totals(const pp_solution *s, double *specular, double *ballistic_top);
+
+/* Sets OpenBLAS's thread count (base/memory.h: ppb_memory_blas_threads), executing ppbench
+ * again (argv) when the library started with another; first thing in main. */
+void pp_blas_threads(char **argv);
+
+/* Has OpenBLAS allocate its work buffer now, while the memory is there (base/memory.h:
+ * PPB_BLAS_BUFFER_BYTES): it keeps it for the process, and a later call never waits for one.
+ * Fails "out of memory: ..." when the buffer cannot be had. */
+int pp_blas_reserve(ppb_err *err);
 
 #endif

@@ -10,6 +10,7 @@
 
 #include "base/atomic_file.h"
 #include "base/hash.h"
+#include "base/memory.h"
 
 #ifndef PPB_SOURCE_DIR
 #define PPB_SOURCE_DIR "."
@@ -112,6 +113,11 @@ static int enumerate(dev_entry *out, int cap, ppb_err *err)
     cl_platform_id plats[MAX_PLATFORMS];
     cl_uint np = 0;
     cl_int rc = clGetPlatformIDs(MAX_PLATFORMS, plats, &np);
+    /* The ICD loader says "no platform" too when the driver cannot be loaded for want of
+     * memory (an address-space limit): then memory is what is reported. */
+    if ((rc == -1001 || (rc == CL_SUCCESS && np == 0)) && ppb_memory_as_limit() > 0.0 &&
+        !ppb_memory_can_have(PPB_OCL_LOAD_BYTES))
+        return ppb_memory_need(PPB_OCL_LOAD_BYTES, "loading the OpenCL platform", err);
     if (rc == -1001 || (rc == CL_SUCCESS && np == 0))
         return ppb_fail(err, "OpenCL: no platform found (install pocl-opencl-icd: make deps)");
     if (ppb_cl_check(rc, "clGetPlatformIDs", err))

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "base/atomic_file.h"
+#include "base/child.h"
 #include "base/clock.h"
 #include "base/csv_read.h"
 #include "base/progress.h"
@@ -75,22 +76,15 @@ static void sleep_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
-/* Runs cmd under /bin/sh in its own process group; 0 when it exited with status 0. */
+/* Runs cmd under /bin/sh in its own process group, under a guard that kills whatever the
+ * command leaves running when it ends, times out or ppbench dies (base/child.h); 0 when it
+ * exited with status 0. */
 static int run_command(const char *cmd, double timeout, ppb_err *err)
 {
-    fflush(NULL);
-    pid_t pid = fork();
+    char *argv[] = {"sh", "-c", (char *)cmd, NULL};
+    pid_t pid = ppb_child_spawn("/bin/sh", argv, 1, 1); /* ppbench's stdout stays its own */
     if (pid < 0)
         return ppb_fail(err, "cannot start its command: %s", strerror(errno));
-    if (pid == 0) {
-        setpgid(0, 0);
-        dup2(STDERR_FILENO, STDOUT_FILENO); /* ppbench's stdout stays its own */
-        signal(SIGINT, SIG_DFL);
-        signal(SIGTERM, SIG_DFL);
-        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
-        _exit(127);
-    }
-    setpgid(pid, pid); /* also here: no race with the child's own call */
     double t0 = ppb_now();
     int st = 0, why = 0; /* why: 1 timeout, 2 interrupted */
     for (int ms = 1;;) {
@@ -296,6 +290,10 @@ int ppb_external_totals(const char *path, const ppb_scene *sc, ppb_result *r, pp
             if (parse_real(ppb_csv_get(&c, col[k]), dst[k]) || !isfinite(*dst[k])) {
                 ppb_fail(err, "%s:%ld: %s = '%s': not a finite number", path, c.line, names[k],
                          ppb_csv_get(&c, col[k]));
+                goto done;
+            } else if (*dst[k] < 0.0 && k != 3) { /* absorbed may be 1 - the rest */
+                ppb_fail(err, "%s:%ld: %s = '%s': a fraction of the power, must be >= 0", path,
+                         c.line, names[k], ppb_csv_get(&c, col[k]));
                 goto done;
             }
     }

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "base/atomic_file.h"
+#include "base/file_read.h"
 #include "base/hash.h"
 #include "kernels/ppb_fresnel.h"
 
@@ -239,9 +240,9 @@ static int checksum_ok(FILE *f, long long size)
 int ppb_mc_tallies_load(ppb_mc_tallies *t, const char *path, ppb_err *err)
 {
     memset(t, 0, sizeof *t);
-    FILE *f = fopen(path, "rb");
+    FILE *f = ppb_fopen_regular(path, PPB_READ_MAX, err); /* never a FIFO: open would block */
     if (!f)
-        return ppb_fail(err, "%s: cannot read: %s", path, strerror(errno));
+        return -1;
     struct stat st;
     char m[8];
     if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode) ||

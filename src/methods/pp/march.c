@@ -206,8 +206,12 @@ int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
     ppb_marcher mr;
     if (ppb_marcher_init(&mr, ocl, sc, maps, tab, opts, err))
         return -1;
-    /* Launches of a few rows each let progress lines and Ctrl-C through; a row is 64 cells. */
-    const int chunk = 16;
+    /* Launches of a few rows each let progress lines and Ctrl-C through; a row is 64 cells.
+     * Where ss sums the beam's images (n > 1, tube, oblique light) a row may cost up to
+     * 1/rows of method_ss.h's PPB_WORK_IMAGE_TERMS_MAX: one row a launch. */
+    int images =
+        !tab->R && sc->geometry == PPB_GEOM_TUBE && sc->n > 1.0 && ppb_scene_tan_theta_l(sc) > 0.0;
+    const int chunk = images ? 1 : 16;
     ppb_progress pr;
     ppb_progress_begin(&pr, label, "rows", mr.rows, quiet);
     int done = 0, rc = 0;

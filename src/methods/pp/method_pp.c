@@ -116,11 +116,23 @@ static void work_march(const ppb_config *cfg, double *rays, double *steps)
     *steps = ceil(len / cfg->pp.step);
 }
 
-/* The marcher's work (pp, ss, and a sum that holds one of them): rays x steps. */
-void ppb_pp_work(const ppb_config *cfg, const char *id, FILE *f)
+void ppb_pp_march_work(const ppb_config *cfg, const char *id, FILE *f)
 {
     double rays, steps;
     work_march(cfg, &rays, &steps);
     fprintf(f, "%s: %s: work: %.3g rays x up to %.3g steps = %.3g steps\n", cfg->name, id, rays,
             steps, rays * steps);
+}
+
+/* pp's work: the march, and the tables' build (slab solves x table directions). */
+void ppb_pp_work(const ppb_config *cfg, const char *id, FILE *f)
+{
+    ppb_pp_march_work(cfg, id, f);
+    double solves, ndir;
+    double w = ppb_march_tables_work(&cfg->scene, &cfg->pp, cfg->samples_dir, PPB_MARCH_TAU_PER_MFP,
+                                     &solves, &ndir);
+    fprintf(f,
+            "%s: %s: work: tables: %.3g slab solves of %d directions, %.3g table directions = "
+            "about %.3g multiply-adds\n",
+            cfg->name, id, solves, cfg->pp.directions, ndir, w);
 }

@@ -18,7 +18,9 @@ int ppb_pp_check(const ppb_config *cfg, ppb_err *err);
  * direct beam's single scattering in the tables: that is `ss` (method_ss.h). */
 int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *err);
 
-/* The work line of pp and ss (the registry's work hook): rays x steps of the march. */
+/* The march's work line, rays x steps (pp's and ss's work hooks begin with it). */
+void ppb_pp_march_work(const ppb_config *cfg, const char *id, FILE *f);
+/* pp's work hook: the march, then the tables' build. */
 void ppb_pp_work(const ppb_config *cfg, const char *id, FILE *f);
 
 #endif
