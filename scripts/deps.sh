@@ -9,7 +9,7 @@ set -euo pipefail
 declare -A PC=(
   [OpenCL]=ocl-icd-opencl-dev [lapacke]=liblapacke-dev [openblas]=libopenblas-dev
   [OpenEXR]=libopenexr-dev [libpng]=libpng-dev [inih]=libinih-dev [cmocka]=libcmocka-dev
-  [libxxhash]=libxxhash-dev [jansson]=libjansson-dev
+  [libxxhash]=libxxhash-dev [jansson]=libjansson-dev [zlib]=zlib1g-dev
 )
 # file or command -> Debian package
 declare -A FILES=(

@@ -19,6 +19,7 @@
 #include "drivers/perf.h"
 #include "drivers/report.h"
 #include "drivers/score.h"
+#include "drivers/study_guard.h"
 #include "drivers/slurm.h"
 #include "drivers/sweep.h"
 #include "io/scene_json.h"
@@ -483,6 +484,9 @@ static int cmd_run(const cli *c)
             code = usage_error(&err);
         } else {
             code = check_config_out(c, &cfgs[i]);
+            /* The committed study is make bench's (docs/reference.md: Outputs). */
+            if (code == EXIT_OK && ppb_study_guard(cfgs[i].out_dir, &err))
+                code = usage_error(&err);
             /* The directory is the run's own: refused, untouched, if ppbench did not write it. */
             if (code == EXIT_OK && ppb_experiment_claim_out(cfgs[i].out_dir, &err))
                 code = usage_error(&err);

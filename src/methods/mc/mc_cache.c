@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <glob.h>
+#include <zlib.h>
 
 #include "base/atomic_file.h"
 #include "base/hash.h"
@@ -71,36 +73,118 @@ int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, 
     return status;
 }
 
-int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t)
+#ifndef PPB_SOURCE_DIR
+#define PPB_SOURCE_DIR "."
+#endif
+
+const char *ppb_mc_shipped_dir(void)
+{
+    static char buf[PPB_PATH_MAX];
+    const char *d = getenv("PPBENCH_REFERENCES");
+    if (d && *d)
+        return d;
+    const char *src = getenv("PPBENCH_SOURCE");
+    snprintf(buf, sizeof buf, "%.4000s/references", src && *src ? src : PPB_SOURCE_DIR);
+    return buf;
+}
+
+/* Loads path (a tally file, or one gzip-compressed when gz) into an uninitialised c, and checks
+ * its header against the run: 1 when it is this run's reference, 0 when not (said on stderr). */
+static int load_checked(ppb_run_ctx *ctx, const char *path, int gz, ppb_mc_tallies *c)
+{
+    const ppb_config *cfg = ctx->cfg;
+    ppb_err err = {{0}};
+    char plain[PPB_PATH_MAX + 64];
+    snprintf(plain, sizeof plain, "%s", path);
+    if (gz) { /* inflated into a temporary file that mc_tally.c's reader checks as any other */
+        const char *tmp = getenv("TMPDIR");
+        snprintf(plain, sizeof plain, "%.4000s/ppbench-ref-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+        int fd = mkstemp(plain);
+        gzFile in = fd < 0 ? NULL : gzopen(path, "rb");
+        FILE *out = in ? fdopen(fd, "wb") : NULL;
+        int ok = out != NULL;
+        char buf[1 << 16];
+        int n;
+        while (ok && (n = gzread(in, buf, sizeof buf)) > 0)
+            ok = fwrite(buf, 1, (size_t)n, out) == (size_t)n;
+        ok = ok && n == 0;
+        if (in)
+            gzclose(in);
+        if (out)
+            ok = fclose(out) == 0 && ok;
+        else if (fd >= 0)
+            close(fd);
+        if (!ok) {
+            if (fd >= 0)
+                unlink(plain);
+            fprintf(stderr, "%s: mc: shipped reference %s: cannot be inflated: not used\n",
+                    cfg->name, path);
+            return 0;
+        }
+    }
+    int rc = ppb_mc_tallies_load(c, plain, &err);
+    if (gz)
+        unlink(plain);
+    if (rc) {
+        fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
+        return 0;
+    }
+    int full = cfg->mc.target_noise > 0 || c->count == (uint64_t)cfg->mc.photons;
+    if (c->fingerprint != ppb_mc_scene_fingerprint(&cfg->scene) ||
+        c->seed != (uint64_t)cfg->mc.seed || c->batches != cfg->mc.batches ||
+        c->first != (uint64_t)cfg->mc.first || c->budget_photons != (uint64_t)cfg->mc.photons ||
+        !full || !ppb_mc_tallies_range_matches(c)) {
+        fprintf(stderr, "%s: mc: reference cache: %s holds another reference: not used\n",
+                cfg->name, path);
+        ppb_mc_tallies_free(c);
+        return 0;
+    }
+    return 1;
+}
+
+/* The shipped layer's file for the key file name `name` (mc-<key>.bin): the first
+ * <shipped>/<case>/<name>.gz that exists, in glob order. */
+static int shipped_find(const char *name, char *buf, size_t cap)
+{
+    char pattern[PPB_PATH_MAX + 128];
+    snprintf(pattern, sizeof pattern, "%.4000s/*/%.64s.gz", ppb_mc_shipped_dir(), name);
+    glob_t g;
+    int found = glob(pattern, 0, NULL, &g) == 0 && g.gl_pathc > 0;
+    if (found)
+        snprintf(buf, cap, "%s", g.gl_pathv[0]);
+    globfree(&g);
+    return found;
+}
+
+int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *shipped)
 {
     const ppb_config *cfg = ctx->cfg;
     char path[PPB_PATH_MAX + 64];
     ppb_err err = {{0}};
+    *shipped = 0;
     if (!ctx->ref_cache)
         return 0;
     if (ppb_mc_cache_path(ctx, chunk, path, sizeof path, &err)) {
         fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
         return 0;
     }
-    if (access(path, F_OK) != 0)
-        return 0;
     ppb_mc_tallies c;
-    if (ppb_mc_tallies_load(&c, path, &err)) {
-        fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
-        return 0;
+    if (access(path, F_OK) == 0 && load_checked(ctx, path, 0, &c)) {
+        snprintf(ctx->mc_reference, sizeof ctx->mc_reference, "%s", path);
+        *t = c;
+        return 1;
     }
-    int full = cfg->mc.target_noise > 0 || c.count == (uint64_t)cfg->mc.photons;
-    if (c.fingerprint != ppb_mc_scene_fingerprint(&cfg->scene) ||
-        c.seed != (uint64_t)cfg->mc.seed || c.batches != cfg->mc.batches ||
-        c.first != (uint64_t)cfg->mc.first || c.budget_photons != (uint64_t)cfg->mc.photons ||
-        !full || !ppb_mc_tallies_range_matches(&c)) {
-        fprintf(stderr, "%s: mc: reference cache: %s holds another reference: not used\n",
-                cfg->name, path);
-        ppb_mc_tallies_free(&c);
-        return 0;
+    /* The shipped layer, under the same key: a file there of another key is never looked at. */
+    const char *slash = strrchr(path, '/');
+    char ship[PPB_PATH_MAX + 128];
+    if (shipped_find(slash ? slash + 1 : path, ship, sizeof ship) &&
+        load_checked(ctx, ship, 1, &c)) {
+        snprintf(ctx->mc_reference, sizeof ctx->mc_reference, "%.4150s", ship);
+        *shipped = 1;
+        *t = c;
+        return 1;
     }
-    *t = c;
-    return 1;
+    return 0;
 }
 
 void ppb_mc_cache_put(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, long long traced)
@@ -116,4 +200,6 @@ void ppb_mc_cache_put(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, long
     if (ppb_mc_cache_path(ctx, chunk, path, sizeof path, &err) ||
         ppb_mkdirs(ctx->ref_cache, &err) || ppb_mc_tallies_save(t, path, &err))
         fprintf(stderr, "%s: mc: reference cache: not stored: %s\n", cfg->name, err.msg);
+    else
+        snprintf(ctx->mc_reference, sizeof ctx->mc_reference, "%s", path);
 }

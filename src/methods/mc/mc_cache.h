@@ -14,7 +14,13 @@
  * kernel receives). The file is DIR/mc-<key>.bin in mc_tally.h's format (header with the photon
  * range, checksum). A file is used only when its header also matches the run in fingerprint, seed,
  * batches and photon range (a stale or damaged file is a miss, never a wrong reference).
- * Interrupted traces are never stored. The directory is ctx->ref_cache; NULL: no cache. */
+ * Interrupted traces are never stored. The directory is ctx->ref_cache; NULL: no cache.
+ *
+ * The shipped layer (docs/reference.md, "The reference cache": shipped references): a read-only
+ * directory, $PPBENCH_REFERENCES or else <source tree>/references, holding <case>/mc-<key>.bin.gz
+ * (the same file, gzip-compressed), consulted after a miss in ctx->ref_cache under the same key
+ * and the same header checks; never written by a run, and not consulted without a cache (tests
+ * run with none, so they trace). */
 #ifndef PPB_MC_CACHE_H
 #define PPB_MC_CACHE_H
 
@@ -30,10 +36,15 @@
  * cfg has a target noise, else unused. Opens ctx's device (its name is in the key). */
 int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, ppb_err *err);
 
-/* Loads ctx->cfg's reference from ctx->ref_cache into an uninitialised t: 1 when found, 0 when
- * not (t then untouched); a file that exists but cannot be used is said on stderr and counts as
- * a miss, as does a kernel source or device that cannot be identified. */
-int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t);
+/* Loads ctx->cfg's reference from ctx->ref_cache, else from the shipped layer, into an
+ * uninitialised t: 1 when found, 0 when not (t then untouched); a file that exists but cannot be
+ * used is said on stderr and counts as a miss, as does a kernel source or device that cannot be
+ * identified. On a hit ctx->mc_reference names the file and *shipped is 1 when it came from the
+ * shipped layer. */
+int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *shipped);
+
+/* The shipped layer's directory: $PPBENCH_REFERENCES, else <source tree>/references. */
+const char *ppb_mc_shipped_dir(void);
 
 /* Stores t, which holds photons [cfg->mc.first, + traced) of ctx->cfg's reference, under
  * ctx->ref_cache (made if missing); a failure is said on stderr and is not the run's failure. */

@@ -477,11 +477,14 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     long long chunk = 0;
     if (ctx->ref_cache && cfg->mc.target_noise > 0 && ppb_mc_chunk(ctx, &chunk, err))
         return -1;
-    if (ctx->ref_cache && ppb_mc_cache_get(ctx, chunk, &t)) {
+    int shipped = 0;
+    ctx->mc_reference[0] = '\0';
+    if (ctx->ref_cache && ppb_mc_cache_get(ctx, chunk, &t, &shipped)) {
         /* The same reference was traced before (docs/external.md): no photon is traced now. */
         if (ctx->quiet < 2)
-            fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n",
-                    cfg->name, (unsigned long long)t.count, ctx->ref_cache);
+            fprintf(stderr, "%s: mc: %llu photons from the %s %s, 0 traced\n", cfg->name,
+                    (unsigned long long)t.count, shipped ? "shipped reference" : "reference cache",
+                    shipped ? ctx->mc_reference : ctx->ref_cache);
     } else {
         if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
             return -1;
