@@ -116,6 +116,12 @@ asan:
 bench: $(BIN)
 	@bash scripts/bench.sh $(if $(QUICK),--quick)
 
+# The shipped Monte Carlo references (references/<case>/) from the study `make bench` ran:
+# its cached tallies, compressed (docs/reference.md, "The reference cache").
+.PHONY: references
+references:
+	@bash scripts/references.sh
+
 perf: $(BIN)
 	@./ppbench perf
 

@@ -485,6 +485,14 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
             fprintf(stderr, "%s: mc: %llu photons from the %s %s, 0 traced\n", cfg->name,
                     (unsigned long long)t.count, shipped ? "shipped reference" : "reference cache",
                     shipped ? ctx->mc_reference : ctx->ref_cache);
+    } else if (getenv("PPBENCH_MC_NO_TRACE") && strcmp(getenv("PPBENCH_MC_NO_TRACE"), "1") == 0) {
+        /* study-score: a reference neither cached nor shipped is not traced unasked
+         * (docs/reference.md, "The reference cache"). */
+        return ppb_fail(err,
+                        "mc: no reference for this config in the cache (%s) nor the shipped "
+                        "layer (%s), and PPBENCH_MC_NO_TRACE=1: nothing traced (set "
+                        "PPBENCH_MC_NO_TRACE=0 to trace it)",
+                        ctx->ref_cache ? ctx->ref_cache : "none", ppb_mc_shipped_dir());
     } else {
         if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
             return -1;
