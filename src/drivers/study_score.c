@@ -18,6 +18,7 @@
 #include "base/progress.h"
 #include "drivers/report.h"
 #include "drivers/study_guard.h"
+#include "methods/registry.h"
 
 enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
 enum { MAX_CASES = 64, MAX_ARGS = 512 };
@@ -205,7 +206,8 @@ static int file_methods(const char *path, char *names, size_t cap, ppb_err *err)
             continue;
         char id[64];
         snprintf(id, sizeof id, "%.*s", (int)strcspn(line, ",\n"), line);
-        if (!id[0] || !strcmp(id, "mc") || !strcmp(id, "mc1"))
+        const ppb_method *ref = ppb_method_reference();
+        if (!id[0] || !strcmp(id, ref->id) || (ref->also && !strcmp(id, ref->also)))
             continue;
         char probe[80];
         snprintf(probe, sizeof probe, ",%s,", id);
@@ -419,7 +421,8 @@ int ppb_study_score_main(const ppb_study_score_opts *o)
             }
         }
         double tc = ppb_now();
-        if (push(&argv, "--set") || push(&argv, "experiment.methods=mc,%s", case_names) ||
+        if (push(&argv, "--set") ||
+            push(&argv, "experiment.methods=%s,%s", ppb_method_reference()->id, case_names) ||
             push(&argv, "--out") || push(&argv, "%s/%s", out, cases[c]) ||
             push(&argv, "%.4000s/configs/%s.ini", ppb_source_dir(), cases[c]))
             goto oom;
