@@ -267,7 +267,8 @@ int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const c
         if (ppb_result_init(r, ids[i], &lo, &err))
             goto done;
         n++;
-        if (ppb_external_read_radiance(radiance, ids[i], 1, &cfg.scene, r, &err) ||
+        if (ppb_external_read_radiance_on(radiance, ids[i], 1, &cfg.scene, PPB_SURFACES_FROM_ROWS,
+                                          r, &err) ||
             ppb_external_totals(beside, &cfg.scene, r, &err))
             goto done;
     }
