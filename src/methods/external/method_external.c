@@ -312,9 +312,10 @@ int ppb_external_totals(const char *path, const ppb_scene *sc, ppb_result *r, pp
         }
         found = 1;
         for (int k = 0; k < 5; k++)
-            if (parse_real(ppb_csv_get(&c, col[k]), dst[k]) || !isfinite(*dst[k])) {
-                ppb_fail(err, "%s:%ld: %s = '%s': not a finite number", path, c.line, names[k],
-                         ppb_csv_get(&c, col[k]));
+            /* nan: not computed (a partial method's own totals.csv, docs/external.md) */
+            if (parse_real(ppb_csv_get(&c, col[k]), dst[k]) || isinf(*dst[k])) {
+                ppb_fail(err, "%s:%ld: %s = '%s': not a number (nan: not computed)", path, c.line,
+                         names[k], ppb_csv_get(&c, col[k]));
                 goto done;
             }
     }
