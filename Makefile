@@ -94,6 +94,18 @@ unit: $(BIN) $(TESTS)
 test: layers methods-check docs unit
 	@bash tests/regress.sh
 
+# The researcher's loop: shipped references, the committed study's guard, score's radiance
+# check, partial external methods (tests/test_study_loop.sh, about 20 s); the newcomer's whole
+# path from a fresh clone (tests/test_newcomer.sh: a clone, its build, every study case scored).
+.PHONY: test-study-loop test-newcomer
+test: test-study-loop test-newcomer
+test-study-loop: $(BIN)
+	@mkdir -p $(BUILD)/tmp
+	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp bash tests/test_study_loop.sh
+test-newcomer:
+	@mkdir -p $(BUILD)/tmp
+	@PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp timeout 900 bash tests/test_newcomer.sh
+
 # The layer order is src/LAYERS; tests/test_layers.sh plants one violation of each rule.
 layers:
 	@bash scripts/check_layers.sh
