@@ -3,7 +3,8 @@
 # (docs/reference.md, "The reference cache": shipped references) from a study already run:
 # for every case (default: configs/study.list) the tally file its run loaded or stored
 # (DIR/<case>/provenance.txt's mc.reference, under make bench's cache), gzip-compressed into
-# OUT/<case>/mc-<key>.bin.gz, with OUT/<case>/provenance.txt saying what it is (photons, seed,
+# OUT/<case>/mc-<key>.bin.gz (<key>: its mc.shipped_key, the cache's key without the device, so
+# that every device is served: docs/reference.md, Keys), with OUT/<case>/provenance.txt saying what it is (photons, seed,
 # batches, version, commit, device, key). DIR defaults to results (what `make bench` wrote),
 # OUT to references. Refuses a case whose run was partial, traced no reference, or whose file
 # is gone; fails when the whole layer passes 30 MB. `make references` runs it.
@@ -28,7 +29,8 @@ for c in "${cases[@]}"; do
   [ -n "$src" ] || { echo "references.sh: $c: $p names no mc.reference (a run without the reference cache)" >&2; exit 1; }
   [ -f "$src" ] || { echo "references.sh: $c: $src (its mc.reference) is gone" >&2; exit 1; }
   [ "$(val "$p" partial)" = 0 ] || { echo "references.sh: $c: $p is a partial run" >&2; exit 1; }
-  name=$(basename "$src"); name=${name%.gz}
+  name=$(val "$p" mc.shipped_key)
+  [ -n "$name" ] || { echo "references.sh: $c: $p names no mc.shipped_key (an older ppbench's run)" >&2; exit 1; }
   rm -rf "$out/$c.tmp" && mkdir -p "$out/$c.tmp"
   if [ "${src%.gz}" != "$src" ]; then cp "$src" "$out/$c.tmp/$name.gz"; else gzip -9 -n -c "$src" > "$out/$c.tmp/$name.gz"; fi
   {
@@ -36,6 +38,7 @@ for c in "${cases[@]}"; do
     echo "case = $c"
     echo "file = $name.gz"
     echo "key = ${name#mc-}" | sed 's/\.bin$//'
+    echo "cache_file = $(basename "${src%.gz}")"
     for k in mc.photons mc.seed mc.batches mc.first mc.target_noise ppbench.version ppbench.commit device opencl.driver_version date; do
       echo "$k = $(val "$p" "$k")"
     done

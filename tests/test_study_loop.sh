@@ -2,7 +2,8 @@
 # test_study_loop.sh: the researcher's loop (docs/external.md, "Scoring on the whole study";
 # docs/reference.md, "The reference cache", Outputs). On a tiny tube (8 + 3 segments, 2 x 2 bins,
 # 2e4 photons, as tests/test_external.c's tiny), each expectation from the rule it checks:
-#  1. shipped references: a run with an empty user cache is served from the shipped layer
+#  1. shipped references (named by mc.shipped_key, the cache's key without the device): a run
+#     with an empty user cache is served from the shipped layer
 #     (scripts/references.sh's output) with zero photons traced (provenance.txt has no
 #     mc.photons_traced; stderr says "from the shipped reference"); a changed key (another seed)
 #     is not served (PPBENCH_MC_NO_TRACE=1: the run fails, exit 1, nothing traced); a file under
@@ -41,7 +42,11 @@ unset PPBENCH_MC_NO_TRACE PPB_BENCH_STUDY
 "$ppb" run --quiet --ref-cache "$t/cache" --out "$t/gen/tiny" "$t/tiny.ini"
 grep -q '^mc.photons_traced = 20000$' "$t/gen/tiny/provenance.txt" || fail "the first run traced"
 grep -q "^mc.reference = $t/cache/mc-" "$t/gen/tiny/provenance.txt" || fail "no mc.reference"
+# The shipped name is the key without the device (mc.shipped_key), not the cache's.
+key=$(sed -n 's/^mc.shipped_key = //p' "$t/gen/tiny/provenance.txt")
+[ -n "$key" ] && [ "$key" != "$(basename "$(ls "$t"/cache/mc-*.bin)")" ] || fail "mc.shipped_key: '$key'"
 bash scripts/references.sh --from "$t/gen" --out "$t/refs" tiny 2> /dev/null
+[ -f "$t/refs/tiny/$key.gz" ] || fail "references.sh did not name the file by mc.shipped_key"
 ls "$t"/refs/tiny/mc-*.bin.gz > /dev/null || fail "references.sh wrote no mc-<key>.bin.gz"
 grep -q '^mc.photons = 20000$' "$t/refs/tiny/provenance.txt" || fail "shipped provenance"
 export PPBENCH_REFERENCES=$t/refs

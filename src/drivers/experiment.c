@@ -133,6 +133,7 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
                     cfg->methods[i]);
     }
     snprintf(ex->mc_reference, sizeof ex->mc_reference, "%s", ctx->mc_reference);
+    snprintf(ex->mc_shipped_key, sizeof ex->mc_shipped_key, "%s", ctx->mc_shipped_key);
     if (ctx->ocl_open) {
         snprintf(ex->device, sizeof ex->device, "%s", ctx->ocl.name);
         ppb_ocl_versions_get(&ctx->ocl, &ex->ocl_versions);
@@ -235,6 +236,8 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, const ppb
         fprintf(af.f, "%s.seconds = %.4f\n", ex->res[i].method, ex->seconds[i]);
     if (ex->mc_reference[0]) /* docs/reference.md, "The reference cache" */
         fprintf(af.f, "mc.reference = %s\n", ex->mc_reference);
+    if (ex->mc_shipped_key[0])
+        fprintf(af.f, "mc.shipped_key = %s\n", ex->mc_shipped_key);
     /* radiance.csv's hash: score refuses a radiance.csv that is not this set's (Outputs) */
     char rpath[PPB_PATH_MAX + 256];
     out_path(dir, "radiance.csv", rpath, sizeof rpath);

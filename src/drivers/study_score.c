@@ -295,16 +295,11 @@ static void prov_value(const char *path, const char *key, char *buf, size_t cap)
     fclose(f);
 }
 
-/* mc-<key>.bin of a provenance's mc.reference (the cache's or the shipped file), "" if none. */
+/* The reference's key of a provenance.txt (mc.shipped_key: every config key, the kernel
+ * source; not the device), "" if none. */
 static void reference_key(const char *prov, char *buf, size_t cap)
 {
-    char v[PPB_PATH_MAX];
-    prov_value(prov, "mc.reference", v, sizeof v);
-    const char *base = strrchr(v, '/');
-    snprintf(buf, cap, "%.200s", base ? base + 1 : v);
-    size_t n = strlen(buf);
-    if (n > 3 && strcmp(buf + n - 3, ".gz") == 0)
-        buf[n - 3] = '\0';
+    prov_value(prov, "mc.shipped_key", buf, cap);
 }
 
 /* Appends to case_dir/file the rows of study_dir/file whose method is not in case_dir/file. */

@@ -31,11 +31,12 @@ static int device_hash(ppb_run_ctx *ctx, uint64_t *h, ppb_err *err)
  * in table order, so a key added to the table joins the key by its flag alone; the photons per
  * launch when a target noise stops the trace between launches; the kernel's source and the
  * device. */
-static int key_text(ppb_run_ctx *ctx, long long chunk, FILE *f, ppb_err *err)
+static int key_text(ppb_run_ctx *ctx, long long chunk, int with_device, FILE *f, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
-    uint64_t source, device;
-    if (ppb_ocl_source_hash(PPB_MC_KERNEL, &source, err) || device_hash(ctx, &device, err))
+    uint64_t source, device = 0;
+    if (ppb_ocl_source_hash(PPB_MC_KERNEL, &source, err) ||
+        (with_device && device_hash(ctx, &device, err)))
         return -1;
     fprintf(f, "ppbench mc reference %d\n", PPB_MC_CACHE_VERSION);
     for (int k = 0; k < ppb_config_nkeys(); k++) {
@@ -51,9 +52,28 @@ static int key_text(ppb_run_ctx *ctx, long long chunk, FILE *f, ppb_err *err)
     }
     if (cfg->mc.target_noise > 0)
         fprintf(f, "photons per launch = %lld\n", chunk);
-    fprintf(f, "kernel = %016llx\ndevice = %016llx\n", (unsigned long long)source,
-            (unsigned long long)device);
+    fprintf(f, "kernel = %016llx\n", (unsigned long long)source);
+    if (with_device)
+        fprintf(f, "device = %016llx\n", (unsigned long long)device);
     return 0;
+}
+
+/* The key's file name, mc-<key>.bin: with_device 1 for the cache, 0 for the shipped layer. */
+static int key_name(ppb_run_ctx *ctx, long long chunk, int with_device, char *buf, size_t cap,
+                    ppb_err *err)
+{
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    if (!f)
+        return ppb_fail(err, "mc: reference cache: out of memory");
+    int status = key_text(ctx, chunk, with_device, f, err);
+    if (fclose(f) && status == 0)
+        status = ppb_fail(err, "mc: reference cache: out of memory");
+    if (status == 0)
+        snprintf(buf, cap, "mc-%016llx.bin", (unsigned long long)ppb_hash64(text, len));
+    free(text);
+    return status;
 }
 
 int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, ppb_err *err)
@@ -63,7 +83,7 @@ int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, 
     FILE *f = open_memstream(&text, &len);
     if (!f)
         return ppb_fail(err, "mc: reference cache: out of memory");
-    int status = key_text(ctx, chunk, f, err);
+    int status = key_text(ctx, chunk, 1, f, err);
     if (fclose(f) && status == 0)
         status = ppb_fail(err, "mc: reference cache: out of memory");
     if (status == 0)
@@ -156,6 +176,14 @@ static int shipped_find(const char *name, char *buf, size_t cap)
     return found;
 }
 
+void ppb_mc_cache_note_key(ppb_run_ctx *ctx, long long chunk)
+{
+    ppb_err err = {{0}};
+    if (!ctx->ref_cache ||
+        key_name(ctx, chunk, 0, ctx->mc_shipped_key, sizeof ctx->mc_shipped_key, &err))
+        ctx->mc_shipped_key[0] = '\0';
+}
+
 int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *shipped)
 {
     const ppb_config *cfg = ctx->cfg;
@@ -174,11 +202,14 @@ int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *
         *t = c;
         return 1;
     }
-    /* The shipped layer, under the same key: a file there of another key is never looked at. */
-    const char *slash = strrchr(path, '/');
-    char ship[PPB_PATH_MAX + 128];
-    if (shipped_find(slash ? slash + 1 : path, ship, sizeof ship) &&
-        load_checked(ctx, ship, 1, &c)) {
+    /* The shipped layer, under the same key but the device's (mc_cache.h): a file there of
+     * another key is never looked at. */
+    char name[64], ship[PPB_PATH_MAX + 128];
+    if (key_name(ctx, chunk, 0, name, sizeof name, &err)) {
+        fprintf(stderr, "%s: mc: shipped references: %s: not used\n", cfg->name, err.msg);
+        return 0;
+    }
+    if (shipped_find(name, ship, sizeof ship) && load_checked(ctx, ship, 1, &c)) {
         snprintf(ctx->mc_reference, sizeof ctx->mc_reference, "%.4150s", ship);
         *shipped = 1;
         *t = c;

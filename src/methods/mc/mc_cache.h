@@ -16,11 +16,14 @@
  * batches and photon range (a stale or damaged file is a miss, never a wrong reference).
  * Interrupted traces are never stored. The directory is ctx->ref_cache; NULL: no cache.
  *
- * The shipped layer (docs/reference.md, "The reference cache": shipped references): a read-only
- * directory, $PPBENCH_REFERENCES or else <source tree>/references, holding <case>/mc-<key>.bin.gz
- * (the same file, gzip-compressed), consulted after a miss in ctx->ref_cache under the same key
- * and the same header checks; never written by a run, and not consulted without a cache (tests
- * run with none, so they trace). */
+ * The shipped layer (docs/reference.md, Keys: shipped references): a read-only directory,
+ * $PPBENCH_REFERENCES or else <source tree>/references, holding <case>/mc-<key>.bin.gz (a tally
+ * file, gzip-compressed), consulted after a miss in ctx->ref_cache under the same header checks
+ * and the same key but for the device line: the key text without the device and driver, so a
+ * reference the repository ships serves every device (two devices agree within the reference's
+ * noise, which every metric states, not bit for bit; the shipped provenance.txt names the device
+ * it was traced on). Never written by a run, and not consulted without a cache (tests run with
+ * none, so they trace). */
 #ifndef PPB_MC_CACHE_H
 #define PPB_MC_CACHE_H
 
@@ -42,6 +45,11 @@ int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, 
  * identified. On a hit ctx->mc_reference names the file and *shipped is 1 when it came from the
  * shipped layer. */
 int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *shipped);
+
+/* Sets ctx->mc_shipped_key to the shipped layer's file name of ctx->cfg's reference
+ * (mc-<key>.bin, the key without the device), "" without a cache or when it cannot be made;
+ * provenance.txt records it (mc.shipped_key) and scripts/references.sh names the file by it. */
+void ppb_mc_cache_note_key(ppb_run_ctx *ctx, long long chunk);
 
 /* The shipped layer's directory: $PPBENCH_REFERENCES, else <source tree>/references. */
 const char *ppb_mc_shipped_dir(void);

@@ -479,6 +479,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         return -1;
     int shipped = 0;
     ctx->mc_reference[0] = '\0';
+    ppb_mc_cache_note_key(ctx, chunk);
     if (ctx->ref_cache && ppb_mc_cache_get(ctx, chunk, &t, &shipped)) {
         /* The same reference was traced before (docs/external.md): no photon is traced now. */
         if (ctx->quiet < 2)
