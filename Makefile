@@ -4,7 +4,7 @@
 # root, otherwise says which command to run).
 CC      ?= gcc
 BUILD   ?= build
-PKGS    := OpenCL lapacke openblas OpenEXR libpng inih libxxhash jansson zlib
+PKGS    := OpenCL lapacke openblas OpenEXR libpng inih libxxhash jansson liblzma
 OPT     ?= -O2 -g
 WARN    := -Wall -Wextra $(if $(WERROR),-Werror)
 SAN     ?=

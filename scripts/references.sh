@@ -2,8 +2,8 @@
 # references.sh [--from DIR] [--out DIR] [CASE...]: the shipped Monte Carlo references
 # (docs/reference.md, "The reference cache": shipped references) from a study already run:
 # for every case (default: configs/study.list) the tally file its run loaded or stored
-# (DIR/<case>/provenance.txt's mc.reference, under make bench's cache), gzip-compressed into
-# OUT/<case>/mc-<key>.bin.gz (<key>: its mc.shipped_key, the cache's key without the device, so
+# (DIR/<case>/provenance.txt's mc.reference, under make bench's cache), xz-compressed into
+# OUT/<case>/mc-<key>.bin.xz (<key>: its mc.shipped_key, the cache's key without the device, so
 # that every device is served: docs/reference.md, Keys), with OUT/<case>/provenance.txt saying what it is (photons, seed,
 # batches, version, commit, device, key). DIR defaults to results (what `make bench` wrote),
 # OUT to references. Refuses a case whose run was partial, traced no reference, or whose file
@@ -32,21 +32,22 @@ for c in "${cases[@]}"; do
   name=$(val "$p" mc.shipped_key)
   [ -n "$name" ] || { echo "references.sh: $c: $p names no mc.shipped_key (an older ppbench's run)" >&2; exit 1; }
   rm -rf "$out/$c.tmp" && mkdir -p "$out/$c.tmp"
-  if [ "${src%.gz}" != "$src" ]; then cp "$src" "$out/$c.tmp/$name.gz"; else gzip -9 -n -c "$src" > "$out/$c.tmp/$name.gz"; fi
+  # a case served from the shipped layer itself (mc.reference ends .xz) is copied as it is
+  if [ "${src%.xz}" != "$src" ]; then cp "$src" "$out/$c.tmp/$name.xz"; else xz -9e -T1 -c "$src" > "$out/$c.tmp/$name.xz"; fi
   {
     echo "# ppbench shipped reference: the Monte Carlo tallies (mc and mc1) of case $c"
     echo "case = $c"
-    echo "file = $name.gz"
+    echo "file = $name.xz"
     echo "key = ${name#mc-}" | sed 's/\.bin$//'
-    echo "cache_file = $(basename "${src%.gz}")"
+    echo "cache_file = $(basename "${src%.xz}")"
     for k in mc.photons mc.seed mc.batches mc.first mc.target_noise ppbench.version ppbench.commit device opencl.driver_version date; do
       echo "$k = $(val "$p" "$k")"
     done
     echo "source = $src"
   } > "$out/$c.tmp/provenance.txt"
   rm -rf "$out/$c" && mv "$out/$c.tmp" "$out/$c"
-  printf '%s: %s (%s bytes)\n' "$c" "$out/$c/$name.gz" "$(stat -c %s "$out/$c/$name.gz")" >&2
+  printf '%s: %s (%s bytes)\n' "$c" "$out/$c/$name.xz" "$(stat -c %s "$out/$c/$name.xz")" >&2
 done
-total=$(du -cb "$out"/*/mc-*.bin.gz | tail -1 | cut -f1)
+total=$(du -cb "$out"/*/mc-*.bin.xz | tail -1 | cut -f1)
 printf 'references.sh: %s holds %s bytes of references\n' "$out" "$total" >&2
 [ "$total" -le $((30 * 1024 * 1024)) ] || { echo "references.sh: over 30 MB" >&2; exit 1; }

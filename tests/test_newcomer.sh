@@ -46,7 +46,7 @@ grep -q 'study-score: 11 of 11 cases scored in .* 0 photons traced' "$t/score.er
 while read -r c; do
   p=$t/score/$c/provenance.txt
   ! grep -q photons_traced "$p" || fail "$c: photons traced"
-  grep -q "^mc.reference = $t/clone/references/$c/mc-.*\.bin\.gz$" "$p" || fail "$c: not shipped"
+  grep -q "^mc.reference = $t/clone/references/$c/mc-.*\.bin\.xz$" "$p" || fail "$c: not shipped"
   grep -q '^dipole_py,R_x0,[0-9]' "$t/score/$c/summary.csv" || fail "$c: no R_x0 score"
   grep -q '^dipole_py,S2_all,nan,nan,nan$' "$t/score/$c/summary.csv" || fail "$c: S2 not nan"
 done < configs/study.list

@@ -46,8 +46,8 @@ grep -q "^mc.reference = $t/cache/mc-" "$t/gen/tiny/provenance.txt" || fail "no 
 key=$(sed -n 's/^mc.shipped_key = //p' "$t/gen/tiny/provenance.txt")
 [ -n "$key" ] && [ "$key" != "$(basename "$(ls "$t"/cache/mc-*.bin)")" ] || fail "mc.shipped_key: '$key'"
 bash scripts/references.sh --from "$t/gen" --out "$t/refs" tiny 2> /dev/null
-[ -f "$t/refs/tiny/$key.gz" ] || fail "references.sh did not name the file by mc.shipped_key"
-ls "$t"/refs/tiny/mc-*.bin.gz > /dev/null || fail "references.sh wrote no mc-<key>.bin.gz"
+[ -f "$t/refs/tiny/$key.xz" ] || fail "references.sh did not name the file by mc.shipped_key"
+ls "$t"/refs/tiny/mc-*.bin.xz > /dev/null || fail "references.sh wrote no mc-<key>.bin.xz"
 grep -q '^mc.photons = 20000$' "$t/refs/tiny/provenance.txt" || fail "shipped provenance"
 export PPBENCH_REFERENCES=$t/refs
 PPBENCH_MC_NO_TRACE=1 "$ppb" run --ref-cache "$t/empty" --out "$t/a" "$t/tiny.ini" 2> "$t/a.err" \
@@ -66,13 +66,19 @@ PPBENCH_MC_NO_TRACE=1 "$ppb" run --quiet --set mc.seed=2 --ref-cache "$t/empty" 
 pass "a changed key is not served"
 # Another reference (seed 2) under the seed-1 key's name: its header is checked, not trusted.
 "$ppb" run --quiet --set mc.seed=2 --ref-cache "$t/cache2" --out "$t/c" "$t/tiny.ini"
-shipped=$(ls "$t"/refs/tiny/mc-*.bin.gz)
-gzip -n -c "$t"/cache2/mc-*.bin > "$shipped"
+shipped=$(ls "$t"/refs/tiny/mc-*.bin.xz)
+xz -c "$t"/cache2/mc-*.bin > "$shipped"
 rc=0
 PPBENCH_MC_NO_TRACE=1 "$ppb" run --quiet --ref-cache "$t/empty" --out "$t/d" "$t/tiny.ini" \
   2> "$t/d.err" || rc=$?
 [ $rc = 1 ] && grep -q 'holds another reference: not used' "$t/d.err" || fail "a wrong file used (rc $rc)"
 pass "a file of another reference under the key's name is not used"
+head -c 1000 "$t"/cache2/mc-*.bin | xz -c | head -c 300 > "$shipped" # a truncated file
+rc=0
+PPBENCH_MC_NO_TRACE=1 "$ppb" run --quiet --ref-cache "$t/empty" --out "$t/e" "$t/tiny.ini" \
+  2> "$t/e.err" || rc=$?
+[ $rc = 1 ] && grep -q 'cannot be decompressed: not used' "$t/e.err" || fail "a damaged file used (rc $rc)"
+pass "a damaged shipped file is not used"
 unset PPBENCH_REFERENCES
 
 # 2. The committed study: a source tree of our own (PPBENCH_SOURCE) with results/tiny.

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 #include <glob.h>
-#include <zlib.h>
+#include <lzma.h>
 
 #include "base/atomic_file.h"
 #include "base/hash.h"
@@ -108,28 +108,59 @@ const char *ppb_mc_shipped_dir(void)
     return buf;
 }
 
-/* Loads path (a tally file, or one gzip-compressed when gz) into an uninitialised c, and checks
+/* Decompresses the xz file at path into out: 0, or -1 when it cannot be read or is not whole. */
+static int unxz(const char *path, FILE *out)
+{
+    FILE *in = fopen(path, "rb");
+    if (!in)
+        return -1;
+    lzma_stream z = LZMA_STREAM_INIT;
+    if (lzma_stream_decoder(&z, UINT64_MAX, 0) != LZMA_OK) {
+        fclose(in);
+        return -1;
+    }
+    static uint8_t ibuf[1 << 16], obuf[1 << 16];
+    lzma_ret r = LZMA_OK;
+    lzma_action action = LZMA_RUN;
+    z.next_out = obuf;
+    z.avail_out = sizeof obuf;
+    while (r == LZMA_OK) {
+        if (z.avail_in == 0 && action == LZMA_RUN) {
+            z.next_in = ibuf;
+            z.avail_in = fread(ibuf, 1, sizeof ibuf, in);
+            if (ferror(in))
+                break;
+            if (feof(in))
+                action = LZMA_FINISH;
+        }
+        r = lzma_code(&z, action);
+        if (z.avail_out == 0 || r == LZMA_STREAM_END) {
+            size_t n = sizeof obuf - z.avail_out;
+            if (fwrite(obuf, 1, n, out) != n)
+                r = LZMA_BUF_ERROR;
+            z.next_out = obuf;
+            z.avail_out = sizeof obuf;
+        }
+    }
+    lzma_end(&z);
+    fclose(in);
+    return r == LZMA_STREAM_END ? 0 : -1;
+}
+
+/* Loads path (a tally file, or one xz-compressed when xz) into an uninitialised c, and checks
  * its header against the run: 1 when it is this run's reference, 0 when not (said on stderr). */
-static int load_checked(ppb_run_ctx *ctx, const char *path, int gz, ppb_mc_tallies *c)
+static int load_checked(ppb_run_ctx *ctx, const char *path, int xz, ppb_mc_tallies *c)
 {
     const ppb_config *cfg = ctx->cfg;
     ppb_err err = {{0}};
     char plain[PPB_PATH_MAX + 64];
     snprintf(plain, sizeof plain, "%s", path);
-    if (gz) { /* inflated into a temporary file that mc_tally.c's reader checks as any other */
+    if (xz) { /* decompressed into a temporary file that mc_tally.c's reader checks as any other */
         const char *tmp = getenv("TMPDIR");
         snprintf(plain, sizeof plain, "%.4000s/ppbench-ref-XXXXXX", tmp && *tmp ? tmp : "/tmp");
         int fd = mkstemp(plain);
-        gzFile in = fd < 0 ? NULL : gzopen(path, "rb");
-        FILE *out = in ? fdopen(fd, "wb") : NULL;
-        int ok = out != NULL;
-        char buf[1 << 16];
-        int n;
-        while (ok && (n = gzread(in, buf, sizeof buf)) > 0)
-            ok = fwrite(buf, 1, (size_t)n, out) == (size_t)n;
-        ok = ok && n == 0;
-        if (in)
-            gzclose(in);
+        FILE *out = fd < 0 ? NULL : fdopen(fd, "wb");
+        int ok = out && unxz(path, out) == 0;
         if (out)
             ok = fclose(out) == 0 && ok;
         else if (fd >= 0)
@@ -137,13 +168,13 @@ static int load_checked(ppb_run_ctx *ctx, const char *path, int gz, ppb_mc_talli
         if (!ok) {
             if (fd >= 0)
                 unlink(plain);
-            fprintf(stderr, "%s: mc: shipped reference %s: cannot be inflated: not used\n",
+            fprintf(stderr, "%s: mc: shipped reference %s: cannot be decompressed: not used\n",
                     cfg->name, path);
             return 0;
         }
     }
     int rc = ppb_mc_tallies_load(c, plain, &err);
-    if (gz)
+    if (xz)
         unlink(plain);
     if (rc) {
         fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
@@ -163,11 +194,11 @@ static int load_checked(ppb_run_ctx *ctx, const char *path, int gz, ppb_mc_talli
 }
 
 /* The shipped layer's file for the key file name `name` (mc-<key>.bin): the first
- * <shipped>/<case>/<name>.gz that exists, in glob order. */
+ * <shipped>/<case>/<name>.xz that exists, in glob order. */
 static int shipped_find(const char *name, char *buf, size_t cap)
 {
     char pattern[PPB_PATH_MAX + 128];
-    snprintf(pattern, sizeof pattern, "%.4000s/*/%.64s.gz", ppb_mc_shipped_dir(), name);
+    snprintf(pattern, sizeof pattern, "%.4000s/*/%.64s.xz", ppb_mc_shipped_dir(), name);
     glob_t g;
     int found = glob(pattern, 0, NULL, &g) == 0 && g.gl_pathc > 0;
     if (found)

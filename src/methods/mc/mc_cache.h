@@ -17,8 +17,8 @@
  * Interrupted traces are never stored. The directory is ctx->ref_cache; NULL: no cache.
  *
  * The shipped layer (docs/reference.md, Keys: shipped references): a read-only directory,
- * $PPBENCH_REFERENCES or else <source tree>/references, holding <case>/mc-<key>.bin.gz (a tally
- * file, gzip-compressed), consulted after a miss in ctx->ref_cache under the same header checks
+ * $PPBENCH_REFERENCES or else <source tree>/references, holding <case>/mc-<key>.bin.xz (a tally
+ * file, xz-compressed), consulted after a miss in ctx->ref_cache under the same header checks
  * and the same key but for the device line: the key text without the device and driver, so a
  * reference the repository ships serves every device (two devices agree within the reference's
  * noise, which every metric states, not bit for bit; the shipped provenance.txt names the device
