@@ -177,7 +177,11 @@ static int load_checked(ppb_run_ctx *ctx, const char *path, int xz, ppb_mc_talli
     if (xz)
         unlink(plain);
     if (rc) {
-        fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
+        if (xz)
+            fprintf(stderr, "%s: mc: shipped reference %s: %s: not used\n", cfg->name, path,
+                    err.msg);
+        else
+            fprintf(stderr, "%s: mc: reference cache: %s: not used\n", cfg->name, err.msg);
         return 0;
     }
     int full = cfg->mc.target_noise > 0 || c->count == (uint64_t)cfg->mc.photons;
