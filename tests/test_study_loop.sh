@@ -8,8 +8,9 @@
 #     mc.photons_traced; stderr says "from the shipped reference"); a changed key (another seed)
 #     is not served (PPBENCH_MC_NO_TRACE=1: the run fails, exit 1, nothing traced); a file under
 #     the right key name holding another reference is refused by its header, never used;
-#  2. the committed study: a run whose output is <source>/results/<case> is refused (exit 2,
-#     "give --out") without bench.sh's marker, and runs with it (PPB_BENCH_STUDY=1);
+#  2. the committed study: a run whose output is <source>/results/<case> (a case of
+#     configs/study.list) is refused (exit 2, "give --out") without bench.sh's marker, and runs
+#     with it (PPB_BENCH_STUDY=1); results/<name> of a config not in the study is not guarded;
 #  3. score: a radiance.csv that is not the one provenance.txt's radiance.xxh64 records is
 #     refused (exit 2);
 #  4. external methods: {name} is the section's NAME; surfaces = S1 leaves S2..S4 not computed
@@ -83,7 +84,8 @@ unset PPBENCH_REFERENCES
 
 # 2. The committed study: a source tree of our own (PPBENCH_SOURCE) with results/tiny.
 src=$t/src
-mkdir -p "$src/results/tiny"
+mkdir -p "$src/results/tiny" "$src/configs"
+echo tiny > "$src/configs/study.list"
 ln -s "$PWD/kernels" "$src/kernels"
 ln -s "$PWD/src" "$src/src"
 rc=0
@@ -97,6 +99,8 @@ rc=0
 [ -z "$(ls "$src/results/tiny")" ] || fail "results/tiny was touched"
 PPB_BENCH_STUDY=1 PPBENCH_SOURCE=$src "$ppb" run --quiet --no-ref-cache --out "$src/results/tiny" \
   "$t/tiny.ini" || fail "make bench's marker did not let it write"
+PPBENCH_SOURCE=$src "$ppb" run --quiet --no-ref-cache --out "$src/results/other" "$t/tiny.ini" \
+  || fail "results/other (not a study case) was refused"
 pass "results/<case> is make bench's alone"
 
 # 3. score: a radiance.csv its provenance does not record.

@@ -934,7 +934,7 @@ static void usage(FILE *out)
     fprintf(out,
             "\n"
             "examples:\n"
-            "  ppbench run configs/uniform_g0_normal.ini\n"
+            "  ppbench run --out /tmp/g0 configs/uniform_g0_normal.ini\n"
             "  ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini\n"
             "  ppbench sweep --shard 2/3 configs/sweep_example.ini\n"
             "  PPBENCH_DEVICE=pthread ppbench devices\n"

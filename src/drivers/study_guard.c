@@ -36,6 +36,29 @@ static int real_parent(const char *path, char *buf)
     return realpath(copy, buf) ? 0 : -1;
 }
 
+/* Whether the last component of path is a case of <source>/configs/study.list. */
+static int study_case(const char *path)
+{
+    char name[256], list[PPB_PATH_MAX + 32], line[256];
+    size_t n = strlen(path);
+    while (n > 1 && path[n - 1] == '/')
+        n--;
+    size_t b = n;
+    while (b > 0 && path[b - 1] != '/')
+        b--;
+    snprintf(name, sizeof name, "%.*s", (int)(n - b), path + b);
+    snprintf(list, sizeof list, "%.4000s/configs/study.list", ppb_source_dir());
+    FILE *f = fopen(list, "r");
+    int found = 0;
+    while (f && !found && fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\r\n")] = '\0';
+        found = line[0] && strcmp(line, name) == 0;
+    }
+    if (f)
+        fclose(f);
+    return found;
+}
+
 int ppb_study_guard(const char *out_dir, ppb_err *err)
 {
     const char *mark = getenv("PPB_BENCH_STUDY");
@@ -45,8 +68,9 @@ int ppb_study_guard(const char *out_dir, ppb_err *err)
     snprintf(results, sizeof results, "%.4000s/results", ppb_source_dir());
     if (!realpath(results, real))
         return 0; /* no committed study here */
-    int is_study = (realpath(out_dir, self) && strcmp(self, real) == 0) ||
-                   (real_parent(out_dir, parent) == 0 && strcmp(parent, real) == 0);
+    int is_study =
+        (realpath(out_dir, self) && strcmp(self, real) == 0) ||
+        (real_parent(out_dir, parent) == 0 && strcmp(parent, real) == 0 && study_case(out_dir));
     if (!is_study)
         return 0;
     return ppb_fail(err,
