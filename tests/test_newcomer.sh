@@ -8,7 +8,9 @@
 # configs/study.list by one `ppbench study-score` with an empty user cache. Asserted: every case
 # scored with zero photons traced (no mc.photons_traced in any case's provenance.txt, its
 # mc.reference in the clone's references/), the report written (README.md, table2.md naming
-# dipole_py), S2..S4 not computed (nan). The scoring's wall time is printed, not asserted
+# dipole_py), S2..S4 not computed (nan), and the committed study's rows of a built-in method (ss,
+# written into the clone's results/uniform_g0_normal at the same budget) beside it in that case
+# only (the other cases' committed sets were made against the 4e8-photon reference). The scoring's wall time is printed, not asserted
 # (machines are noisy); the brief's bound is 60 s.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -27,6 +29,11 @@ while read -r c; do
   ./ppbench run --quiet --ref-cache "$t/gencache" --set experiment.methods=mc \
     --set mc.photons=2e4 --out "$t/gen/$c" "configs/$c.ini"
 done < configs/study.list
+# One case of the committed study at the same budget, with a built-in method (ss), as make bench
+# would write it: study-score shows its rows beside the new method's (the same mc.shipped_key).
+PPB_BENCH_STUDY=1 ./ppbench run --quiet --ref-cache "$t/gencache" --set experiment.methods=mc,ss \
+  --set mc.photons=2e4 --set pp.directions=16 --out results/uniform_g0_normal \
+  configs/uniform_g0_normal.ini
 bash scripts/references.sh --from "$t/gen" 2> "$t/refs.log" || { cat "$t/refs.log"; fail "references.sh"; }
 echo "test_newcomer: shipped layer of $(wc -l < configs/study.list) cases made in $(( $(date +%s) - t0 )) s: $(tail -1 "$t/refs.log")"
 # The newcomer: an empty user cache, the example method, one command.
@@ -51,6 +58,8 @@ while read -r c; do
   grep -q '^dipole_py,S2_all,nan,nan,nan$' "$t/score/$c/summary.csv" || fail "$c: S2 not nan"
 done < configs/study.list
 grep -q dipole_py "$t/score/table2.md" || fail "table2.md has no dipole_py"
+grep -q '^ss,R_x0,' "$t/score/uniform_g0_normal/summary.csv" || fail "the committed ss not beside"
+! grep -q '^ss,' "$t/score/density_step/summary.csv" || fail "ss added where results/ has another reference"
 [ -s "$t/score/README.md" ] || fail "no README.md"
 [ -z "$(ls -A "$t/usercache" 2> /dev/null)" ] || fail "the user cache was written"
 echo "test_newcomer: every study case scored with 0 photons traced in $secs s (bound: 60 s)"
