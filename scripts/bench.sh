@@ -68,3 +68,5 @@ fi
 bash scripts/summary_plot.sh "$out" "${cases[@]}"
 ./ppbench report "$out" "${cases[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2
+# The shipped references (references/<case>/, docs/reference.md: Keys) come from this study's
+# cache by `make references` (scripts/references.sh), run after a full bench.
