@@ -219,12 +219,12 @@ void ppb_mc_cache_note_key(ppb_run_ctx *ctx, long long chunk)
         ctx->mc_shipped_key[0] = '\0';
 }
 
-int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *shipped)
+int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t)
 {
     const ppb_config *cfg = ctx->cfg;
     char path[PPB_PATH_MAX + 64];
     ppb_err err = {{0}};
-    *shipped = 0;
+    ctx->mc_reference_shipped = 0;
     if (!ctx->ref_cache)
         return 0;
     if (ppb_mc_cache_path(ctx, chunk, path, sizeof path, &err)) {
@@ -246,7 +246,7 @@ int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *
     }
     if (shipped_find(name, ship, sizeof ship) && load_checked(ctx, ship, 1, &c)) {
         snprintf(ctx->mc_reference, sizeof ctx->mc_reference, "%.4150s", ship);
-        *shipped = 1;
+        ctx->mc_reference_shipped = 1;
         *t = c;
         return 1;
     }

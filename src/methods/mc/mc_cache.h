@@ -42,9 +42,9 @@ int ppb_mc_cache_path(ppb_run_ctx *ctx, long long chunk, char *buf, size_t cap, 
 /* Loads ctx->cfg's reference from ctx->ref_cache, else from the shipped layer, into an
  * uninitialised t: 1 when found, 0 when not (t then untouched); a file that exists but cannot be
  * used is said on stderr and counts as a miss, as does a kernel source or device that cannot be
- * identified. On a hit ctx->mc_reference names the file and *shipped is 1 when it came from the
- * shipped layer. */
-int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t, int *shipped);
+ * identified. On a hit ctx->mc_reference names the file and ctx->mc_reference_shipped is 1 when
+ * it came from the shipped layer. */
+int ppb_mc_cache_get(ppb_run_ctx *ctx, long long chunk, ppb_mc_tallies *t);
 
 /* Sets ctx->mc_shipped_key to the shipped layer's file name of ctx->cfg's reference
  * (mc-<key>.bin, the key without the device), "" without a cache or when it cannot be made;
