@@ -10,7 +10,8 @@
 # mc.reference in the clone's references/), the report written (README.md, table2.md naming
 # dipole_py), S2..S4 not computed (nan), and the committed study's rows of a built-in method (ss,
 # written into the clone's results/uniform_g0_normal at the same budget) beside it in that case
-# only (the other cases' committed sets were made against the 4e8-photon reference). The scoring's wall time is printed, not asserted
+# only (the other cases' committed sets were made against the 4e8-photon reference); then the
+# same files scored again by --radiance-dir give the same summary rows. The scoring's wall time is printed, not asserted
 # (machines are noisy); the brief's bound is 60 s.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -63,4 +64,13 @@ grep -q '^ss,R_x0,' "$t/score/uniform_g0_normal/summary.csv" || fail "the commit
 [ -s "$t/score/README.md" ] || fail "no README.md"
 [ -z "$(ls -A "$t/usercache" 2> /dev/null)" ] || fail "the user cache was written"
 echo "test_newcomer: every study case scored with 0 photons traced in $secs s (bound: 60 s)"
+# The same radiance files scored as files made elsewhere (--radiance-dir DIR: DIR/<case>/
+# radiance.csv): the surfaces come from the rows, and the scores are the run's own.
+./ppbench study-score --quiet --set mc.photons=2e4 --radiance-dir "$t/score" --out "$t/rd" \
+  2> "$t/rd.err" || { cat "$t/rd.err"; fail "study-score --radiance-dir failed"; }
+while read -r c; do
+  cmp <(grep '^dipole_py,' "$t/score/$c/summary.csv") <(grep '^dipole_py,' "$t/rd/$c/summary.csv") \
+    || fail "$c: --radiance-dir scored the file differently"
+done < configs/study.list
+echo "test_newcomer: --radiance-dir: the same scores ($(grep '^study-score: 11' "$t/rd.err"))"
 echo "test_newcomer: passed"

@@ -223,8 +223,32 @@ static int file_methods(const char *path, char *names, size_t cap, ppb_err *err)
     return names[0] ? 0 : ppb_fail(err, "%s: no rows of a method", path);
 }
 
+/* The surfaces (S1..S4) id has rows of in the radiance file, as a surfaces value ("S1,S2"). */
+static void file_surfaces(const char *path, const char *id, char *buf, size_t cap)
+{
+    unsigned mask = 0;
+    FILE *f = fopen(path, "r");
+    char *line = NULL;
+    size_t lcap = 0, idlen = strlen(id);
+    while (f && getline(&line, &lcap, f) > 0)
+        if (strncmp(line, id, idlen) == 0 && line[idlen] == ',' && line[idlen + 1] == 'S' &&
+            line[idlen + 2] >= '1' && line[idlen + 2] <= '4' && line[idlen + 3] == ',')
+            mask |= 1u << (line[idlen + 2] - '1');
+    free(line);
+    if (f)
+        fclose(f);
+    buf[0] = '\0';
+    for (int k = 0; k < 4; k++)
+        if (mask & (1u << k)) {
+            size_t n = strlen(buf);
+            snprintf(buf + n, cap - n, "%sS%d", n ? "," : "", k + 1);
+        }
+}
+
 /* Each method of a --radiance-dir file becomes an external method whose command copies its
- * rows (and its totals.csv rows, when one is beside the file) into {out}. */
+ * rows (and its totals.csv rows, when one is beside the file) into {out}; the surfaces it has
+ * rows of are its surfaces (as `ppbench score` infers them: docs/external.md, "Partial
+ * coverage"). */
 static int radiance_methods(const char *file, const char *names, strlist *sets, ppb_err *err)
 {
     char dir[PPB_PATH_MAX], totals[PPB_PATH_MAX + 16];
@@ -247,7 +271,10 @@ static int radiance_methods(const char *file, const char *names, strlist *sets, 
         if (access(totals, R_OK) == 0)
             snprintf(cmd + n, sizeof cmd - (size_t)n,
                      " && awk -F, -v m=%s 'NR == 1 || $1 == m' %s > {out}/totals.csv", id, qt);
-        if (push(sets, "--set") || push(sets, "method.%s.command=%s", id, cmd))
+        char surf[32];
+        file_surfaces(file, id, surf, sizeof surf);
+        if (push(sets, "--set") || push(sets, "method.%s.command=%s", id, cmd) ||
+            (surf[0] && (push(sets, "--set") || push(sets, "method.%s.surfaces=%s", id, surf))))
             rc = ppb_fail(err, "out of memory");
     }
     free(qf);
