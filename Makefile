@@ -4,7 +4,7 @@
 # root, otherwise says which command to run).
 CC      ?= gcc
 BUILD   ?= build
-PKGS    := OpenCL lapacke openblas OpenEXR libpng inih libxxhash jansson
+PKGS    := OpenCL lapacke openblas OpenEXR libpng inih libxxhash jansson liblzma
 OPT     ?= -O2 -g
 WARN    := -Wall -Wextra $(if $(WERROR),-Werror)
 SAN     ?=
@@ -103,6 +103,18 @@ test-physics: $(BIN) $(PHYSICS_TESTS)
 test: layers methods-check docs unit
 	@bash tests/regress.sh
 
+# The researcher's loop: shipped references, the committed study's guard, score's radiance
+# check, partial external methods (tests/test_study_loop.sh, about 20 s); the newcomer's whole
+# path from a fresh clone (tests/test_newcomer.sh: a clone, its build, every study case scored).
+.PHONY: test-study-loop test-newcomer
+test: test-study-loop test-newcomer
+test-study-loop: $(BIN)
+	@mkdir -p $(BUILD)/tmp
+	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp bash tests/test_study_loop.sh
+test-newcomer:
+	@mkdir -p $(BUILD)/tmp
+	@PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp timeout 900 bash tests/test_newcomer.sh
+
 # The layer order is src/LAYERS; tests/test_layers.sh plants one violation of each rule.
 layers:
 	@bash scripts/check_layers.sh
@@ -125,6 +137,12 @@ asan:
 
 bench: $(BIN)
 	@bash scripts/bench.sh $(if $(QUICK),--quick)
+
+# The shipped Monte Carlo references (references/<case>/) from the study `make bench` ran:
+# its cached tallies, compressed (docs/reference.md, "The reference cache").
+.PHONY: references
+references:
+	@bash scripts/references.sh
 
 perf: $(BIN)
 	@./ppbench perf

@@ -46,7 +46,7 @@ for i in "${!cases[@]}"; do
   [ "$i" -gt 0 ] && eta=$(printf ', study ETA %ds more' $(( el * (total_w - done_w) / done_w )))
   printf '[%d/%d] %s (%ds elapsed%s)\n' $((i + 1)) ${#cases[@]} "$c" $el "$eta" >&2
   # ppbench run draws the case's figures itself (scripts/plots.sh, theta_L from provenance).
-  ./ppbench run "${sets[@]}" --ref-cache "$cache" --out "$out/$c" "configs/$c.ini"
+  PPB_BENCH_STUDY=1 ./ppbench run "${sets[@]}" --ref-cache "$cache" --out "$out/$c" "configs/$c.ini"
   done_w=$((done_w + weights[i]))
 done
 # The quick study's README says what it is: ppbench report copies notes.md into it (and states
@@ -68,3 +68,5 @@ fi
 bash scripts/summary_plot.sh "$out" "${cases[@]}"
 ./ppbench report "$out" "${cases[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2
+# The shipped references (references/<case>/, docs/reference.md: Keys) come from this study's
+# cache by `make references` (scripts/references.sh), run after a full bench.

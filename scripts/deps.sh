@@ -9,7 +9,7 @@ set -euo pipefail
 declare -A PC=(
   [OpenCL]=ocl-icd-opencl-dev [lapacke]=liblapacke-dev [openblas]=libopenblas-dev
   [OpenEXR]=libopenexr-dev [libpng]=libpng-dev [inih]=libinih-dev [cmocka]=libcmocka-dev
-  [libxxhash]=libxxhash-dev [jansson]=libjansson-dev
+  [libxxhash]=libxxhash-dev [jansson]=libjansson-dev [liblzma]=liblzma-dev
 )
 # file or command -> Debian package
 declare -A FILES=(
@@ -17,8 +17,8 @@ declare -A FILES=(
   [/usr/include/Random123/philox.h]=librandom123-dev
   [/etc/OpenCL/vendors/pocl.icd]=pocl-opencl-icd
 )
-declare -A CMDS=([pkg-config]=pkg-config [gnuplot]=gnuplot-nox [parallel]=parallel [clinfo]=clinfo
-  [clang]=clang) # clang: `make fuzz` (libFuzzer)
+declare -A CMDS=([pkg-config]=pkg-config [xz]=xz-utils [gnuplot]=gnuplot-nox [parallel]=parallel
+  [clinfo]=clinfo [clang]=clang) # clang: `make fuzz` (libFuzzer)
 if [ "${1:-}" = --cluster ]; then
   declare -A PC=() FILES=()
   declare -A CMDS=([slurmctld]=slurm-wlm [slurmd]=slurm-wlm [sbatch]=slurm-wlm [munged]=munge)

@@ -19,6 +19,17 @@ alpha'/2 sum q_i sign(h_i) exp(-sigma_tr |h_i|) agree to 1e-12 at the study's me
 dipole's exit radiance is Lambertian: cos(theta_L) R / pi on S1 and cos(theta_L) T / pi on S2,
 the same in every bin (a negative flux, the first source below a thin slab, is set to 0 as the C
 mp method does). Slab scenes only (the tube needs the flux through the sides).
+
+Options (docs/external.md, "Partial coverage"): `--name NAME` writes its rows under NAME (the
+config's `{name}`), default dipole_py; `--reflectance-only` writes S1's rows alone (the section
+then says `surfaces = S1`) and takes a tube too, as the slab of the tube's height: a reflectance-
+only method for the study's every case. `--approx` also takes a stepped medium (the medium at
+x < step_x) and n != 1 (A = 1 still): a rough stand-in, for trying the study loop, not a model
+of those cases.
+
+    [method.dipole_py]
+    command = python3 -m ppbench.dipole --reflectance-only --approx --name {name} {scene} {out}
+    surfaces = S1
 """
 import math
 import os
@@ -68,17 +79,30 @@ def dipole_RT(sigma_t, albedo, g, depth, panels=60):
 
 
 def main(argv):
-    if len(argv) != 3:
-        sys.exit("usage: python3 -m ppbench.dipole SCENE.json OUT_DIR")
+    args, name, only_r, approx = [], "dipole_py", False, False
+    it = iter(argv[1:])
+    for a in it:
+        if a == "--name":
+            name = next(it, "")
+        elif a == "--reflectance-only":
+            only_r = True
+        elif a == "--approx":
+            approx = True
+        else:
+            args.append(a)
+    if len(args) != 2 or not name:
+        sys.exit("usage: python3 -m ppbench.dipole [--name NAME] [--reflectance-only] [--approx] "
+                 "SCENE.json OUT_DIR")
+    argv = [argv[0]] + args
     from ppbench import read_scene
     sc = read_scene(argv[1])
-    if sc["geometry"]["kind"] != "slab":
-        sys.exit("ppbench.dipole: slab scenes only (geometry = slab)")
+    if sc["geometry"]["kind"] != "slab" and not only_r:
+        sys.exit("ppbench.dipole: slab scenes only (geometry = slab; a tube: --reflectance-only)")
     m, light = sc["medium"], sc["light"]
-    if m["step"] != "none":
-        sys.exit("ppbench.dipole: uniform media only")
-    if m.get("n", 1.0) != 1.0:
-        sys.exit("ppbench.dipole: n = 1 only (the boundary factor A = 1)")
+    if m["step"] != "none" and not approx:
+        sys.exit("ppbench.dipole: uniform media only (--approx: the medium at x < step_x)")
+    if m.get("n", 1.0) != 1.0 and not approx:
+        sys.exit("ppbench.dipole: n = 1 only (the boundary factor A = 1; --approx: A = 1 anyway)")
     R, T = dipole_RT(m["sigma_t"], m["albedo"], m["g"], sc["geometry"]["height"])
     cos_l = light["irradiance_s1"]  # cos(theta_L): the irradiance S1 receives
     # Where the first source lies below a thin slab T comes out negative: 0, as the C mp does.
@@ -86,15 +110,19 @@ def main(argv):
     with open(os.path.join(argv[2], "radiance.csv"), "w") as f:
         f.write("method,surface,segment,s,theta_bin,phi_bin,radiance,stderr\n")
         for p in sc["sample_points"]:
+            if only_r and p["surface"] != "S1":
+                continue  # not computed: the config's surfaces = S1 says so
             for b in sc["bins"]:
-                f.write("dipole_py,%s,%d,%.17g,%d,%d,%.17g,0\n" % (
-                    p["surface"], p["segment"], p["s"], b["theta_bin"], b["phi_bin"],
+                f.write("%s,%s,%d,%.17g,%d,%d,%.17g,0\n" % (
+                    name, p["surface"], p["segment"], p["s"], b["theta_bin"], b["phi_bin"],
                     L[p["surface"]]))
+    if only_r:
+        return  # no totals.csv: ppbench integrates S1 (R) and marks the rest not computed
     # totals: fractions of the power in; the unscattered beam leaves S2 with exp(-tau / cos)
     ballistic = math.exp(-m["sigma_t"] * sc["geometry"]["height"] / cos_l)
     with open(os.path.join(argv[2], "totals.csv"), "w") as f:
         f.write("method,R,T,sides,absorbed,ballistic\n")
-        f.write("dipole_py,%.17g,%.17g,0,%.17g,%.17g\n" % (R, T, 1 - R - T - ballistic, ballistic))
+        f.write("%s,%.17g,%.17g,0,%.17g,%.17g\n" % (name, R, T, 1 - R - T - ballistic, ballistic))
 
 
 if __name__ == "__main__":

@@ -7,10 +7,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "base/atomic_file.h"
+#include "base/file_read.h"
+#include "base/hash.h"
 #include "base/memory.h"
 #include "io/csv.h"
 #include "io/images.h"
@@ -129,6 +132,8 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
             fprintf(stderr, "%s: %s skipped: interrupted before it started\n", cfg->name,
                     cfg->methods[i]);
     }
+    snprintf(ex->mc_reference, sizeof ex->mc_reference, "%s", ctx->mc_reference);
+    snprintf(ex->mc_shipped_key, sizeof ex->mc_shipped_key, "%s", ctx->mc_shipped_key);
     if (ctx->ocl_open) {
         snprintf(ex->device, sizeof ex->device, "%s", ctx->ocl.name);
         ppb_ocl_versions_get(&ctx->ocl, &ex->ocl_versions);
@@ -229,6 +234,18 @@ static int write_provenance(const ppb_experiment *ex, const char *dir, const ppb
             fprintf(af.f, "%s.photons_traced = %lld\n", ex->res[i].method, ex->res[i].photons);
     for (int i = 0; i < ex->n; i++)
         fprintf(af.f, "%s.seconds = %.4f\n", ex->res[i].method, ex->seconds[i]);
+    if (ex->mc_reference[0]) /* docs/reference.md, "The reference cache" */
+        fprintf(af.f, "mc.reference = %s\n", ex->mc_reference);
+    if (ex->mc_shipped_key[0])
+        fprintf(af.f, "mc.shipped_key = %s\n", ex->mc_shipped_key);
+    /* radiance.csv's hash: score refuses a radiance.csv that is not this set's (Outputs) */
+    char rpath[PPB_PATH_MAX + 256];
+    out_path(dir, "radiance.csv", rpath, sizeof rpath);
+    size_t rlen;
+    char *rad = ppb_read_file(rpath, &rlen);
+    if (rad)
+        fprintf(af.f, "radiance.xxh64 = %016llx\n", (unsigned long long)ppb_hash64(rad, rlen));
+    free(rad);
     for (int i = 0; i < ex->nfailed; i++)
         fprintf(af.f, "%s.failed = %s\n", ex->failed[i], ex->failed_why[i]);
     for (int i = 0; i < ex->nincomplete; i++)

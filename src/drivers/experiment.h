@@ -24,6 +24,8 @@ typedef struct ppb_experiment {
     double seconds[PPB_MAX_RESULTS]; /* wall time of the method run that produced it */
     char device[512];                /* "" when no method used OpenCL */
     ppb_ocl_versions ocl_versions;   /* the device's versions (when device is not "") */
+    char mc_reference[4096 + 160];   /* the reference's cache or shipped file, "" when none */
+    char mc_shipped_key[64];         /* its name in the shipped layer, "" when none */
     int partial;                     /* interrupted: results are incomplete */
     /* Methods that failed at this point: no results of theirs, their reasons kept,
      * the other methods run on. */

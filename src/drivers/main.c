@@ -21,6 +21,8 @@
 #include "drivers/perf.h"
 #include "drivers/report.h"
 #include "drivers/score.h"
+#include "drivers/study_guard.h"
+#include "drivers/study_score.h"
 #include "drivers/slurm.h"
 #include "drivers/sweep.h"
 #include "io/scene_json.h"
@@ -59,6 +61,8 @@ enum {
     OPT_QOS = 1 << 14,
     OPT_GRES = 1 << 15,
     OPT_SBATCH = 1 << 16,
+    OPT_METHODS = 1 << 17, /* study-score's */
+    OPT_RADIANCE_DIR = 1 << 18,
 };
 
 static const struct option_doc {
@@ -81,6 +85,11 @@ static const struct option_doc {
      "~/.cache/ppbench/ref ($PPBENCH_CACHE set empty: none)"},
     {OPT_NO_REF_CACHE, "--no-ref-cache", NULL,
      "run, sweep: no reference cache: trace the Monte Carlo"},
+    {OPT_METHODS, "--methods", "A,B",
+     "study-score: the methods to score (built-in ids, or\nexternal ones defined by CONFIG or "
+     "--set method.NAME...)"},
+    {OPT_RADIANCE_DIR, "--radiance-dir", "DIR",
+     "study-score: score the files DIR/<case>.csv (or\nDIR/<case>/radiance.csv), one per case"},
     {OPT_SHARDS, "--shards", "N",
      "slurm: N array tasks, each one shard (1 to 1000; at most\nthe grid points or photons)"},
     {OPT_PARTITION, "--partition", "P", "slurm: #SBATCH --partition (default: the cluster's)"},
@@ -109,6 +118,7 @@ typedef struct cli {
     int shard_i, shard_n;
     int jobs;
     const char *ref;
+    const char *methods, *radiance_dir; /* study-score's */
     const char *ref_cache;
     int no_ref_cache;
     int shards, cpus, submit; /* slurm's */
@@ -214,6 +224,12 @@ static int parse_cli(int argc, char **argv, const command *cmd, cli *c)
             break;
         case OPT_REF:
             c->ref = v;
+            break;
+        case OPT_METHODS:
+            c->methods = v;
+            break;
+        case OPT_RADIANCE_DIR:
+            c->radiance_dir = v;
             break;
         case OPT_REF_CACHE:
             c->ref_cache = v;
@@ -493,6 +509,9 @@ static int cmd_run(const cli *c)
             code = usage_error(&err);
         } else {
             code = check_config_out(c, &cfgs[i]);
+            /* The committed study is make bench's (docs/reference.md: Outputs). */
+            if (code == EXIT_OK && ppb_study_guard(cfgs[i].out_dir, &err))
+                code = usage_error(&err);
             /* The directory is the run's own: refused, untouched, if ppbench did not write it. */
             if (code == EXIT_OK && ppb_experiment_claim_out(cfgs[i].out_dir, &err))
                 code = usage_error(&err);
@@ -787,6 +806,26 @@ static int cmd_score(const cli *c)
     return ppb_score_main(c->nargs ? c->args[0] : NULL, c->nargs, c->ref, c->out, c->quiet);
 }
 
+static int cmd_study_score(const cli *c)
+{
+    if (c->nargs > 1) {
+        fprintf(stderr,
+                "ppbench study-score: at most one CONFIG (see ppbench study-score --help)\n");
+        return EXIT_USAGE;
+    }
+    ppb_study_score_opts o = {.methods = c->methods,
+                              .radiance_dir = c->radiance_dir,
+                              .out = c->out,
+                              .config = c->nargs ? c->args[0] : NULL,
+                              .sets = c->sets,
+                              .nsets = c->nsets,
+                              .ref_cache = c->ref_cache,
+                              .no_ref_cache = c->no_ref_cache,
+                              .quiet = c->quiet,
+                              .device = c->device};
+    return ppb_study_score_main(&o);
+}
+
 static int cmd_report(const cli *c)
 {
     if (c->nargs < 2) {
@@ -848,6 +887,13 @@ static const command commands[] = {
      cmd_keys},
     {"perf", NULL, 0, "benchmarks: solver, ray marcher, Monte Carlo", "ppbench perf --device 0",
      OPT_DEVICE, 0, cmd_perf},
+    {"study-score", "[CONFIG]", 0,
+     "score methods on every case of configs/study.list\nagainst the shipped or cached reference "
+     "(no photon\ntraced) into --out DIR/<case>, and the study's report",
+     "ppbench study-score --out /tmp/mine configs/mine.ini",
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET | OPT_REF_CACHE | OPT_NO_REF_CACHE | OPT_METHODS |
+         OPT_RADIANCE_DIR,
+     1, cmd_study_score},
     {"report", "STUDY_DIR CASE...", 0, "table2.csv/.md and README.md of a study from its cases",
      "ppbench report results uniform_g0_normal density_step", 0, 1, cmd_report},
     {"version", NULL, 0, "print the version (as --version)", "ppbench version", 0, 0, cmd_version},
@@ -898,7 +944,7 @@ static void usage(FILE *out)
     fprintf(out,
             "\n"
             "examples:\n"
-            "  ppbench run configs/uniform_g0_normal.ini\n"
+            "  ppbench run --out /tmp/g0 configs/uniform_g0_normal.ini\n"
             "  ppbench run --device 0 --set mc.photons=1e6 --out /tmp/x configs/density_step.ini\n"
             "  ppbench sweep --shard 2/3 configs/sweep_example.ini\n"
             "  PPBENCH_DEVICE=pthread ppbench devices\n"

@@ -10,6 +10,8 @@
 #include "base/atomic_file.h"
 #include "base/progress.h"
 #include "base/csv_read.h"
+#include "base/file_read.h"
+#include "base/hash.h"
 #include "drivers/experiment.h"
 #include "drivers/summary_table.h"
 #include "io/csv.h"
@@ -22,6 +24,28 @@ enum { EXIT_OK = 0, EXIT_RUN = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
 /* The start of the first line of provenance.txt in score's output set: what marks a directory
  * as one (ppb_out_claim). */
 static const char score_mark[] = "# ppbench score provenance";
+
+/* DIR/radiance.csv against the hash its set's provenance.txt records (docs/reference.md:
+ * Outputs, provenance.txt's radiance.xxh64): a radiance.csv left by another run beside this
+ * provenance is refused, never scored against. */
+static int check_radiance(const char *dir, const char *want, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 32], got[32];
+    snprintf(path, sizeof path, "%s/radiance.csv", dir);
+    size_t len;
+    char *data = ppb_read_file(path, &len);
+    if (!data)
+        return 0; /* no radiance.csv: said where it is read */
+    snprintf(got, sizeof got, "%016llx", (unsigned long long)ppb_hash64(data, len));
+    free(data);
+    if (strcmp(got, want) != 0)
+        return ppb_fail(err,
+                        "--ref %s: radiance.csv is not the one its provenance.txt records "
+                        "(radiance.xxh64 %s, the file hashes to %s): another run wrote it; run "
+                        "the experiment again, or score against a set whose files agree",
+                        dir, want, got);
+    return 0;
+}
 
 /* The experiment's config from DIR/provenance.txt: its "section.key = value" lines from
  * experiment.name on (the resolved config, model/config.h) applied as --set options would be
@@ -49,6 +73,9 @@ static int load_provenance(const char *dir, ppb_config *cfg, ppb_err *err)
             goto done;
         }
         line[strcspn(line, "\n")] = '\0';
+        if (!on && strncmp(line, "radiance.xxh64 = ", 17) == 0 &&
+            check_radiance(dir, line + 17, err))
+            goto done;
         on |= strncmp(line, "experiment.name = ", 18) == 0;
         char *eq = strstr(line, " = ");
         if (!on || !eq || strncmp(line, "method.", 7) == 0)
@@ -245,7 +272,8 @@ int ppb_score_main(const char *radiance, int nargs, const char *ref_dir, const c
         if (ppb_result_init(r, ids[i], &lo, &err))
             goto done;
         n++;
-        if (ppb_external_read_radiance(radiance, ids[i], 1, &cfg.scene, r, &err) ||
+        if (ppb_external_read_radiance_on(radiance, ids[i], 1, &cfg.scene, PPB_SURFACES_FROM_ROWS,
+                                          r, &err) ||
             ppb_external_totals(beside, &cfg.scene, r, &err))
             goto done;
     }

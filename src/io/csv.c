@@ -21,6 +21,8 @@ int ppb_write_radiance_csv(const char *path, const ppb_scene *sc, const ppb_resu
                 double s = ppb_scene_sample_point(sc, surf, seg, &x, &y);
                 for (int b = 0; b < lo->nbins; b++) {
                     size_t c = ppb_cell(lo, surf, seg, b);
+                    if (isnan(rs[m].radiance[c]))
+                        continue; /* not computed (docs/reference.md: Outputs) */
                     fprintf(af.f, "%s,%s,%d,%.6g,%d,%d,%.10g,%.10g\n", rs[m].method,
                             ppb_surface_name(surf), seg, s, b / sc->nphi, b % sc->nphi,
                             rs[m].radiance[c], rs[m].se[c]);

@@ -46,6 +46,11 @@ typedef struct ppb_run_ctx {
     int nprior;
     const struct ppb_method *self; /* the method running, set by the runner */
     const char *ref_cache;         /* --ref-cache DIR: mc's tallies reused from there */
+    /* The reference's file in the cache or the shipped layer (mc_cache.h), set by mc: the one
+     * it was loaded from or stored into; "" when none (provenance.txt's mc.reference). */
+    char mc_reference[4096 + 160];
+    char mc_shipped_key[64];  /* its shipped layer's name, mc-<key>.bin (mc_cache.h) */
+    int mc_reference_shipped; /* 1: mc_reference is the shipped layer's */
     ppb_method_state state[PPB_MAX_STATES];
     int nstate;
 } ppb_run_ctx;

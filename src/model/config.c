@@ -755,6 +755,35 @@ static int on_method_key(parse_state *st, const char *section, const char *name,
             d->command[0] = '\0', d->command_line = 0, d->command_set = 0;
         if (strcmp(name, "timeout") == 0)
             d->timeout = 0, d->timeout_line = 0, d->timeout_set = 0;
+        if (strcmp(name, "surfaces") == 0)
+            d->surfaces = 0, d->surfaces_line = 0, d->surfaces_set = 0;
+    }
+    if (strcmp(name, "surfaces") == 0) {
+        /* A list of S1..S4 (docs/external.md, "Partial coverage"). */
+        if (d->surfaces_line) {
+            snprintf(st->why, sizeof st->why, "given twice");
+            return 0;
+        }
+        unsigned mask = 0;
+        char list[256];
+        snprintf(list, sizeof list, "%s", value);
+        for (char *save = NULL, *tok = strtok_r(list, ", \t", &save); tok;
+             tok = strtok_r(NULL, ", \t", &save)) {
+            if ((tok[0] != 'S' && tok[0] != 's') || tok[1] < '1' || tok[1] > '4' || tok[2]) {
+                snprintf(st->why, sizeof st->why,
+                         "'%.40s' is not a surface: a list of S1, S2, S3, S4", tok);
+                return 0;
+            }
+            mask |= 1u << (tok[1] - '1');
+        }
+        if (!mask) {
+            snprintf(st->why, sizeof st->why, "a list of S1, S2, S3, S4 (at least one)");
+            return 0;
+        }
+        d->surfaces = mask;
+        d->surfaces_line = st->line ? st->line : 1;
+        d->surfaces_set = st->from_set;
+        return 1;
     }
     if (strcmp(name, "command") == 0) {
         size_t have = strlen(d->command);
@@ -799,7 +828,8 @@ static int on_method_key(parse_state *st, const char *section, const char *name,
         d->timeout_set = st->from_set;
         return 1;
     }
-    snprintf(st->why, sizeof st->why, "unknown key (a [method.NAME] holds command and timeout)");
+    snprintf(st->why, sizeof st->why,
+             "unknown key (a [method.NAME] holds command, timeout and surfaces)");
     return 0;
 }
 
@@ -1087,7 +1117,9 @@ static int set_method_key(ppb_config *cfg, const char *set, const char *eq, ppb_
             dot = p;
     if (!dot || dot == name || dot + 1 == eq || (size_t)(dot - set) >= sizeof section ||
         (size_t)(eq - dot - 1) >= sizeof key)
-        return ppb_fail(err, "--set %s: expected method.NAME.KEY=VALUE (KEY: command or timeout)",
+        return ppb_fail(err,
+                        "--set %s: expected method.NAME.KEY=VALUE (KEY: command, timeout or "
+                        "surfaces)",
                         shown(set, q, sizeof q));
     snprintf(section, sizeof section, "%.*s", (int)(dot - set), set);
     snprintf(key, sizeof key, "%.*s", (int)(eq - dot - 1), dot + 1);
@@ -1168,6 +1200,17 @@ static void write_value(const ppb_config *cfg, const key_def *k, FILE *out)
     }
 }
 
+void ppb_surfaces_write(unsigned mask, FILE *out)
+{
+    const char *sep = "";
+    for (int k = 0; k < 4; k++)
+        if (mask & (1u << k)) {
+            fprintf(out, "%sS%d", sep, k + 1);
+            sep = ", ";
+        }
+    fputc('\n', out);
+}
+
 void ppb_config_write_resolved(const ppb_config *cfg, FILE *out)
 {
     for (int i = 0; i < NKEYS; i++) {
@@ -1180,6 +1223,10 @@ void ppb_config_write_resolved(const ppb_config *cfg, FILE *out)
         if (cfg->external[i].timeout > 0) /* given: in the file or by --set */
             fprintf(out, "method.%s.timeout = %.17g\n", cfg->external[i].name,
                     cfg->external[i].timeout);
+        if (cfg->external[i].surfaces) {
+            fprintf(out, "method.%s.surfaces = ", cfg->external[i].name);
+            ppb_surfaces_write(cfg->external[i].surfaces, out);
+        }
     }
 }
 
@@ -1245,6 +1292,13 @@ static void write_externals(const ppb_config *cfg, int ini, FILE *out)
             fprintf(out, "timeout = %.17g\n", d->timeout);
         else if (d->timeout > 0)
             fprintf(out, "method.%s.timeout = %.17g\n", d->name, d->timeout);
+        if (d->surfaces) {
+            if (ini)
+                fprintf(out, "surfaces = ");
+            else
+                fprintf(out, "method.%s.surfaces = ", d->name);
+            ppb_surfaces_write(d->surfaces, out);
+        }
     }
 }
 

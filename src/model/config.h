@@ -85,6 +85,11 @@ typedef struct ppb_external_def {
     int timeout_line; /* line of its timeout (0: not in the file) */
     int command_set;  /* 1: the command is --set's */
     int timeout_set;  /* 1: the timeout is --set's */
+    /* The surfaces it answers (docs/external.md, "Partial coverage"): bit k for S(k+1); 0: all
+     * of them. The others are not computed: absent from its rows, NaN in its result, left out
+     * of every metric. */
+    unsigned surfaces;
+    int surfaces_line, surfaces_set;
 } ppb_external_def;
 
 /* Where a key's value came from, so that checks made after loading name the right place. */
@@ -188,6 +193,9 @@ void ppb_config_key_info(int key, ppb_key_info *info);
 void ppb_config_write_key(const ppb_config *cfg, int key, FILE *out);
 
 int ppb_config_has_method(const ppb_config *cfg, const char *id);
+
+/* A [method.NAME] surfaces mask as its config value ("S1, S2") and a newline. */
+void ppb_surfaces_write(unsigned mask, FILE *out);
 
 /* The [method.NAME] section of id, or NULL. */
 const ppb_external_def *ppb_config_external(const ppb_config *cfg, const char *id);

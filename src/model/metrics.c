@@ -28,7 +28,8 @@ ppb_rms ppb_rms_points_w(const ppb_result *m, const ppb_result *ref, const ppb_p
         r.rms_rel = sqrt(num / den);
         r.noise_rel = sqrt(noise / den);
         double ex = r.rms_rel * r.rms_rel - r.noise_rel * r.noise_rel;
-        r.rms_excess = sqrt(ex > 0 ? ex : 0);
+        /* NaN stays NaN: a method's surface not computed (docs/reference.md: Metrics) */
+        r.rms_excess = isnan(ex) ? NAN : sqrt(ex > 0 ? ex : 0);
     }
     return r;
 }

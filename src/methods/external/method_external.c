@@ -49,17 +49,22 @@ static int put_quoted(char *buf, size_t cap, size_t *n, const char *s)
     return 0;
 }
 
-/* The command with {scene} and {out} replaced. */
-static int expand(const char *cmd, const char *scene, const char *out, char *buf, size_t cap)
+/* The command with {scene}, {out} and {name} (the method's NAME: docs/external.md, The
+ * config) replaced, each shell-quoted. */
+static int expand(const char *cmd, const char *scene, const char *out, const char *name, char *buf,
+                  size_t cap)
 {
     size_t n = 0;
     buf[0] = '\0';
     for (const char *c = cmd; *c;) {
-        if (!strncmp(c, "{scene}", 7) || !strncmp(c, "{out}", 5)) {
-            int is_scene = c[1] == 's';
-            if (put_quoted(buf, cap, &n, is_scene ? scene : out))
+        const char *what = !strncmp(c, "{scene}", 7)  ? scene
+                           : !strncmp(c, "{out}", 5)  ? out
+                           : !strncmp(c, "{name}", 6) ? name
+                                                      : NULL;
+        if (what) {
+            if (put_quoted(buf, cap, &n, what))
                 return -1;
-            c += is_scene ? 7 : 5;
+            c = strchr(c, '}') + 1;
             continue;
         }
         if (n + 1 >= cap)
@@ -153,6 +158,13 @@ static int surface_of(const char *name, int nsurf)
 int ppb_external_read_radiance(const char *path, const char *id, int others_ok, const ppb_scene *sc,
                                ppb_result *r, ppb_err *err)
 {
+    return ppb_external_read_radiance_on(path, id, others_ok, sc, 0, r, err);
+}
+
+int ppb_external_read_radiance_on(const char *path, const char *id, int others_ok,
+                                  const ppb_scene *sc, unsigned surfaces, ppb_result *r,
+                                  ppb_err *err)
+{
     ppb_csv c;
     if (ppb_csv_open(&c, path, err))
         return -1;
@@ -218,6 +230,11 @@ int ppb_external_read_radiance(const char *path, const char *id, int others_ok, 
                      ppb_csv_get(&c, 3), ppb_surface_name(surf), seg, s_want);
             goto done;
         }
+        if (surfaces && surfaces != PPB_SURFACES_FROM_ROWS && !(surfaces & (1u << surf))) {
+            ppb_fail(err, "%s:%ld: a row of %s, which its surfaces key leaves out", path, c.line,
+                     ppb_surface_name(surf));
+            goto done;
+        }
         size_t cell = ppb_cell(lo, surf, seg, it * sc->nphi + ip);
         if (seen[cell]) {
             ppb_fail(err,
@@ -231,8 +248,9 @@ int ppb_external_read_radiance(const char *path, const char *id, int others_ok, 
     }
     if (got < 0)
         goto done;
+    unsigned answered = ppb_external_answered(lo, seen, surfaces);
     for (int surf = 0; surf < lo->nsurf; surf++)
-        for (int seg = 0; seg < lo->nseg[surf]; seg++)
+        for (int seg = 0; seg < lo->nseg[surf] && (answered & (1u << surf)); seg++)
             for (int bin = 0; bin < lo->nbins; bin++)
                 if (!seen[ppb_cell(lo, surf, seg, bin)]) {
                     ppb_fail(err,
@@ -241,6 +259,7 @@ int ppb_external_read_radiance(const char *path, const char *id, int others_ok, 
                              path, ppb_surface_name(surf), seg, bin / sc->nphi, bin % sc->nphi);
                     goto done;
                 }
+    ppb_external_not_computed(r, answered);
     rc = 0;
 done:
     free(seen);
@@ -287,9 +306,10 @@ int ppb_external_totals(const char *path, const ppb_scene *sc, ppb_result *r, pp
         }
         found = 1;
         for (int k = 0; k < 5; k++)
-            if (parse_real(ppb_csv_get(&c, col[k]), dst[k]) || !isfinite(*dst[k])) {
-                ppb_fail(err, "%s:%ld: %s = '%s': not a finite number", path, c.line, names[k],
-                         ppb_csv_get(&c, col[k]));
+            /* nan: not computed (a partial method's own totals.csv, docs/external.md) */
+            if (parse_real(ppb_csv_get(&c, col[k]), dst[k]) || isinf(*dst[k])) {
+                ppb_fail(err, "%s:%ld: %s = '%s': not a number (nan: not computed)", path, c.line,
+                         names[k], ppb_csv_get(&c, col[k]));
                 goto done;
             } else if (*dst[k] < 0.0 && k != 3) { /* absorbed may be 1 - the rest */
                 ppb_fail(err, "%s:%ld: %s = '%s': a fraction of the power, must be >= 0", path,
@@ -342,7 +362,7 @@ int ppb_method_external(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     char *cmd = malloc(cap);
     if (!cmd)
         return ppb_fail(err, "out of memory");
-    if (expand(d->command, scene, odir, cmd, cap)) {
+    if (expand(d->command, scene, odir, id, cmd, cap)) {
         free(cmd);
         return ppb_fail(err, "its command is too long once expanded");
     }
@@ -357,12 +377,14 @@ int ppb_method_external(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     if (rc == 0 && access(rad, F_OK) != 0)
         rc = ppb_fail(err, "its command wrote no %s", rad);
     if (rc == 0)
-        rc = ppb_external_read_radiance(rad, id, 0, &cfg->scene, out, err);
+        rc = ppb_external_read_radiance_on(rad, id, 0, &cfg->scene, d->surfaces, out, err);
     if (rc == 0)
         rc = ppb_external_totals(tot, &cfg->scene, out, err);
-    if (rc == 0)
+    /* A partial method's surfaces not computed are NaN: the reader checked the others. */
+    int partial = ppb_external_is_partial(&out->layout, d->surfaces);
+    if (rc == 0 && !partial)
         rc = ppb_radiance_check(cfg->name, out, NULL, err);
-    if (rc == 0)
+    if (rc == 0 && !partial)
         rc = ppb_totals_check(cfg->name, out, err);
     if (rc) {
         size_t n = strlen(err->msg);

@@ -31,6 +31,24 @@ int ppb_external_check(const ppb_config *cfg, const ppb_external_def *d, ppb_err
 int ppb_external_read_radiance(const char *path, const char *id, int others_ok, const ppb_scene *sc,
                                ppb_result *r, ppb_err *err);
 
+/* ppb_external_read_radiance for a method that answers only some surfaces (docs/external.md,
+ * "Partial coverage"): surfaces is a mask (bit k: S(k+1)) of those it answers, 0 for all, or
+ * PPB_SURFACES_FROM_ROWS: those with at least one row (`ppbench score`, which has no config of the
+ * method). A row of a surface outside the mask is refused; every row of a surface answered is
+ * required; the cells of the others are NaN (not computed) in r. */
+#define PPB_SURFACES_FROM_ROWS 0x100u
+int ppb_external_read_radiance_on(const char *path, const char *id, int others_ok,
+                                  const ppb_scene *sc, unsigned surfaces, ppb_result *r,
+                                  ppb_err *err);
+
+/* The surfaces answered (a mask of the layout's), given the line of each cell's row (seen, 0:
+ * none) and the surfaces argument above. */
+unsigned ppb_external_answered(const ppb_layout *lo, const long *seen, unsigned surfaces);
+/* Sets every cell of the surfaces not in answered to NaN, radiance and stderr. */
+void ppb_external_not_computed(ppb_result *r, unsigned answered);
+/* Whether a surfaces mask leaves out a surface of the layout. */
+int ppb_external_is_partial(const ppb_layout *lo, unsigned surfaces);
+
 /* Totals of r: from totals.csv at path when it exists (the row of r's method), otherwise R, T
  * and sides integrated from the radiance (cell energy = radiance x ppb_scene_cell_measure),
  * ballistic 0 and absorbed the rest. */

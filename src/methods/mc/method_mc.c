@@ -477,11 +477,23 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     long long chunk = 0;
     if (ctx->ref_cache && cfg->mc.target_noise > 0 && ppb_mc_chunk(ctx, &chunk, err))
         return -1;
+    ctx->mc_reference[0] = '\0';
+    ppb_mc_cache_note_key(ctx, chunk);
     if (ctx->ref_cache && ppb_mc_cache_get(ctx, chunk, &t)) {
         /* The same reference was traced before (docs/external.md): no photon is traced now. */
         if (ctx->quiet < 2)
-            fprintf(stderr, "%s: mc: %llu photons from the reference cache %s, 0 traced\n",
-                    cfg->name, (unsigned long long)t.count, ctx->ref_cache);
+            fprintf(stderr, "%s: mc: %llu photons from the %s %s, 0 traced\n", cfg->name,
+                    (unsigned long long)t.count,
+                    ctx->mc_reference_shipped ? "shipped reference" : "reference cache",
+                    ctx->mc_reference_shipped ? ctx->mc_reference : ctx->ref_cache);
+    } else if (getenv("PPBENCH_MC_NO_TRACE") && strcmp(getenv("PPBENCH_MC_NO_TRACE"), "1") == 0) {
+        /* study-score: a reference neither cached nor shipped is not traced unasked
+         * (docs/reference.md, Keys: shipped references). */
+        return ppb_fail(err,
+                        "mc: no reference for this config in the cache (%s) nor the shipped "
+                        "layer (%s), and PPBENCH_MC_NO_TRACE=1: nothing traced (set "
+                        "PPBENCH_MC_NO_TRACE=0 to trace it)",
+                        ctx->ref_cache ? ctx->ref_cache : "none", ppb_mc_shipped_dir());
     } else {
         if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, err))
             return -1;
