@@ -349,12 +349,26 @@ static void test_sigterm_while_writing_exits_130(void **state)
     (void)state;
     const char *dir = tu_scratch("harden_term");
     char env[2400], args[4096], path[1400];
-    wrap_plots(dir, "kill -TERM $PPID");
+    /* ppbench itself (the script runs under its guard, base/child.h: PPBENCH_OWNER names it) */
+    wrap_plots(dir, "kill -TERM ${PPBENCH_OWNER%%:*}");
     snprintf(env, sizeof env, "PPBENCH_CACHE= PPBENCH_SCRIPTS='%s/scripts'", dir);
     snprintf(args, sizeof args, "%s --out '%s/o' configs/density_step.ini", small, dir);
     cli_expect_env(env, args, 130, "");
     snprintf(path, sizeof path, "%s/o/rms.csv", dir);
     assert_true(file_ok(path));
+}
+
+/* --out relative, its parent not there yet: the run makes the parent and takes its lock once.
+ * Before, the lock was taken under the relative name at the check and again under the absolute
+ * one at the write, and the process refused itself ("another ppbench is writing it"), exit 1. */
+static void test_relative_out_new_parent(void **state)
+{
+    (void)state;
+    const char *dir = tu_scratch("harden_rel");
+    assert_int_equal(tu_sh("cd '%s' && PPBENCH_CACHE= \"$PPBENCH\" %s --out rel/sub/x "
+                           "'%s/configs/density_step.ini' && test -f rel/sub/x/rms.csv",
+                           dir, small, PPB_SOURCE_DIR),
+                     0);
 }
 
 /* The same run twice gives the same PDFs: cairo wrote the wall-clock /CreationDate into each,
@@ -444,6 +458,7 @@ int main(void)
         cmocka_unit_test(test_dangling_symlink_refused),
         cmocka_unit_test(test_second_run_on_one_out_refused),
         cmocka_unit_test(test_sigterm_while_writing_exits_130),
+        cmocka_unit_test(test_relative_out_new_parent),
         cmocka_unit_test(test_same_run_same_pdfs),
         cmocka_unit_test(test_report_files_replaced_together),
         cmocka_unit_test(test_sweep_heatmap_cut_short_left_out),

@@ -331,8 +331,13 @@ static int check_owned(const ppb_adir *ad, const char *dir, const char *mark, pp
                     dir, other, mark);
 }
 
-/* The output directories this process holds the lock of (claim_out: at most one a config). */
-static char locked[64][PPB_PATH_MAX];
+/* The lock files this process holds (claim_out: at most one a config), by device and inode:
+ * the same directory may be named first relative, while its parent does not exist yet, and
+ * then absolute, and a second flock of the same file would refuse this very process. */
+static struct {
+    dev_t dev;
+    ino_t ino;
+} locked[64];
 static int nlocked;
 
 /* An exclusive lock on .<name>.lock beside the directory (hidden: a listing of the parent shows
@@ -341,9 +346,6 @@ static int nlocked;
  * of computing and then losing the swap (docs/reference.md: Outputs). */
 static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
 {
-    for (int i = 0; i < nlocked; i++)
-        if (!strcmp(locked[i], ad->path))
-            return 0;
     char path[PPB_PATH_MAX + 16], parent[PPB_PATH_MAX + 16];
     snprintf(parent, sizeof parent, "%s", ad->path);
     char *slash = strrchr(parent, '/');
@@ -356,8 +358,18 @@ static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
     if (slash && slash != parent && ppb_mkdirs(parent, err))
         return -1;
     int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-    if (fd < 0)
-        return ppb_fail(err, "%s: cannot take its lock %s: %s", dir, path, strerror(errno));
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        int e = errno;
+        if (fd >= 0)
+            close(fd);
+        return ppb_fail(err, "%s: cannot take its lock %s: %s", dir, path, strerror(e));
+    }
+    for (int i = 0; i < nlocked; i++)
+        if (locked[i].dev == st.st_dev && locked[i].ino == st.st_ino) {
+            close(fd); /* held already, by this process */
+            return 0;
+        }
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
         int e = errno;
         close(fd);
@@ -368,8 +380,10 @@ static int lock_out(const ppb_adir *ad, const char *dir, ppb_err *err)
                             dir, path);
         return ppb_fail(err, "%s: cannot lock %s: %s", dir, path, strerror(e));
     }
-    if (nlocked < 64) /* the descriptor stays open: the lock lasts as long as the process */
-        snprintf(locked[nlocked++], sizeof locked[0], "%s", ad->path);
+    if (nlocked < 64) { /* the descriptor stays open: the lock lasts as long as the process */
+        locked[nlocked].dev = st.st_dev;
+        locked[nlocked++].ino = st.st_ino;
+    }
     return 0;
 }
 
