@@ -224,7 +224,7 @@ int ppb_external_read_radiance(const char *path, const char *id, int others_ok, 
                      ppb_csv_get(&c, 3), ppb_surface_name(surf), seg, s_want);
             goto done;
         }
-        size_t cell = ppb_cell(lo, surf, seg, it * sc->nphi + ip);
+        size_t cell = ppb_cell(lo, surf, seg, ppb_bin_index(it, ip, sc->nphi));
         if (seen[cell]) {
             ppb_fail(err,
                      "%s:%ld: a second row for %s segment %d bin (%d, %d) (the first: line %ld)",
