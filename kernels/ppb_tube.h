@@ -158,6 +158,17 @@ PPB_FN int ppb_tube_lit_at(const ppb_medium *M, double xp, double tol)
     return xp >= -0.5 * M->width - tol && (M->step != PPB_STEP_SHADOW || xp < M->step_x);
 }
 
+/* The medium of the piece [la, lb] of the ray from (px, py) along (mx, my), read at the piece's
+ * middle x: one sigma_t and alpha hold along a piece, as pieces are cut at the step plane
+ * (ppb_tube_breaks). */
+PPB_FN void ppb_piece_medium(const ppb_medium *M, double px, double mx, double la, double lb,
+                             double *sigma_t, double *alpha)
+{
+    double xm = px + 0.5 * (la + lb) * mx;
+    *sigma_t = ppb_medium_sigma_t(M, xm);
+    *alpha = ppb_medium_albedo(M, xm);
+}
+
 /* Where a ray from (px, py) along (mx, my) crosses the lines where the medium or the direct
  * light change (tube only): the step plane x = step_x (density or albedo step), the light line
  * through S1 at x' = step_x (any step) and the light line through S1's lit edge x' = -W/2
@@ -192,15 +203,23 @@ PPB_FN int ppb_exit_cell(int gid, int row0, int nbins, const int *offset, const 
     return ppb_row_surface(row0 + gid / nbins, offset, nseg, seg);
 }
 
-/* Sample k of such a cell, k = (ip nsamp + a) nsamp + b in [0, npts nsamp^2): the exit point ip
- * of the segment (ppb_segment_sample; slab: its one point) in (*px, *py) and the bin's direction
- * sample (a, b) in w[0..2] (ppb_bin_sample_dir). Returns the sample's index
- * (ppb_bin_sample_index), the order of the marchers' tables and source planes. */
+/* The samples of such a cell: npts points of its segment (slab: the face's one point) times the
+ * bin's nsamp x nsamp directions. */
+PPB_FN int ppb_exit_nsamples(const ppb_medium *M, int npts, int nsamp)
+{
+    return (M->tube ? npts : 1) * nsamp * nsamp;
+}
+
+/* Sample k of such a cell, k = (ip nsamp + a) nsamp + b in [0, ppb_exit_nsamples): the exit
+ * point ip of the segment (ppb_segment_sample) in (*px, *py) and the bin's direction sample
+ * (a, b) in w[0..2] (ppb_bin_sample_dir). Returns the sample's index (ppb_bin_sample_index), the
+ * order of the marchers' tables and source planes. */
 PPB_FN int ppb_exit_sample(const ppb_medium *M, int surf, int seg, int nseg, int bin, int npts,
                            int nsamp, int ntheta, int nphi, int k, double *px, double *py,
                            double *w)
 {
     int b = k % nsamp, a = k / nsamp % nsamp, ip = k / (nsamp * nsamp);
+    npts = M->tube ? npts : 1;
     ppb_segment_sample(M->tube, surf, seg, nseg, M->width, M->height, ip, npts, px, py);
     ppb_bin_sample_dir(surf, bin, a, b, nsamp, ntheta, nphi, &w[0], &w[1], &w[2]);
     return ppb_bin_sample_index(surf, bin, a, b, nsamp, ppb_bin_count(ntheta, nphi));

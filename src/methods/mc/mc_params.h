@@ -77,7 +77,7 @@ typedef struct ppb_mc_params {
     ppb_u64 ncells; /* cells of one tally (layout.ncells) */
     /* The medium block (ppb_medium_of): med.n <= 1 runs no boundary code. The kernel steps in
      * float: it rounds W, H, step_x, the sigma_t and albedos and g to float where it reads them
-     * (mc.cl, ppb_mc_f). */
+     * (mc.cl: ppb_mc_segment, ppb_mc_vbins, ppb_mc_step). */
     ppb_medium med;
     int batches;      /* batch of photon i is i % batches */
     int ntheta, nphi; /* direction bins */

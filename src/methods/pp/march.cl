@@ -220,9 +220,8 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
         double la = brk[k], lb = brk[k + 1];
         if (lb <= la)
             continue;
-        double xm = px + 0.5 * (la + lb) * mx;
-        double sigma_t = ppb_medium_sigma_t(&P->med, xm);
-        double alpha = ppb_medium_albedo(&P->med, xm);
+        double sigma_t, alpha;
+        ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
         /* The piece lies in one column (pieces are cut at x = step_x): the right column's slab
          * when its extinction is the right medium's and the tables have that column. */
         int c = P->ncols > 1 && sigma_t != P->med.sigma_t;
@@ -376,9 +375,8 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
         double la = brk[k], lb = brk[k + 1];
         if (lb <= la)
             continue;
-        double xm = px + 0.5 * (la + lb) * mx;
-        double sigma_t = ppb_medium_sigma_t(&P->med, xm);
-        double alpha = ppb_medium_albedo(&P->med, xm);
+        double sigma_t, alpha;
+        ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
         double db = sigma_t * P->med.height / ct;
         double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
         if (P->with_modes) {
@@ -462,11 +460,11 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
     /* pp's tables at n > 1 hold 2 (slab) or 4 (tube) variants of each sample (march_tables.h) */
     int nvar = P.med.n > 1.0 && P.with_modes ? (P.med.tube ? 4 : 2) : 1;
     int ndir = nvar * ppb_bin_sample_count(ppb_surface_count(P.med.tube), nbins, P.nsamp);
-    int npts = P.med.tube ? P.npts : 1;
+    int ns = ppb_exit_nsamples(&P.med, P.npts, P.nsamp);
     double sum = 0.0;
-    for (int k = 0; k < npts * P.nsamp * P.nsamp; k++) {
+    for (int k = 0; k < ns; k++) {
         double px, py, w[3];
-        int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, npts, P.nsamp, P.ntheta,
+        int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
                                   P.nphi, k, &px, &py, w);
         if (P.med.n > 1.0)
             sum += ppb_march_ray_fresnel(&P, map, tabR, tabS, coefC, ndir, dir, surf, px, py, w[0],
@@ -474,5 +472,5 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
         else
             sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, w[0], w[1]);
     }
-    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
+    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
 }

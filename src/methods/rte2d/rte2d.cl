@@ -116,9 +116,8 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         double la = brk[k], lb = brk[k + 1], len = lb - la;
         if (len <= 0.0)
             continue;
-        double xm = px + 0.5 * (la + lb) * mx, ym = py + 0.5 * (la + lb) * my;
-        double sigma_t = ppb_medium_sigma_t(&P->med, xm);
-        double alpha = ppb_medium_albedo(&P->med, xm);
+        double xm = px + 0.5 * (la + lb) * mx, ym = py + 0.5 * (la + lb) * my, sigma_t, alpha;
+        ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
         double sum = 0.0;
         if (P->beam && P->med.n > 1.0 && P->med.tube && P->tan_theta_l > 0.0) {
             sum += rte_beam_images(P, cb, px, py, mx, my, la, lb, sigma_t, d);
@@ -208,11 +207,11 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
     if (surf < 0)
         return;
     int nn = ppb_rte_nnodes(&P);
-    int npts = P.med.tube ? P.npts : 1;
+    int ns = ppb_exit_nsamples(&P.med, P.npts, P.nsamp);
     double sum = 0.0;
-    for (int k = 0; k < npts * P.nsamp * P.nsamp; k++) {
+    for (int k = 0; k < ns; k++) {
         double px, py, v[3];
-        int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, npts, P.nsamp, P.ntheta,
+        int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
                                   P.nphi, k, &px, &py, v);
         if (P.med.n > 1.0) {
             /* Air-side sample w = v: inside along Snell's direction, (1 - F) / n^2 times the
@@ -229,7 +228,7 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                         0.0, 0.0};
         sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, v[0], v[1]);
     }
-    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
+    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
 }
 
 /* ---- The conservative sweep: a flat-source method of characteristics (reference: Methods) ----
