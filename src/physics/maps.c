@@ -160,8 +160,8 @@ double ppb_beam_depth(const ppb_scene *sc, double xe)
     /* It leaves through S2, or through S4 when oblique light reaches x = W/2 first. */
     double t = ppb_scene_tan_theta_l(sc);
     double xb = xe + sc->height * t, yb = -sc->height;
-    if (xb > 0.5 * sc->width) {
-        xb = 0.5 * sc->width;
+    if (xb > ppb_face_line(PPB_S4, sc->width, sc->height)) {
+        xb = ppb_face_line(PPB_S4, sc->width, sc->height);
         yb = -(xb - xe) / t;
     }
     return ppb_segment_optical_depth(sc, xe, 0.0, xb, yb);

@@ -629,9 +629,10 @@ static double beam_path_absorbed(const ppb_scene *sc, double xe)
     double c = ppb_scene_cos_theta_l(sc), s = ppb_scene_sin_theta_l(sc);
     if (sc->geometry == PPB_GEOM_SLAB)
         return (1.0 - sc->albedo) * (1.0 - exp(-sc->sigma_t * sc->height / c));
+    ppb_medium M = ppb_medium_of(sc);
     double lend = sc->height / c;
-    if (s > 0.0)
-        lend = fmin(lend, (0.5 * sc->width - xe) / s);
+    if (s > 0.0) /* or through S4 first */
+        lend = fmin(lend, ppb_tube_length_x(sc->width, xe, s));
     double ls = lend;
     if (s > 0.0 && xe < sc->step_x && (sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO))
         ls = fmin(lend, (sc->step_x - xe) / s);
@@ -640,9 +641,8 @@ static double beam_path_absorbed(const ppb_scene *sc, double xe)
         double len = seg[k][1] - seg[k][0];
         if (len <= 0.0)
             continue;
-        double xm = xe + 0.5 * (seg[k][0] + seg[k][1]) * s;
-        double st = ppb_sigma_t_at(xm, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-        double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+        double st, al;
+        ppb_piece_medium(&M, xe, s, seg[k][0], seg[k][1], &st, &al);
         sum += (1.0 - al) * exp(-tau) * -expm1(-st * len);
         tau += st * len;
     }
@@ -660,12 +660,8 @@ static double path_absorbed(const ppb_scene *sc, double x_entry, void *arg)
 static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
 {
     const double *fc = arg;
-    double st = sc->geometry == PPB_GEOM_TUBE
-                    ? ppb_sigma_t_at(xe, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right)
-                    : sc->sigma_t;
-    double al = sc->geometry == PPB_GEOM_TUBE
-                    ? ppb_albedo_at(xe, sc->step, sc->step_x, sc->albedo, sc->albedo_right)
-                    : sc->albedo;
+    ppb_medium M = ppb_medium_of(sc); /* slab: no step, sigma_t and alpha everywhere */
+    double st = ppb_medium_sigma_t(&M, xe), al = ppb_medium_albedo(&M, xe);
     double e = exp(-st * sc->height / fc[1]);
     return (1.0 - al) * (1.0 - e) / (1.0 - fc[0] * e);
 }
@@ -678,6 +674,7 @@ static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
 static double fresnel_walk_absorbed(const ppb_scene *sc, double x_e, void *arg)
 {
     const ppb_fresnel_beam *b = arg;
+    ppb_medium M = ppb_medium_of(sc);
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
     double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, out = 0.0;
     for (int hit = 0; hit < 100000 && w > 1e-16; hit++) {
@@ -692,9 +689,8 @@ static double fresnel_walk_absorbed(const ppb_scene *sc, double x_e, void *arg)
                 cut[1] = ls, nc = 3;
         }
         for (int k = 0; k + 1 < nc; k++) {
-            double xm = x + 0.5 * (cut[k] + cut[k + 1]) * dx;
-            double st = ppb_sigma_t_at(xm, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-            double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+            double st, al;
+            ppb_piece_medium(&M, x, dx, cut[k], cut[k + 1], &st, &al);
             double lost = -expm1(-st * (cut[k + 1] - cut[k]));
             out += w * (1.0 - al) * lost;
             w *= 1.0 - lost;
