@@ -86,7 +86,7 @@ static void maps_grid(const ppb_scene *sc, int map_res, ppb_maps *m)
          * for the paths of S3's lower end; step_x = 0 then lies on a column edge too. Of the
          * `left` columns beyond -W/2, all in shadow, only the nearest is stored (maps.h). */
         int left = (int)ceil(sc->height * m->tan_theta_l * map_res - 1e-9);
-        m->xp0 = -0.5 * sc->width - left * m->h;
+        m->xp0 = ppb_face_line(PPB_S3, sc->width, sc->height) - left * m->h;
         m->i0 = left > 0 ? left - 1 : 0;
         m->nx = left - m->i0 + (int)ceil(sc->width * map_res - 1e-9);
     } else {
@@ -179,7 +179,8 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
      * those breaks never sample a break and are exact to ~1e-14 for these exponentials. */
     double t = ppb_scene_tan_theta_l(sc), brk[5] = {a, b, 0, 0, 0};
     int nb = 2;
-    double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
+    double cand[3] = {ppb_face_line(PPB_S4, sc->width, sc->height) - sc->height * t, sc->step_x,
+                      sc->step_x - sc->height * t};
     for (int k = 0; k < 3; k++)
         if (cand[k] > a && cand[k] < b)
             brk[nb++] = cand[k];

@@ -288,19 +288,19 @@ inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, dou
                       double delta, double vk, __global const double *sig, __global const double *Q,
                       __global double *tal, __global double *bout, __global double *scr, int mode)
 {
-    double hw = 0.5 * P->med.width, p0x = -uy * vk, p0y = ux * vk;
+    double W = P->med.width, H = P->med.height, p0x = -uy * vk, p0y = ux * vk;
+    /* Where the line crosses the lines of S3/S4 (tx) and S1/S2 (ty), ascending in t: it leaves
+     * through the face u moves toward (ppb_tube.h) and came in through the opposite one. */
     double txa = -INFINITY, txb = INFINITY, tya = -INFINITY, tyb = INFINITY;
     if (ux != 0.0) {
-        double a = (-hw - p0x) / ux, b = (hw - p0x) / ux;
-        txa = fmin(a, b);
-        txb = fmax(a, b);
-    } else if (p0x <= -hw || p0x >= hw)
+        txa = -ppb_tube_length_x(W, p0x, -ux);
+        txb = ppb_tube_length_x(W, p0x, ux);
+    } else if (p0x <= ppb_face_line(PPB_S3, W, H) || p0x >= ppb_face_line(PPB_S4, W, H))
         return;
     if (uy != 0.0) {
-        double a = -p0y / uy, b = (-P->med.height - p0y) / uy;
-        tya = fmin(a, b);
-        tyb = fmax(a, b);
-    } else if (p0y >= 0.0 || p0y <= -P->med.height)
+        tya = -ppb_tube_length_y(H, p0y, -uy);
+        tyb = ppb_tube_length_y(H, p0y, uy);
+    } else if (p0y >= ppb_face_line(PPB_S1, W, H) || p0y <= ppb_face_line(PPB_S2, W, H))
         return;
     double tin = fmax(txa, tya), tout = fmin(txb, tyb);
     if (!(tout > tin))
