@@ -10,7 +10,7 @@
 #ifndef PPB_MARCH_PARAMS_H
 #define PPB_MARCH_PARAMS_H
 
-#include "ppb_conventions.h"
+#include "ppb_tube.h"
 
 #ifdef __OPENCL_VERSION__
 #define PPB_GMEM __global
@@ -52,12 +52,11 @@ enum {
     PPB_MAP_STRIDE = 12 /* PPB_MAP_NFIELD x 4 corners */
 };
 
-/* Parameters of one launch, passed by value. All doubles first, then an even number of ints, so
- * host and device agree on the layout without packing attributes; the host asserts the size. */
+/* Parameters of one launch, passed by value. The medium block, then all doubles, then an even
+ * number of ints, so host and device agree on the layout without packing attributes; the host
+ * asserts the size. */
 typedef struct ppb_march_params {
-    /* scene (reference: Medium to Light) */
-    double width, height; /* W (tube only), H */
-    double sigma_t, sigma_t_right, albedo, albedo_right, step_x;
+    ppb_medium med; /* the cross-section and the medium (reference: Medium to Light) */
     double tan_theta_l, cos_theta_l; /* light incidence */
     double light_x, light_y;         /* w_L = (light_x, light_y, 0) */
     /* map: light-aligned grid over x' = x + y tan(theta_L) and depth -y */
@@ -67,17 +66,15 @@ typedef struct ppb_march_params {
     double tau0[PPB_MARCH_MAX_COLS], tau_h[PPB_MARCH_MAX_COLS];
     double alb0, alb_h;
     /* march */
-    double step;  /* ray-march step length, mfp */
+    double ds;    /* ray-march step length, mfp (`pp.step`) */
     double d_cap; /* optical distance from the exit point beyond which the march stops */
-    /* refractive boundaries (issue 18; reference: Keys, `medium.n`): n <= 1 skips them all.
+    /* refractive boundaries (reference: Keys, `medium.n`): med.n <= 1 skips them all.
      * At n > 1 the light fields above (tan/cos_theta_l, light_x/y) are the refracted beam's
      * inside; beam_in is its perpendicular irradiance inside per unit E_perp in air,
      * (1 - F(cos theta_L)) cos theta_L / cos theta_t, and beam_fb = F(cos theta_t, 1/n) the
      * reflectance it meets at S2 and S1, beam_fs = F(sin theta_t, 1/n) the one at a side wall
      * (1 under total internal reflection). */
-    double n, g, beam_in, beam_fb, beam_fs;
-    int tube; /* 1 tube, 0 slab */
-    int step_kind;
+    double beam_in, beam_fb, beam_fs;
     int map_nx, map_ny; /* cells stored */
     int map_i0;         /* grid column of the first stored cell column (maps.h) */
     int map_pad;        /* unused: keeps the count of ints even */
@@ -93,37 +90,6 @@ typedef struct ppb_march_params {
     int nseg[4];   /* segments per surface (slab: 1, 1, 0, 0) */
     int offset[4]; /* first segment row of each surface, as ppb_layout */
 } ppb_march_params;
-
-/* Direction sample (a, b) of bin (itheta, iphi) on surface surf: the stratified midpoints of an
- * n x n grid in (sin^2 theta, phi), i.e. uniform in projected solid angle (reference: Bins). */
-PPB_FN void ppb_march_dir(int surf, int bin, int a, int b, int n, int ntheta, int nphi, double *wx,
-                          double *wy, double *wz)
-{
-    ppb_bin_direction(surf, bin / nphi, bin % nphi, (a + 0.5) / n, (b + 0.5) / n, ntheta, nphi, wx,
-                      wy, wz);
-}
-
-/* Column of the integral tables that belongs to that direction sample. */
-PPB_FN int ppb_march_dir_index(int surf, int bin, int a, int b, int n, int nbins)
-{
-    return ((surf * nbins + bin) * n + a) * n + b;
-}
-
-/* Direction samples in the tables: every sample of every bin of every surface. */
-PPB_FN int ppb_march_ndir(int nsurf, int nbins, int n)
-{
-    return nsurf * nbins * n * n;
-}
-
-/* The inverse of ppb_march_dir_index: surface, bin and sample (a, b) of table column dir. */
-PPB_FN void ppb_march_dir_split(int dir, int n, int nbins, int *surf, int *bin, int *a, int *b)
-{
-    int per_bin = n * n, ab = dir % per_bin;
-    *surf = dir / (nbins * per_bin);
-    *bin = dir / per_bin % nbins;
-    *a = ab / n;
-    *b = ab % n;
-}
 
 /* Table layout: R and S are [column][albedo node][direction][tau node] with ntau[c] tau nodes
  * in column c, C is [column][albedo node][direction]. First element of block (c, node) in R and

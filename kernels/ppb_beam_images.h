@@ -15,7 +15,7 @@
 #ifndef PPB_BEAM_IMAGES_H
 #define PPB_BEAM_IMAGES_H
 
-#include "ppb_conventions.h"
+#include "ppb_tube.h"
 
 /* The image series' stopping tolerance, relative to what has been summed: 2^-60, 64 times below
  * the half ulp (2^-54 of the sum at least) under which a term leaves a double sum unchanged. */
@@ -41,33 +41,38 @@ inline double ppb_beam_step(double C, double sigma_t, double h, double e_a, doub
     return C * exp(e_a) * sigma_t * h * ppb_phi1(z);
 }
 
+/* The phase coefficients cb of ppb_beam_images for light leaving along v = (vx, vy, .): HG of
+ * the angle between v and each of the beam's four directions inside, (st, -ct) (+sin, down),
+ * (st, ct) (+sin, up), (-st, -ct) (-sin, down) and (-st, ct) (-sin, up), st, ct = sin, cos
+ * theta_t. */
+inline void ppb_beam_phases(double g, double st, double ct, double vx, double vy, double *cb)
+{
+    cb[0] = ppb_hg_phase(g, vx * st - vy * ct);
+    cb[1] = ppb_hg_phase(g, vx * st + vy * ct);
+    cb[2] = ppb_hg_phase(g, -vx * st - vy * ct);
+    cb[3] = ppb_hg_phase(g, -vx * st + vy * ct);
+}
+
 /* The refracted beam inside the tube (n > 1), as both kernels' parameters hold it. */
 typedef struct ppb_beam_tube {
-    double width, height;                  /* W, H */
-    double step_x, sigma_t, sigma_t_right; /* sigma_t_right at x >= step_x (density step) */
-    double sin_t, cos_t, tan_t;            /* the beam's direction (sin, -cos) inside */
-    double beam_in;                        /* its perpendicular irradiance inside */
-    double beam_fb, beam_fs;               /* F at S1, S2 and at S3, S4 from inside */
-    double d_cap;                          /* optical distance where a march stops */
-    int step_kind;
+    ppb_medium med;             /* the cross-section and the medium (ppb_medium.h) */
+    double sin_t, cos_t, tan_t; /* the beam's direction (sin, -cos) inside */
+    double beam_in;             /* its perpendicular irradiance inside */
+    double beam_fb, beam_fs;    /* F at S1, S2 and at S3, S4 from inside */
+    double d_cap;               /* optical distance where a march stops */
 } ppb_beam_tube;
 
 /* The beam of a kernel's launch parameters P (march_params.h, rte2d_params.h: the same field
  * names but the sine of the beam's angle, SIN: light_x in march's, sin_theta_l in rte2d's). */
 #define PPB_BEAM_TUBE(P, SIN)                                                                      \
-    ((ppb_beam_tube){.width = (P)->width,                                                          \
-                     .height = (P)->height,                                                        \
-                     .step_x = (P)->step_x,                                                        \
-                     .sigma_t = (P)->sigma_t,                                                      \
-                     .sigma_t_right = (P)->sigma_t_right,                                          \
+    ((ppb_beam_tube){.med = (P)->med,                                                              \
                      .sin_t = (P)->SIN,                                                            \
                      .cos_t = (P)->cos_theta_l,                                                    \
                      .tan_t = (P)->tan_theta_l,                                                    \
                      .beam_in = (P)->beam_in,                                                      \
                      .beam_fb = (P)->beam_fb,                                                      \
                      .beam_fs = (P)->beam_fs,                                                      \
-                     .d_cap = (P)->d_cap,                                                          \
-                     .step_kind = (P)->step_kind})
+                     .d_cap = (P)->d_cap})
 
 /* The unfolded tube's right medium (ppb_beam_images): tile (k, j) holds the cross-section
  * mirrored in x when k is odd, so the real x >= step_x = s is x' >= kW + s in an even tile and
@@ -85,9 +90,10 @@ inline double ppb_image_right(double x, double s, double W)
  * (G(x') - G(x_e)) / sin theta_t lies in the right medium's images (ppb_image_right). */
 inline double ppb_image_depth(const ppb_beam_tube *B, double xp, double xe, double dp)
 {
-    double W = B->width, s = B->step_x;
-    return B->sigma_t * dp / B->cos_t + (B->sigma_t_right - B->sigma_t) / B->sin_t *
-                                            (ppb_image_right(xp, s, W) - ppb_image_right(xe, s, W));
+    double W = B->med.width, s = B->med.step_x;
+    return B->med.sigma_t * dp / B->cos_t +
+           (B->med.sigma_t_right - B->med.sigma_t) / B->sin_t *
+               (ppb_image_right(xp, s, W) - ppb_image_right(xe, s, W));
 }
 
 /* The tube at oblique incidence (n > 1): the beam meets the side walls too. Unfolded by the
@@ -108,14 +114,14 @@ inline double ppb_image_depth(const ppb_beam_tube *B, double xp, double xe, doub
 inline double ppb_beam_images(const ppb_beam_tube *B, const double *cb, double px, double py,
                               double mx, double my, double la, double lb, double sigma_t, double d0)
 {
-    double W = B->width, H = B->height, ct = B->cos_t, tn = B->tan_t;
-    double lo = -0.5 * W, hi = B->step_kind == PPB_STEP_SHADOW ? fmin(0.5 * W, B->step_x) : 0.5 * W;
+    double W = B->med.width, H = B->med.height, ct = B->cos_t, tn = B->tan_t;
+    double lo = -0.5 * W, hi = ppb_tube_lit_hi(&B->med); /* S1's lit part */
     if (!(hi > lo))
         return 0.0;
     /* Image j's beam has come at least j H / cos theta_t, through the lesser sigma_t at worst;
      * with the ray's own d0 beyond d_cap it counts for nothing. */
-    int step = B->step_kind == PPB_STEP_DENSITY && B->sigma_t_right != B->sigma_t;
-    double sig_beam = step ? fmin(B->sigma_t, B->sigma_t_right) : sigma_t;
+    int step = B->med.step == PPB_STEP_DENSITY && B->med.sigma_t_right != B->med.sigma_t;
+    double sig_beam = step ? fmin(B->med.sigma_t, B->med.sigma_t_right) : sigma_t;
     int jmax = (int)ceil((B->d_cap - d0) * ct / (sig_beam * H));
     /* The contribution bound (docs/reference.md: Methods, ss at n > 1): term (k, j) is at
      * most beam_in F_b^j F_s^k c_max sigma_t (lb - la) e^{-d0} e^{-j a}, a = sig_beam H / cos
@@ -166,7 +172,7 @@ inline double ppb_beam_images(const ppb_beam_tube *B, const double *cb, double p
             double cut[3] = {l1, l2, l2};
             int ncut = 2;
             if (xel != 0.0) {
-                double ls = (B->step_x - xe0) / xel;
+                double ls = (B->med.step_x - xe0) / xel;
                 if (ls > l1 && ls < l2)
                     cut[1] = ls, ncut = 3;
             }

@@ -70,15 +70,22 @@ PPB_FN int ppb_phi_bin(double wt, double wb, int nphi)
     return k < 0 ? 0 : (k >= nphi ? nphi - 1 : k);
 }
 
+/* The bin of theta bin itheta and phi bin iphi: bin = itheta * nphi + iphi, so itheta =
+ * bin / nphi and iphi = bin % nphi (reference: Bins). */
+PPB_FN int ppb_bin_index(int itheta, int iphi, int nphi)
+{
+    return itheta * nphi + iphi;
+}
+
 /* Bin of an outgoing direction w = (wx, wy, wz) leaving surface surf. */
 PPB_FN int ppb_dir_bin(int surf, double wx, double wy, double wz, int ntheta, int nphi)
 {
     double mu = wx * ppb_normal_x(surf) + wy * ppb_normal_y(surf);
     double wt = wx * ppb_tangent_x(surf) + wy * ppb_tangent_y(surf);
-    return ppb_theta_bin(mu, ntheta) * nphi + ppb_phi_bin(wt, wz, nphi);
+    return ppb_bin_index(ppb_theta_bin(mu, ntheta), ppb_phi_bin(wt, wz, nphi), nphi);
 }
 
-/* Direction bins per surface point; bin = theta_bin * nphi + phi_bin. */
+/* Direction bins per surface point (ppb_bin_index). */
 PPB_FN int ppb_bin_count(int ntheta, int nphi)
 {
     return ntheta * nphi;
@@ -124,27 +131,36 @@ PPB_FN void ppb_bin_direction(int surf, int itheta, int iphi, double u, double v
     *wz = wb;
 }
 
-/* Segment centres (reference: Geometry): S1/S2 numbered along x from -W/2, S3/S4 along y from -H.
- * Returns the coordinate s along the surface; (x, y) is the point. Slab mode uses s = 0. */
-PPB_FN double ppb_segment_centre(int surf, int seg, int nseg, double width, double height,
-                                 double *x, double *y)
+/* The stratified direction samples of the deterministic marchers (`pp`, `ss`, `rte2d`;
+ * reference: Bins): sample (a, b) of bin `bin` on surface surf is the midpoint of cell (a, b) of
+ * an n x n grid in (sin^2 theta, phi), i.e. uniform in projected solid angle. */
+PPB_FN void ppb_bin_sample_dir(int surf, int bin, int a, int b, int n, int ntheta, int nphi,
+                               double *wx, double *wy, double *wz)
 {
-    if (surf == PPB_S1 || surf == PPB_S2) {
-        double s = -0.5 * width + (seg + 0.5) * width / nseg;
-        *x = s;
-        *y = surf == PPB_S1 ? 0.0 : -height;
-        return s;
-    }
-    double s = -height + (seg + 0.5) * height / nseg;
-    *x = surf == PPB_S3 ? -0.5 * width : 0.5 * width;
-    *y = s;
-    return s;
+    ppb_bin_direction(surf, bin / nphi, bin % nphi, (a + 0.5) / n, (b + 0.5) / n, ntheta, nphi, wx,
+                      wy, wz);
 }
 
-/* Length of one segment of a tube surface: W / nseg on S1 and S2, H / nseg on S3 and S4. */
-PPB_FN double ppb_segment_length(int surf, int nseg, double width, double height)
+/* The samples' flat index (the marchers' tables and source planes are in this order). */
+PPB_FN int ppb_bin_sample_index(int surf, int bin, int a, int b, int n, int nbins)
 {
-    return (surf == PPB_S1 || surf == PPB_S2 ? width : height) / nseg;
+    return ((surf * nbins + bin) * n + a) * n + b;
+}
+
+/* Samples of every bin of nsurf surfaces. */
+PPB_FN int ppb_bin_sample_count(int nsurf, int nbins, int n)
+{
+    return nsurf * nbins * n * n;
+}
+
+/* The inverse of ppb_bin_sample_index: surface, bin and sample (a, b) of index dir. */
+PPB_FN void ppb_bin_sample_split(int dir, int n, int nbins, int *surf, int *bin, int *a, int *b)
+{
+    int per_bin = n * n, ab = dir % per_bin;
+    *surf = dir / (nbins * per_bin);
+    *bin = dir / per_bin % nbins;
+    *a = ab / n;
+    *b = ab % n;
 }
 
 /* The surface and segment of layout row `row`: surface s holds the rows [offset[s], offset[s] +
@@ -157,42 +173,6 @@ PPB_FN int ppb_row_surface(int row, const int *offset, const int *nseg, int *seg
             surf = s;
     *seg = surf < 0 ? 0 : row - offset[surf];
     return surf;
-}
-
-/* Point ip of npts spread evenly along segment seg, where a deterministic method averages the
- * segment (reference: Bins); slab mode: the one point of the face, at x = 0. */
-PPB_FN void ppb_segment_sample(int tube, int surf, int seg, int nseg, double width, double height,
-                               int ip, int npts, double *px, double *py)
-{
-    double cx = 0.0, cy = surf == PPB_S1 ? 0.0 : -height, seglen = 0.0;
-    int along_x = surf == PPB_S1 || surf == PPB_S2;
-    if (tube) {
-        ppb_segment_centre(surf, seg, nseg, width, height, &cx, &cy);
-        seglen = ppb_segment_length(surf, nseg, width, height);
-    }
-    double o = ((ip + 0.5) / npts - 0.5) * seglen;
-    *px = cx + (along_x ? o : 0.0);
-    *py = cy + (along_x ? 0.0 : o);
-}
-
-/* Length of the ray from (px, py) along the in-plane direction (mx, my) (per unit 3-D length)
- * to where it leaves the cross-section: through S1 or S2, or a side wall in the tube. INFINITY
- * for a ray parallel to a slab's faces. */
-PPB_FN double ppb_exit_length(int tube, double width, double height, double px, double py,
-                              double mx, double my)
-{
-    double l = INFINITY;
-    if (my > 0.0)
-        l = -py / my;
-    else if (my < 0.0)
-        l = (-height - py) / my;
-    if (tube) {
-        if (mx > 0.0)
-            l = fmin(l, (0.5 * width - px) / mx);
-        else if (mx < 0.0)
-            l = fmin(l, (-0.5 * width - px) / mx);
-    }
-    return l;
 }
 
 /* Segment holding coordinate s along a surface of length len starting at s0. */

@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "methods/pp/march.h"
+#include "physics/totals.h"
 #include "methods/pp/method_pp.h"
 #include "physics/ppsolver.h"
 
@@ -98,8 +99,8 @@ static void test_ss_slab_closed_form(void **state)
                     for (int a = 0; a < n; a++)
                         for (int b = 0; b < n; b++) {
                             double w[3];
-                            ppb_march_dir(surf, bin, a, b, n, sc.ntheta, sc.nphi, &w[0], &w[1],
-                                          &w[2]);
+                            ppb_bin_sample_dir(surf, bin, a, b, n, sc.ntheta, sc.nphi, &w[0], &w[1],
+                                               &w[2]);
                             ref += ss_slab_closed(&sc, surf, w) / (n * n);
                         }
                     assert_close(rad[ppb_cell(&lo, surf, 0, bin)], ref, 1e-9 * ref + 1e-14);
@@ -121,8 +122,9 @@ static void assert_mirror_symmetric(const ppb_scene *sc, const double *rad, doub
             int mseg = surf <= PPB_S2 ? lo.nseg[surf] - 1 - seg : seg;
             for (int it = 0; it < sc->ntheta; it++)
                 for (int ip = 0; ip < sc->nphi; ip++) {
-                    double v = rad[ppb_cell(&lo, surf, seg, it * sc->nphi + ip)];
-                    double m = rad[ppb_cell(&lo, msurf, mseg, it * sc->nphi + sc->nphi - 1 - ip)];
+                    double v = rad[ppb_cell(&lo, surf, seg, ppb_bin_index(it, ip, sc->nphi))];
+                    double m = rad[ppb_cell(&lo, msurf, mseg,
+                                            ppb_bin_index(it, sc->nphi - 1 - ip, sc->nphi))];
                     worst = fmax(worst, fabs(v - m));
                     scale = fmax(scale, fabs(v));
                 }
@@ -188,7 +190,7 @@ static double solver_bin(const pp_solution *sol, const ppb_scene *sc, int surf, 
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++) {
             double w[3];
-            ppb_march_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
             sum += pp_radiance(sol, surf == PPB_S1 ? 0.0 : sc->sigma_t * sc->height, w);
         }
     return sum / (n * n);
@@ -308,7 +310,7 @@ static void test_pp_slab_totals(void **state)
     double *rad = march(&sc, &tab, o);
     ppb_layout lo = ppb_scene_layout(&sc);
     ppb_totals t;
-    ppb_march_totals(&sc, &lo, rad, &t);
+    ppb_bin_totals(&sc, &lo, rad, &t);
     double R, T, B;
     pp_totals(sol, &R, &T, &B);
     printf("    slab totals: march R %.5f T %.5f, solver R %.5f T %.5f\n", t.R, t.T, R, T);
@@ -394,7 +396,7 @@ static double col_solver_bin(const pp_solution *sol, double tau0, const ppb_scen
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++) {
             double w[3];
-            ppb_march_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
             sum += pp_radiance(sol, surf == PPB_S1 ? 0.0 : tau0, w);
         }
     return sum / (n * n);
@@ -408,7 +410,7 @@ static int bin_stays_in_column(const ppb_scene *sc, int surf, int bin, int n, do
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++) {
             double w[3];
-            ppb_march_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
             double xf = x - sc->height / fabs(w[1]) * w[0]; /* where -w meets the far face */
             if (!(x > lo + 1e-9 && x < hi - 1e-9 && xf > lo + 1e-9 && xf < hi - 1e-9))
                 return 0;
@@ -554,19 +556,19 @@ static void assert_tables_identical(const ppb_march_tables *a, const ppb_march_t
 static void test_shared_layout(void **state)
 {
     (void)state;
-    /* Table directions: ppb_march_dir_index is a bijection onto [0, ndir) and
-     * ppb_march_dir_split its inverse. */
+    /* Table directions: ppb_bin_sample_index is a bijection onto [0, ndir) and
+     * ppb_bin_sample_split its inverse. */
     enum { NSURF = 4, NBINS = 6, N = 3 };
-    int ndir = ppb_march_ndir(NSURF, NBINS, N), seen[NSURF * NBINS * N * N] = {0};
+    int ndir = ppb_bin_sample_count(NSURF, NBINS, N), seen[NSURF * NBINS * N * N] = {0};
     assert_int_equal(ndir, NSURF * NBINS * N * N);
     for (int surf = 0; surf < NSURF; surf++)
         for (int bin = 0; bin < NBINS; bin++)
             for (int a = 0; a < N; a++)
                 for (int b = 0; b < N; b++) {
-                    int dir = ppb_march_dir_index(surf, bin, a, b, N, NBINS), s2, bin2, a2, b2;
+                    int dir = ppb_bin_sample_index(surf, bin, a, b, N, NBINS), s2, bin2, a2, b2;
                     assert_in_range(dir, 0, ndir - 1);
                     seen[dir]++;
-                    ppb_march_dir_split(dir, N, NBINS, &s2, &bin2, &a2, &b2);
+                    ppb_bin_sample_split(dir, N, NBINS, &s2, &bin2, &a2, &b2);
                     assert_int_equal(s2, surf);
                     assert_int_equal(bin2, bin);
                     assert_int_equal(a2, a);

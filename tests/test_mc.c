@@ -260,7 +260,7 @@ static void test_single_scattering(void **state)
             avg += alpha / (4 * PPB_PI) * lr_shape(mu, tau) / m;
         }
         for (int ip = 0; ip < f.cfg.scene.nphi; ip++) {
-            size_t c = ppb_cell(&lo, PPB_S1, 0, it * f.cfg.scene.nphi + ip);
+            size_t c = ppb_cell(&lo, PPB_S1, 0, ppb_bin_index(it, ip, f.cfg.scene.nphi));
             double z = (mc1.radiance[c] - avg) / mc1.se[c];
             chi2 += z * z;
         }
@@ -451,8 +451,8 @@ static void test_mirror_symmetry(void **state)
             int mseg = (s == PPB_S1 || s == PPB_S2) ? lo.nseg[s] - 1 - seg : seg;
             for (int it = 0; it < nth; it++)
                 for (int ip = 0; ip < nphi; ip++)
-                    map[ppb_cell(&lo, s, seg, it * nphi + ip)] =
-                        ppb_cell(&lo, ms, mseg, it * nphi + (nphi - 1 - ip));
+                    map[ppb_cell(&lo, s, seg, ppb_bin_index(it, ip, nphi))] =
+                        ppb_cell(&lo, ms, mseg, ppb_bin_index(it, nphi - 1 - ip, nphi));
         }
     }
     int count;
@@ -695,13 +695,13 @@ static void test_vector_bins_match_conventions(void **state)
             const int *lo = layouts[j];
             ppb_mc_params p = {0};
             p.seed = 0x9e3779b97f4a7c15ull + (cl_ulong)j;
-            p.tube = lo[4];
+            p.med.tube = lo[4];
             p.ntheta = lo[0], p.nphi = lo[1];
             p.nseg[0] = p.nseg[1] = lo[2];
-            p.nseg[2] = p.nseg[3] = p.tube ? lo[3] : 0;
+            p.nseg[2] = p.nseg[3] = p.med.tube ? lo[3] : 0;
             p.offset[0] = 0, p.offset[1] = lo[2], p.offset[2] = 2 * lo[2];
             p.offset[3] = 2 * lo[2] + p.nseg[2];
-            p.width = 4.0f, p.height = 2.5f;
+            p.med.width = 4.0, p.med.height = 2.5;
             cl_uint counts[3] = {0, 0, 0};
             cl_int rc;
             cl_mem buf = clCreateBuffer(ocl->context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,

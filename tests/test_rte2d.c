@@ -256,7 +256,7 @@ static void test_slab_matches_ppslab_n14(void **state)
  * flat-source sweep conserves in every region for the tracks it lays (rte2d.cl, ppb_rte_moc),
  * the walls reflect exactly what they do not transmit, and the beam enters as its exact region
  * integrals (rte2d_beam.h) while ballistic and specular come from their own closed forms
- * (ppb_march_totals): so the sum misses 1 by the solve's residual alone, within 1e-6 at the
+ * (ppb_bin_totals): so the sum misses 1 by the solve's residual alone, within 1e-6 at the
  * default tolerance (1e-7), on a coarse grid as on a fine one, for every geometry, light,
  * step and boundary. (The nodal scheme before it missed by -3.3e-3 at the study's defaults.) */
 static void test_energy_balance(void **state)

@@ -122,7 +122,7 @@ static void write_angular_cell(FILE *f, const ppb_scene *sc, const ppb_result *r
     int np = ppb_cell_points(lo, cell, pts, cap);
     for (int it = 0; np > 0 && it < sc->ntheta; it++)
         for (int ip = 0; ip < sc->nphi; ip++) {
-            int b = it * sc->nphi + ip;
+            int b = ppb_bin_index(it, ip, sc->nphi);
             double sum = 0.0, var = 0.0;
             for (int i = 0; i < np; i++) {
                 size_t c = ppb_cell(lo, pts[i].surf, pts[i].seg, b);

@@ -4,6 +4,8 @@
 #include <float.h>
 #include <math.h>
 
+#include "kernels/ppb_tube.h"
+
 /* Directions toward the camera of the paper-style views, in world coordinates: from the left
  * (-x) and the front (+z) so the near cap and S3 show, and from above (+y, S1) or below (-y,
  * S2). Elevation ~44 deg, so S1/S2 and S3 are both seen at a useful slant. */
@@ -38,10 +40,10 @@ static int normalize3(double a[3])
 /* Box bounds per axis: [lo, hi] of x, y, z. */
 static void box_bounds(const ppb_tube_view *v, double lo[3], double hi[3])
 {
-    lo[0] = -0.5 * v->width;
-    hi[0] = 0.5 * v->width;
-    lo[1] = -v->height;
-    hi[1] = 0.0;
+    lo[0] = ppb_face_line(PPB_S3, v->width, v->height);
+    hi[0] = ppb_face_line(PPB_S4, v->width, v->height);
+    lo[1] = ppb_face_line(PPB_S2, v->width, v->height);
+    hi[1] = ppb_face_line(PPB_S1, v->width, v->height);
     lo[2] = -v->half_len;
     hi[2] = v->half_len;
 }
@@ -165,9 +167,7 @@ size_t ppb_tube_view_cell(const ppb_tube_view *v, const ppb_layout *lo, const pp
     int top = h->surf == PPB_S1 || h->surf == PPB_S2;
     /* s along the surface as the reference numbers segments (Geometry): x from -W/2, y from -H. */
     double s = top ? h->p[0] : h->p[1];
-    double s0 = top ? -0.5 * v->width : -v->height;
-    double len = top ? v->width : v->height;
-    int seg = ppb_segment_of(s, s0, len, lo->nseg[h->surf]);
+    int seg = ppb_segment_at(h->surf, s, lo->nseg[h->surf], v->width, v->height);
     /* The radiance a pixel shows leaves the surface toward the camera, along to_cam. */
     int bin = ppb_dir_bin(h->surf, v->to_cam[0], v->to_cam[1], v->to_cam[2], v->ntheta, v->nphi);
     return ppb_cell(lo, h->surf, seg, bin);

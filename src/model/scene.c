@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "kernels/ppb_tube.h"
+
 ppb_layout ppb_scene_layout(const ppb_scene *sc)
 {
     ppb_layout lo = {0};

@@ -9,6 +9,7 @@
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
 #include "kernels/ppb_sort.h"
+#include "physics/medium.h"
 
 /* Fraction of a straight path whose x runs from x0 to x1 that lies right of the step
  * (x >= step_x); a vertical path is wholly on one side. */
@@ -67,8 +68,8 @@ void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, do
     }
     /* Reference: Light: lit only if the path meets S1 inside its lit part; for theta_L >= 0 a
      * path that would meet S1's plane left of -W/2 leaves through S3 first. */
-    *lit = xp >= -0.5 * sc->width && xp <= 0.5 * sc->width &&
-           !(sc->step == PPB_STEP_SHADOW && xp >= sc->step_x);
+    ppb_medium M = ppb_medium_of(sc);
+    *lit = ppb_tube_lit_at(&M, xp, 0.0) && xp <= ppb_face_line(PPB_S4, sc->width, sc->height);
 }
 
 /* The grid of the maps without its cells (ppb_maps_build, ppb_maps_bytes). */
@@ -85,7 +86,7 @@ static void maps_grid(const ppb_scene *sc, int map_res, ppb_maps *m)
          * for the paths of S3's lower end; step_x = 0 then lies on a column edge too. Of the
          * `left` columns beyond -W/2, all in shadow, only the nearest is stored (maps.h). */
         int left = (int)ceil(sc->height * m->tan_theta_l * map_res - 1e-9);
-        m->xp0 = -0.5 * sc->width - left * m->h;
+        m->xp0 = ppb_face_line(PPB_S3, sc->width, sc->height) - left * m->h;
         m->i0 = left > 0 ? left - 1 : 0;
         m->nx = left - m->i0 + (int)ceil(sc->width * map_res - 1e-9);
     } else {
@@ -159,8 +160,8 @@ double ppb_beam_depth(const ppb_scene *sc, double xe)
     /* It leaves through S2, or through S4 when oblique light reaches x = W/2 first. */
     double t = ppb_scene_tan_theta_l(sc);
     double xb = xe + sc->height * t, yb = -sc->height;
-    if (xb > 0.5 * sc->width) {
-        xb = 0.5 * sc->width;
+    if (xb > ppb_face_line(PPB_S4, sc->width, sc->height)) {
+        xb = ppb_face_line(PPB_S4, sc->width, sc->height);
         yb = -(xb - xe) / t;
     }
     return ppb_segment_optical_depth(sc, xe, 0.0, xb, yb);
@@ -168,9 +169,8 @@ double ppb_beam_depth(const ppb_scene *sc, double xe)
 
 double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *width)
 {
-    double a = -0.5 * sc->width, b = 0.5 * sc->width;
-    if (sc->step == PPB_STEP_SHADOW)
-        b = fmin(b, sc->step_x);
+    ppb_medium M = ppb_medium_of(sc);
+    double a = ppb_face_line(PPB_S3, sc->width, sc->height), b = ppb_tube_lit_hi(&M);
     *width = b > a ? b - a : 0.0;
     if (b <= a)
         return 0.0;
@@ -179,7 +179,8 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
      * those breaks never sample a break and are exact to ~1e-14 for these exponentials. */
     double t = ppb_scene_tan_theta_l(sc), brk[5] = {a, b, 0, 0, 0};
     int nb = 2;
-    double cand[3] = {0.5 * sc->width - sc->height * t, sc->step_x, sc->step_x - sc->height * t};
+    double cand[3] = {ppb_face_line(PPB_S4, sc->width, sc->height) - sc->height * t, sc->step_x,
+                      sc->step_x - sc->height * t};
     for (int k = 0; k < 3; k++)
         if (cand[k] > a && cand[k] < b)
             brk[nb++] = cand[k];
@@ -201,9 +202,8 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
 
 double ppb_lit_midpoint_sum(const ppb_scene *sc, ppb_entry_fn f, void *arg, int np, double *width)
 {
-    double a = -0.5 * sc->width, hi = 0.5 * sc->width;
-    if (sc->step == PPB_STEP_SHADOW)
-        hi = fmin(hi, sc->step_x);
+    ppb_medium M = ppb_medium_of(sc);
+    double a = ppb_face_line(PPB_S3, sc->width, sc->height), hi = ppb_tube_lit_hi(&M);
     *width = hi > a ? hi - a : 0.0;
     if (!(hi > a))
         return 0.0;

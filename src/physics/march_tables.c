@@ -13,17 +13,18 @@
 #include "kernels/march_params.h"
 #include "kernels/ppb_fresnel.h"
 
-/* Direction sample `dir` in the table order of ppb_march_dir_index. At n > 1 (issue 18) the
+/* Direction sample `dir` in the table order of ppb_bin_sample_index. At n > 1 (issue 18) the
  * tables hold nvar variants of every sample, variant v at dir + v ndir_base: the air-side sample
  * mapped inside by Snell (kernels/ppb_fresnel.h: ppb_inside_dir), mirrored in y when v & 1 and in
  * x when v & 2: the directions of the viewing ray's legs after its reflections (march.cl). */
 static void table_dir(const ppb_scene *sc, int nsamp, int dir, double w[3])
 {
     int surf, bin, a, b, nbins = ppb_bin_count(sc->ntheta, sc->nphi);
-    int nbase = ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE), nbins, nsamp);
+    int nbase =
+        ppb_bin_sample_count(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE), nbins, nsamp);
     int var = dir / nbase;
-    ppb_march_dir_split(dir % nbase, nsamp, nbins, &surf, &bin, &a, &b);
-    ppb_march_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+    ppb_bin_sample_split(dir % nbase, nsamp, nbins, &surf, &bin, &a, &b);
+    ppb_bin_sample_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
     if (sc->n > 1.0) {
         ppb_inside_dir(surf, sc->n, w);
         if (var & 1)
@@ -118,8 +119,8 @@ static int alloc_common(const ppb_scene *sc, const table_key *k, ppb_march_table
     memset(t, 0, sizeof *t);
     t->nsamp = k->nsamp;
     t->nvar = k->with_modes ? table_variants(sc) : 1;
-    t->ndir = t->nvar * ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
-                                       ppb_bin_count(sc->ntheta, sc->nphi), k->nsamp);
+    t->ndir = t->nvar * ppb_bin_sample_count(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                             ppb_bin_count(sc->ntheta, sc->nphi), k->nsamp);
     t->nalb = k->nalb;
     t->alb0 = k->alb0;
     t->alb_h = k->alb_h;
@@ -144,8 +145,8 @@ double ppb_march_tables_bytes(const ppb_scene *sc, const ppb_pp_settings *pp, in
 {
     table_key k = plan(sc, pp, nsamp, tau_per_mfp, with_modes);
     int nvar = with_modes ? table_variants(sc) : 1;
-    double ndir = nvar * ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
-                                        ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
+    double ndir = nvar * ppb_bin_sample_count(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                              ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
     double ntau = 0.0, ntau_max = 0.0;
     for (int c = 0; c < k.ncols; c++) {
         ntau += k.ntau[c];
@@ -168,8 +169,8 @@ double ppb_march_tables_work(const ppb_scene *sc, const ppb_pp_settings *pp, int
 {
     table_key k = plan(sc, pp, nsamp, tau_per_mfp, 1);
     *ndir = table_variants(sc) *
-            (double)ppb_march_ndir(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
-                                   ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
+            (double)ppb_bin_sample_count(ppb_surface_count(sc->geometry == PPB_GEOM_TUBE),
+                                         ppb_bin_count(sc->ntheta, sc->nphi), k.nsamp);
     double m = 2.0 * pp->directions, work = 0.0;
     *solves = 0.0;
     for (int c = 0; c < k.ncols; c++) {

@@ -46,7 +46,7 @@ typedef struct ppb_march_col {
 
 typedef struct ppb_march_tables {
     int nsamp; /* direction samples per bin axis */
-    int ndir;  /* nvar x nsurf x nbins x nsamp^2, ordered by ppb_march_dir_index per variant */
+    int ndir;  /* nvar x nsurf x nbins x nsamp^2, ordered by ppb_bin_sample_index per variant */
     int nvar;  /* direction variants: 1; at n > 1 in pp's tables 2 (slab) or 4 (tube): the
                 * inside direction and its mirrors in y, x, both (march_tables.c) */
     int nalb;  /* albedo nodes */

@@ -82,7 +82,7 @@ __kernel void ppb_mc_bins_check(const ppb_mc_params p, __global uint *out)
     VSTORE(c.v0, 0, r[0]), VSTORE(c.v1, 0, r[1]), VSTORE(c.v2, 0, r[2]), VSTORE(c.v3, 0, r[3]);
     float fx[LANES], fy[LANES], fwx[LANES], fwy[LANES], fwz[LANES];
     int fside[LANES], fsurf[LANES];
-    const int nsurf = p.tube ? 4 : 2;
+    const int nsurf = p.med.tube ? 4 : 2;
     for (int l = 0; l < LANES; l++) {
         int kind = (int)(c0[l] % 4u), surf = (int)(r[0][l] % (uint)nsurf);
         double u1 = ((double)r[1][l] + 0.5) / 4294967296.0;
@@ -93,14 +93,14 @@ __kernel void ppb_mc_bins_check(const ppb_mc_params p, __global uint *out)
             s2 = (double)(r[1][l] % (uint)(p.ntheta + 1)) / p.ntheta;
         if (kind == 2)
             phi = (double)(r[2][l] % (uint)(p.nphi + 1)) * PPB_PI / p.nphi;
-        int nseg = p.tube ? p.nseg[surf] : 1;
+        int nseg = p.med.tube ? p.nseg[surf] : 1;
         if (kind == 3)
             along = (double)(r[3][l] % (uint)(nseg + 1)) / nseg;
         double mu = sqrt(1.0 - s2), st = sqrt(s2);
         double wt = st * cos(phi), wb = st * sin(phi) * ((r[0][l] >> 16) & 1 ? -1.0 : 1.0);
         double wx = mu * ppb_normal_x(surf) + wt * ppb_tangent_x(surf);
         double wy = mu * ppb_normal_y(surf) + wt * ppb_tangent_y(surf);
-        double w = (double)p.width, h = (double)p.height, x, y;
+        double w = (double)(float)p.med.width, h = (double)(float)p.med.height, x, y;
         if (surf == PPB_S1 || surf == PPB_S2)
             x = -0.5 * w + along * w, y = surf == PPB_S1 ? 0.0 : -h;
         else
@@ -128,9 +128,8 @@ __kernel void ppb_mc_bins_check(const ppb_mc_params p, __global uint *out)
         }
         int surf = fsurf[l];
         double sv = (surf == PPB_S1 || surf == PPB_S2) ? (double)fx[l] : (double)fy[l];
-        double s0 = (surf == PPB_S1 || surf == PPB_S2) ? -0.5 * (double)p.width : -(double)p.height;
-        double len = (surf == PPB_S1 || surf == PPB_S2) ? (double)p.width : (double)p.height;
-        int seg = p.tube ? ppb_segment_of(sv, s0, len, p.nseg[surf]) : 0;
+        double w = (double)(float)p.med.width, h = (double)(float)p.med.height;
+        int seg = p.med.tube ? ppb_segment_at(surf, sv, p.nseg[surf], w, h) : 0;
         int bin =
             ppb_dir_bin(surf, (double)fwx[l], (double)fwy[l], (double)fwz[l], p.ntheta, p.nphi);
         size_t ref = ppb_cell_index(p.offset[surf], seg, ppb_bin_count(p.ntheta, p.nphi), bin);

@@ -235,7 +235,7 @@ int ppb_external_read_radiance_on(const char *path, const char *id, int others_o
                      ppb_surface_name(surf));
             goto done;
         }
-        size_t cell = ppb_cell(lo, surf, seg, it * sc->nphi + ip);
+        size_t cell = ppb_cell(lo, surf, seg, ppb_bin_index(it, ip, sc->nphi));
         if (seen[cell]) {
             ppb_fail(err,
                      "%s:%ld: a second row for %s segment %d bin (%d, %d) (the first: line %ld)",

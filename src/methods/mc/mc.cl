@@ -41,6 +41,7 @@
 #include "mc_params.h"
 #include "ppb_conventions.h"
 #include "ppb_fresnel.h"
+#include "ppb_tube.h"
 
 #ifndef PPB_MC_LANES
 #define PPB_MC_LANES 8
@@ -123,11 +124,12 @@ PPB_MC_HOT vfloat ppb_mc_log(vfloat x)
 /* Segment of an exit point on surface surf (slab: always 0). */
 inline int ppb_mc_segment(const ppb_mc_params *p, int surf, float x, float y)
 {
-    if (!p->tube)
+    if (!p->med.tube)
         return 0;
-    if (surf == PPB_S1 || surf == PPB_S2)
-        return ppb_segment_of((double)x, -0.5 * (double)p->width, (double)p->width, p->nseg[surf]);
-    return ppb_segment_of((double)y, -(double)p->height, (double)p->height, p->nseg[surf]);
+    /* the float tube's (mc_params.h) */
+    double w = (double)(float)p->med.width, h = (double)(float)p->med.height;
+    return ppb_segment_at(surf, ppb_face_is_side(surf) ? (double)y : (double)x, p->nseg[surf], w,
+                          h);
 }
 
 /* The phi-bin edges e_k = k pi / nphi, k = 1 .. nphi - 1, as (cos e_k, sin e_k): computed once
@@ -178,7 +180,8 @@ inline int ppb_mc_dir_bin(const ppb_mc_params *p, const ppb_mc_edges *e, int sur
 {
     double mu = wx * ppb_normal_x(surf) + wy * ppb_normal_y(surf);
     double wt = wx * ppb_tangent_x(surf) + wy * ppb_tangent_y(surf);
-    return ppb_theta_bin(mu, p->ntheta) * p->nphi + ppb_mc_phi_bin(e, wt, fabs(wz), p->nphi);
+    return ppb_bin_index(ppb_theta_bin(mu, p->ntheta), ppb_mc_phi_bin(e, wt, fabs(wz), p->nphi),
+                         p->nphi);
 }
 
 /* Fixed-point weights (kernels/mc_params.h) of every lane, round(w 2^32) half to even, as
@@ -362,7 +365,7 @@ PPB_MC_HOT uint ppb_mc_refill(const ppb_mc_params *p, ppb_mc_state *s, ppb_mc_qu
     vint start = s->done & CONVERT_VINT(m < (vulong)q->n);
     vulong photon = (vulong)q->base + (vulong)q->stride * m;
     vuint c0 = CONVERT_VUINT(photon), c1 = CONVERT_VUINT(photon >> 32);
-    vfloat x = p->tube ? ppb_mc_entry_x(p, q, bits) : (vfloat)0.0f;
+    vfloat x = p->med.tube ? ppb_mc_entry_x(p, q, bits) : (vfloat)0.0f;
     vfloat zero = (vfloat)0.0f;
     s->x = select(s->x, x, start), s->y = select(s->y, zero, start);
     s->wx = select(s->wx, (vfloat)p->light_x, start);
@@ -429,14 +432,14 @@ PPB_MC_HOT vint ppb_mc_vbins(const ppb_mc_params *p, const ppb_mc_edges *e, vint
         near = (vint)-1;
 
     vint seg = (vint)0;
-    if (p->tube) {
+    if (p->med.tube) {
+        const float w = (float)p->med.width, h = (float)p->med.height;
         vint top = ~side;
         vint nseg =
             select(select((vint)p->nseg[PPB_S2], (vint)p->nseg[PPB_S1], surf == PPB_S1),
                    select((vint)p->nseg[PPB_S3], (vint)p->nseg[PPB_S4], surf == PPB_S4), side);
         vfloat fseg = CONVERT_VFLOAT(nseg);
-        vfloat vs = select(y + p->height, x + 0.5f * p->width, top) *
-                    select(fseg / p->height, fseg / p->width, top);
+        vfloat vs = select(y + h, x + 0.5f * w, top) * select(fseg / h, fseg / w, top);
         near |= fabs(vs - rint(vs)) < 2e-6f * fseg;
         seg = clamp(CONVERT_VINT(vs), 0, nseg - 1);
     }
@@ -445,7 +448,7 @@ PPB_MC_HOT vint ppb_mc_vbins(const ppb_mc_params *p, const ppb_mc_edges *e, vint
                select((vint)p->offset[PPB_S3], (vint)p->offset[PPB_S4], surf == PPB_S4), side);
     *exact = near;
     int nbins = ppb_bin_count(p->ntheta, p->nphi);
-    return (off + seg) * nbins + kt * p->nphi + kp;
+    return (off + seg) * nbins + kt * p->nphi + kp; /* ppb_cell_index, ppb_bin_index per lane */
 }
 
 /* Tallies every finished lane (s->done), before ppb_mc_refill replaces it: the totals as lane
@@ -532,7 +535,7 @@ PPB_MC_HOT void ppb_mc_boundaries(const ppb_mc_params *p, ppb_mc_state *s, vint 
     vdouble wx = CONVERT_VDOUBLE(s->wx), wy = CONVERT_VDOUBLE(s->wy);
     vdouble wn = select(wy, wx, side_l);
     vdouble cos_i = fabs(wn);
-    double inv_n = 1.0 / p->n_in, n = p->n_in;
+    double inv_n = 1.0 / p->med.n, n = p->med.n;
     vdouble cos_t = ppb_mc_vrefract_cos(cos_i, inv_n);
     vdouble f = ppb_mc_vfresnel(cos_i, cos_t, inv_n);
     vlong reflect = (cos_t < 0.0) | (CONVERT_VDOUBLE(ppb_mc_uniform(r)) < f);
@@ -556,7 +559,9 @@ PPB_MC_HOT void ppb_mc_boundaries(const ppb_mc_params *p, ppb_mc_state *s, vint 
  * dies) is marked done and keeps its state. */
 PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float *medium)
 {
-    const float half_w = 0.5f * p->width, sx = p->step_x;
+    /* The float tube (mc_params.h): W, H and step_x rounded to float. */
+    const float half_w = 0.5f * (float)p->med.width, sx = (float)p->med.step_x;
+    const float h = (float)p->med.height;
     vint active = s->active;
     vfloat x = s->x, y = s->y;
     vfloat wx = s->wx, wy = s->wy, wz = s->wz;
@@ -570,13 +575,13 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float
      * moving parallel to a wall divide by zero; select() discards those values. */
     vfloat inf = (vfloat)INFINITY;
     vfloat dx = inf;
-    if (p->tube) /* the wall ahead's offset, then one division */
+    if (p->med.tube) /* the wall ahead's offset, then one division */
         dx = select(inf, select(-half_w - x, half_w - x, wx > 0.0f) / wx, wx != 0.0f);
-    vfloat dy = select(inf, select(-p->height - y, -y, wy > 0.0f) / wy, wy != 0.0f);
+    vfloat dy = select(inf, select(-h - y, -y, wy > 0.0f) / wy, wy != 0.0f);
     vfloat d_wall = fmin(dx, dy);
     /* medium: sigma_t left/right, 1/sigma_t left/right, alpha left/right (ppb_conventions.h) */
     vfloat sigma = (vfloat)medium[0], inv_sigma = (vfloat)medium[2], d_plane = inf;
-    if (p->step == PPB_STEP_DENSITY) {
+    if (p->med.step == PPB_STEP_DENSITY) {
         /* A point on the plane belongs to the side it moves into (x >= step_x is right). */
         vint right = (x > sx) | ((x == sx) & (wx >= 0.0f));
         sigma = select(sigma, (vfloat)medium[1], right);
@@ -597,11 +602,11 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float
     s->need_tau = ~cross;
     vint side = left & (dx <= dy);
     x = select(x, select((vfloat)-half_w, (vfloat)half_w, wx > 0.0f), side);
-    y = select(y, select((vfloat)-p->height, (vfloat)0.0f, wy > 0.0f), left & ~side);
+    y = select(y, select((vfloat)-h, (vfloat)0.0f, wy > 0.0f), left & ~side);
 
     /* Interaction: implicit capture with the albedo at the point, then scattering. */
     vfloat alpha = (vfloat)medium[4];
-    if (p->step == PPB_STEP_ALBEDO)
+    if (p->med.step == PPB_STEP_ALBEDO)
         alpha = select(alpha, (vfloat)medium[5], x >= sx);
     vfloat weight = s->weight;
     s->capture = s->capture + select((vfloat)0.0f, weight * (1.0f - alpha), inter);
@@ -609,7 +614,8 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float
     vint nscat = s->nscat - inter;
     s->nscat = nscat;
 
-    vfloat ct = ppb_mc_hg_cos(p->g, 0.5f / p->g, ppb_mc_uniform(c.v1));
+    const float g = (float)p->med.g;
+    vfloat ct = ppb_mc_hg_cos(g, 0.5f / g, ppb_mc_uniform(c.v1));
     vfloat cp, sp = ppb_mc_sincos2pi(ppb_mc_uniform(c.v2), &cp);
     /* New direction (MCML Eq. 3.30-3.31 with z as the reference axis; w.z = 0 at entry, so
      * the pole case is rare), then one Newton step for 1/|n| so round-off cannot build up. */
@@ -643,7 +649,7 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float
     /* A finished lane stays where it left (the step moved it by its wall distance). */
     s->x = select(s->x, x, active), s->y = select(s->y, y, active);
     s->weight = weight;
-    if (p->n_in > 1.0 && ppb_mc_bits(left))
+    if (p->med.n > 1.0 && ppb_mc_bits(left))
         ppb_mc_boundaries(p, s, &left, side, c.v3);
     vint finished = left | dead;
     s->done |= finished, s->left |= left, s->side |= side & left;
@@ -677,11 +683,12 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
 
     /* The medium's two sides from the shared conventions (x < step_x left, x >= step_x right). */
     float medium[6];
-    medium[0] = (float)ppb_sigma_t_at(p.step_x - 1.0, p.step, p.step_x, p.sigma_t, p.sigma_t_right);
-    medium[1] = (float)ppb_sigma_t_at(p.step_x, p.step, p.step_x, p.sigma_t, p.sigma_t_right);
+    const ppb_medium *M = &p.med;
+    medium[0] = (float)ppb_medium_sigma_t(M, M->step_x - 1.0);
+    medium[1] = (float)ppb_medium_sigma_t(M, M->step_x);
     medium[2] = 1.0f / medium[0], medium[3] = 1.0f / medium[1];
-    medium[4] = (float)ppb_albedo_at(p.step_x - 1.0, p.step, p.step_x, p.albedo, p.albedo_right);
-    medium[5] = (float)ppb_albedo_at(p.step_x, p.step, p.step_x, p.albedo, p.albedo_right);
+    medium[4] = (float)ppb_medium_albedo(M, M->step_x - 1.0);
+    medium[5] = (float)ppb_medium_albedo(M, M->step_x);
 
     ppb_mc_edges edges;
     ppb_mc_edges_init(&p, &edges);
@@ -695,7 +702,7 @@ __kernel void ppb_mc_trace_kernel(const ppb_mc_params p, __global ulong *cells,
     s.done = (vint)-1; /* every lane finished: the first refill fills them all */
     ppb_mc_queue queue = {q0, n, per_batch, p.first + off, batches};
     queue.used = 0;
-    if (p.tube)
+    if (p.med.tube)
         ppb_mc_entry_words(&p, &queue, q0, queue.word);
     uint flying = ppb_mc_refill(&p, &s, &queue, (1u << LANES) - 1u);
     while (flying) {

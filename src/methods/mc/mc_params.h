@@ -8,6 +8,8 @@
 #ifndef PPB_MC_PARAMS_H
 #define PPB_MC_PARAMS_H
 
+#include "ppb_medium.h"
+
 #ifdef __OPENCL_VERSION__
 typedef ulong ppb_u64;
 typedef uint ppb_u32;
@@ -69,26 +71,19 @@ enum { PPB_MC_ARG_PARAMS = 0, PPB_MC_ARG_CELLS = 1, PPB_MC_ARG_TOTALS = 2, PPB_M
 /* Parameters of one launch, passed by value. 64-bit members first so host and device agree on
  * the layout without packing attributes; the host asserts the size. */
 typedef struct ppb_mc_params {
-    ppb_u64 seed;     /* Philox key */
-    ppb_u64 first;    /* photon index of work-item 0 */
-    ppb_u64 count;    /* photons in this launch */
-    ppb_u64 ncells;   /* cells of one tally (layout.ncells) */
-    double n_in;      /* refractive index inside; <= 1: no boundary code runs (issue 18) */
+    ppb_u64 seed;   /* Philox key */
+    ppb_u64 first;  /* photon index of work-item 0 */
+    ppb_u64 count;  /* photons in this launch */
+    ppb_u64 ncells; /* cells of one tally (layout.ncells) */
+    /* The medium block (ppb_medium_of): med.n <= 1 runs no boundary code. The kernel steps in
+     * float: it rounds W, H, step_x, the sigma_t and albedos and g to float where it reads them
+     * (mc.cl: ppb_mc_segment, ppb_mc_vbins, ppb_mc_step). */
+    ppb_medium med;
     int batches;      /* batch of photon i is i % batches */
-    int tube;         /* 1 tube, 0 slab (no side walls) */
-    int step;         /* PPB_STEP_* */
     int ntheta, nphi; /* direction bins */
     int nseg[4];      /* segments per surface (slab: 1, 1, 0, 0) */
     int offset[4];    /* first segment row of each surface, as ppb_layout */
-    float width;      /* W, mfp (tube) */
-    float height;     /* H, mfp */
-    float sigma_t;    /* left of the step (everywhere without a density step) */
-    float sigma_t_right;
-    float albedo; /* left of the step */
-    float albedo_right;
-    float step_x;
-    float g;       /* Henyey-Greenstein asymmetry */
-    float light_x; /* w_L = (light_x, light_y, 0), refracted into the medium at n > 1 */
+    float light_x;    /* w_L = (light_x, light_y, 0), refracted into the medium at n > 1 */
     float light_y;
     float enter_x0; /* photons enter S1 uniformly in [enter_x0, enter_x0 + enter_width) */
     float enter_width;

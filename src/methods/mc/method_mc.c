@@ -6,13 +6,15 @@
 #include <string.h>
 
 #include "kernels/ppb_fresnel.h"
+#include "physics/medium.h"
 #include "methods/mc/mc_cache.h"
 #include "model/metrics.h"
 #include "base/memory.h"
 #include "base/progress.h"
 
 /* Host and kernel must agree on the parameter block passed by value (kernels/mc_params.h). */
-_Static_assert(sizeof(ppb_mc_params) == 144, "ppb_mc_params layout changed: check mc.cl");
+_Static_assert(sizeof(ppb_mc_params) == 4 * 8 + sizeof(ppb_medium) + 11 * 4 + 5 * 4,
+               "ppb_mc_params layout changed: check mc.cl");
 
 /* Everything one trace holds on the device, released by one NULL-safe cleanup. */
 typedef struct mc_device {
@@ -68,20 +70,10 @@ static ppb_mc_params make_params(const ppb_config *cfg)
     ppb_mc_params p = {
         .seed = (ppb_u64)cfg->mc.seed,
         .ncells = (ppb_u64)lo.ncells,
-        .n_in = sc->n,
+        .med = ppb_medium_of(sc),
         .batches = cfg->mc.batches,
-        .tube = sc->geometry == PPB_GEOM_TUBE,
-        .step = sc->step,
         .ntheta = sc->ntheta,
         .nphi = sc->nphi,
-        .width = (float)sc->width,
-        .height = (float)sc->height,
-        .sigma_t = (float)sc->sigma_t,
-        .sigma_t_right = (float)sc->sigma_t_right,
-        .albedo = (float)sc->albedo,
-        .albedo_right = (float)sc->albedo_right,
-        .step_x = (float)sc->step_x,
-        .g = (float)sc->g,
         .light_x = (float)wl[0],
         .light_y = (float)wl[1],
         .enter_x0 = (float)(-0.5 * sc->width),

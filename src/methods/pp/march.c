@@ -7,9 +7,11 @@
 
 #include "base/progress.h"
 #include "kernels/ppb_fresnel.h"
+#include "physics/medium.h"
 
-_Static_assert(sizeof(ppb_march_params) == 26 * sizeof(double) + 26 * sizeof(int),
-               "ppb_march_params: doubles first, an even number of ints, no padding");
+_Static_assert(sizeof(ppb_march_params) ==
+                   sizeof(ppb_medium) + 17 * sizeof(double) + 24 * sizeof(int),
+               "ppb_march_params: the medium, doubles, an even number of ints, no padding");
 
 static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
 {
@@ -33,15 +35,8 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
 {
     double wl[3];
     ppb_scene_light_dir(sc, wl);
-    int tube = sc->geometry == PPB_GEOM_TUBE;
     ppb_march_params P = {
-        .width = sc->width,
-        .height = sc->height,
-        .sigma_t = sc->sigma_t,
-        .sigma_t_right = sc->sigma_t_right,
-        .albedo = sc->albedo,
-        .albedo_right = sc->albedo_right,
-        .step_x = sc->step_x,
+        .med = ppb_medium_of(sc),
         .tan_theta_l = ppb_scene_tan_theta_l(sc),
         .cos_theta_l = ppb_scene_cos_theta_l(sc),
         .light_x = wl[0],
@@ -50,10 +45,8 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
         .map_h = maps->h,
         .alb0 = tab->alb0,
         .alb_h = tab->alb_h,
-        .step = opts->step,
+        .ds = opts->step,
         .d_cap = opts->d_cap > 0.0 ? opts->d_cap : 40.0,
-        .tube = tube,
-        .step_kind = tube ? sc->step : PPB_STEP_NONE,
         .map_nx = maps->nx,
         .map_i0 = maps->i0,
         .map_ny = maps->ny,
@@ -67,8 +60,6 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
         .npts = opts->npts < 1 ? 1 : opts->npts,
         .ntheta = sc->ntheta,
         .nphi = sc->nphi,
-        .n = sc->n,
-        .g = sc->g,
     };
     if (sc->n > 1.0) {
         /* Inside, the beam runs along the refracted direction (the maps follow it, maps.c). */
@@ -238,91 +229,4 @@ int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
     }
     ppb_marcher_free(&mr);
     return rc;
-}
-
-/* At n > 1: the fraction of the entering beam's power that leaves unscattered. From the beam
- * of optical depth tau between S1 and S2, (1 - F_b) e^{-tau} leaves at S2, F_b (1 - F_b)
- * e^{-2 tau} at S1 after one reflection, and so on: (1 - F_b) e^{-tau} / (1 - F_b e^{-tau}).
- * Slab, and the tube at normal incidence (a vertical beam meets only S2 and S1; the column's
- * tau is ppb_beam_depth's). */
-static double fresnel_unscattered(const ppb_scene *sc, double x_entry, void *arg)
-{
-    double fb = *(const double *)arg, e = exp(-ppb_beam_depth(sc, x_entry));
-    return (1.0 - fb) * e / (1.0 - fb * e);
-}
-
-/* The tube at oblique incidence: the beam from x_e followed through its reflections off all four
- * faces, adding at each face the part that leaves, (1 - F) of what arrives, until what is left
- * is below 1e-16. With a density step a leg's optical depth counts its part at x >= step_x with
- * sigma_t_right: a straight leg's x is monotone, so that part is the overlap of its x range with
- * [step_x, W/2], over |dx|. arg: the ppb_fresnel_beam. */
-static double fresnel_walk(const ppb_scene *sc, double x_e, void *arg)
-{
-    const ppb_fresnel_beam *b = arg;
-    double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
-    double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, tau = 0.0, out = 0.0;
-    for (int hit = 0; hit < 100000 && w * exp(-tau) > 1e-16; hit++) {
-        double ly = dy > 0.0 ? -y / dy : (-H - y) / dy;
-        double lx = dx > 0.0 ? (0.5 * W - x) / dx : (-0.5 * W - x) / dx;
-        double l = fmin(lx, ly), f = lx < ly ? fs : b->f_inside;
-        double x1 = x + l * dx;
-        if (sc->step == PPB_STEP_DENSITY && sc->sigma_t_right != sc->sigma_t) {
-            double right = fmax(0.0, fmax(x, x1) - fmax(sc->step_x, fmin(x, x1)));
-            tau += sc->sigma_t * l + (sc->sigma_t_right - sc->sigma_t) * right / fabs(dx);
-        } else
-            tau += sc->sigma_t * l;
-        x = x1, y += l * dy;
-        out += w * (1.0 - f) * exp(-tau);
-        w *= f;
-        if (lx < ly)
-            dx = -dx, x = dx < 0.0 ? 0.5 * W : -0.5 * W;
-        else
-            dy = -dy, y = dy > 0.0 ? -H : 0.0;
-    }
-    return out;
-}
-
-static double fresnel_ballistic(const ppb_scene *sc, const ppb_fresnel_beam *b)
-{
-    double fb = b->f_inside, width;
-    if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
-        /* The walk's mean over the lit part of S1, by midpoints (maps.h). */
-        const int np = PPB_LIT_MIDPOINTS;
-        double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, (void *)b, np, &width);
-        return (1.0 - b->specular) * sum / np;
-    }
-    if (sc->geometry == PPB_GEOM_SLAB) {
-        double e = exp(-sc->sigma_t * sc->height / b->cos_t);
-        return (1.0 - b->specular) * (1.0 - fb) * e / (1.0 - fb * e);
-    }
-    double sum = ppb_lit_integral(sc, fresnel_unscattered, &fb, &width);
-    return width > 0.0 ? (1.0 - b->specular) * sum / width : 0.0;
-}
-
-void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
-                      ppb_totals *t)
-{
-    double flux[PPB_NSURF] = {0};
-    for (int s = 0; s < lo->nsurf; s++) {
-        /* A cell's energy: its average radiance times segment length x projected solid angle. */
-        double measure = ppb_scene_cell_measure(sc, s);
-        for (int seg = 0; seg < lo->nseg[s]; seg++)
-            for (int b = 0; b < lo->nbins; b++)
-                flux[s] += radiance[ppb_cell(lo, s, seg, b)] * measure;
-    }
-    double entering = ppb_scene_power_in(sc);
-    memset(t, 0, sizeof *t);
-    if (entering > 0.0) {
-        t->R = flux[PPB_S1] / entering;
-        t->T = flux[PPB_S2] / entering;
-        t->sides = (flux[PPB_S3] + flux[PPB_S4]) / entering;
-    }
-    t->ballistic = ppb_ballistic_fraction(sc);
-    if (sc->n > 1.0) {
-        ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
-        t->ballistic = fresnel_ballistic(sc, &b);
-        t->specular = b.specular;
-    }
-    t->absorbed_tracked = 0;
-    ppb_totals_complete(t);
 }

@@ -60,6 +60,23 @@ inline ppb_msample ppb_sample(const ppb_march_params *P, __global const double *
     return s;
 }
 
+/* Step i of a piece [la, lb] marched in n steps of length h, whose optical distance at la is
+ * d0: the optical distance d1 at the step's start and the maps at its end (s2: the piece's own
+ * end sample b at the last step) and midpoint (sm). Returns 0, sampling nothing, once d1 is past
+ * d_cap: the march stops there. */
+inline int ppb_step(const ppb_march_params *P, __global const double *map, double tau0, double px,
+                    double py, double mx, double my, double la, double h, int i, int n, double d0,
+                    double sigma_t, ppb_msample b, double *d1, ppb_msample *s2, ppb_msample *sm)
+{
+    *d1 = d0 + sigma_t * h * i;
+    if (*d1 > P->d_cap)
+        return 0;
+    double l1 = la + h * i;
+    *s2 = i + 1 == n ? b : ppb_sample(P, map, tau0, px, py, mx, my, l1 + h);
+    *sm = ppb_sample(P, map, tau0, px, py, mx, my, l1 + 0.5 * h);
+    return 1;
+}
+
 /* Albedo node weights (paper Sec. 3.3: tables at several albedos, interpolated linearly). */
 typedef struct ppb_anodes {
     int i;
@@ -140,7 +157,7 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
                    exp(-d0) * ppb_table(tabS, col, ndir, dir, an, a.tau);
         } else if (P->with_modes) {
             /* R rule on a linear tau: the midpoints need no map lookups. */
-            int n = max(1, (int)ceil(len / P->step));
+            int n = max(1, (int)ceil(len / P->ds));
             double h = len / n, att = exp(-sigma_t * h), e = exp(-(d0 + 0.5 * sigma_t * h));
             for (int i = 0; i < n && d0 + sigma_t * h * i < P->d_cap; i++, e *= att)
                 sum += sigma_t * h * e *
@@ -149,16 +166,12 @@ inline double ppb_piece(const ppb_march_params *P, __global const double *map,
         return alpha * a.lit * sum;
     }
     /* Irregular piece: step by step, maps sampled at every step's ends and midpoint. */
-    int n = max(1, (int)ceil(len / P->step));
-    double h = len / n;
-    ppb_msample s1 = a;
-    for (int i = 0; i < n; i++) {
-        double d1 = d0 + sigma_t * h * i;
-        if (d1 > P->d_cap)
-            break;
-        double l1 = la + h * i;
-        ppb_msample s2 = i + 1 == n ? b : ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + h);
-        ppb_msample sm = ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + 0.5 * h);
+    int n = max(1, (int)ceil(len / P->ds));
+    double h = len / n, d1;
+    ppb_msample s1 = a, s2, sm;
+    for (int i = 0; i < n && ppb_step(P, map, col.tau0, px, py, mx, my, la, h, i, n, d0, sigma_t, b,
+                                      &d1, &s2, &sm);
+         i++) {
         if (sm.lit > 0.0) {
             ppb_anodes an = ppb_albedo_nodes(P, sm.abar);
             double C = ppb_coef(coefC, ndir, dir, an);
@@ -187,35 +200,17 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
                             double wx, double wy)
 {
     double mx = -wx, my = -wy; /* the march direction, per unit length along the 3-D ray */
-    double lfar = ppb_exit_length(P->tube, P->width, P->height, px, py, mx, my);
+    double lfar = ppb_exit_length(P->med.tube, P->med.width, P->med.height, px, py, mx, my);
     /* Beyond optical distance d_cap nothing counts (e^-d_cap is below double resolution of the
      * sum); capping l keeps grazing rays finite. */
-    double sig_min =
-        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
-    lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
+    lfar = fmax(0.0, fmin(lfar, P->d_cap / ppb_medium_sigma_min(&P->med)));
 
-    /* Piece ends: the step plane and the light lines through S1's shadow edges. */
+    /* Piece ends: the step plane and the light lines through S1's shadow edges (ppb_tube.h). */
     double brk[5];
     int nb = 0;
     brk[nb++] = 0.0;
-    if (P->tube && P->step_kind != PPB_STEP_NONE) {
-        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
-        double cand[3] = {-1.0, -1.0, -1.0};
-        if ((P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO) && mx != 0.0)
-            cand[0] = (P->step_x - px) / mx;
-        if (dxp != 0.0)
-            cand[1] = (P->step_x - xp) / dxp;
-        if (P->tan_theta_l > 0.0 && dxp != 0.0)
-            cand[2] = (-0.5 * P->width - xp) / dxp;
-        for (int k = 0; k < 3; k++)
-            if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
-                brk[nb++] = cand[k];
-    } else if (P->tube && P->tan_theta_l > 0.0) {
-        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
-        double c = dxp != 0.0 ? (-0.5 * P->width - xp) / dxp : -1.0;
-        if (c > 1e-12 && c < lfar - 1e-12)
-            brk[nb++] = c;
-    }
+    if (P->med.tube)
+        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
     ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first; at most three breaks */
     brk[nb++] = lfar;
 
@@ -225,16 +220,11 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
         double la = brk[k], lb = brk[k + 1];
         if (lb <= la)
             continue;
-        double xm = px + 0.5 * (la + lb) * mx;
-        double sigma_t =
-            P->tube ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
-                    : P->sigma_t;
-        double alpha = P->tube
-                           ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
-                           : P->albedo;
+        double sigma_t, alpha;
+        ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
         /* The piece lies in one column (pieces are cut at x = step_x): the right column's slab
          * when its extinction is the right medium's and the tables have that column. */
-        int c = P->ncols > 1 && sigma_t != P->sigma_t;
+        int c = P->ncols > 1 && sigma_t != P->med.sigma_t;
         L += ppb_piece(P, map, tabR, tabS, coefC, ppb_column(P, ndir, c), ndir, dir, r0, px, py, mx,
                        my, la, lb, sigma_t, alpha, &d);
     }
@@ -278,16 +268,12 @@ inline double ppb_piece_fresnel(const ppb_march_params *P, __global const double
                    ppb_beam_step(c_up, sigma_t, len, -(d0 + db2 - a.D), -(zl - b.D + a.D));
         return alpha * a.lit * v;
     }
-    int n = max(1, (int)ceil(len / P->step));
-    double h = len / n, sum = 0.0;
-    ppb_msample s1 = a;
-    for (int i = 0; i < n; i++) {
-        double d1 = d0 + sigma_t * h * i;
-        if (d1 > P->d_cap)
-            break;
-        double l1 = la + h * i;
-        ppb_msample s2 = i + 1 == n ? b : ppb_sample(P, map, tau0, px, py, mx, my, l1 + h);
-        ppb_msample sm = ppb_sample(P, map, tau0, px, py, mx, my, l1 + 0.5 * h);
+    int n = max(1, (int)ceil(len / P->ds));
+    double h = len / n, sum = 0.0, d1;
+    ppb_msample s1 = a, s2, sm;
+    for (int i = 0; i < n && ppb_step(P, map, tau0, px, py, mx, my, la, h, i, n, d0, sigma_t, b,
+                                      &d1, &s2, &sm);
+         i++) {
         if (sm.lit > 0.0) {
             double zl = sigma_t * h;
             double v = ppb_beam_step(c_down, sigma_t, h, -(d1 + s1.D), -(zl + s2.D - s1.D)) +
@@ -331,17 +317,13 @@ inline double ppb_piece_up(const ppb_march_params *P, __global const double *map
         return alpha * a.lit *
                ppb_beam_step(c_up, sigma_t, len, -(d0 + db - Da), -(sigma_t * len - Db + Da));
     }
-    int n = max(1, (int)ceil(len / P->step));
-    double h = len / n, sum = 0.0, D1 = Da;
-    for (int i = 0; i < n; i++) {
-        double d1 = d0 + sigma_t * h * i;
-        if (d1 > P->d_cap)
-            break;
-        double l1 = la + h * i;
-        double D2 = i + 1 == n
-                        ? Db
-                        : clamp(ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + h).D, 0.0, db);
-        ppb_msample sm = ppb_sample(P, map, col.tau0, px, py, mx, my, l1 + 0.5 * h);
+    int n = max(1, (int)ceil(len / P->ds));
+    double h = len / n, sum = 0.0, D1 = Da, d1;
+    ppb_msample s2, sm;
+    for (int i = 0; i < n && ppb_step(P, map, col.tau0, px, py, mx, my, la, h, i, n, d0, sigma_t, b,
+                                      &d1, &s2, &sm);
+         i++) {
+        double D2 = clamp(s2.D, 0.0, db); /* Db at the last step */
         if (sm.lit > 0.0) {
             double c_up = ppb_coef(cup, ndir, dir, ppb_albedo_nodes(P, sm.abar));
             sum +=
@@ -361,9 +343,8 @@ inline double ppb_piece_images(const ppb_march_params *P, double px, double py, 
 {
     double d0 = *d;
     *d = d0 + sigma_t * (lb - la);
-    double ct = P->cos_theta_l, st = P->light_x;
-    double cb[4] = {ppb_hg_phase(P->g, vx * st - vy * ct), ppb_hg_phase(P->g, vx * st + vy * ct),
-                    ppb_hg_phase(P->g, -vx * st - vy * ct), ppb_hg_phase(P->g, -vx * st + vy * ct)};
+    double cb[4];
+    ppb_beam_phases(P->med.g, P->light_x, P->cos_theta_l, vx, vy, cb);
     ppb_beam_tube B = PPB_BEAM_TUBE(P, light_x);
     return alpha * ppb_beam_images(&B, cb, px, py, mx, my, la, lb, sigma_t, d0);
 }
@@ -382,37 +363,21 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
     double brk[5];
     int nb = 0;
     brk[nb++] = 0.0;
-    if (P->tube) {
-        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
-        double cand[3] = {-1.0, -1.0, -1.0};
-        if ((P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO) && mx != 0.0)
-            cand[0] = (P->step_x - px) / mx;
-        if (P->step_kind != PPB_STEP_NONE && dxp != 0.0)
-            cand[1] = (P->step_x - xp) / dxp;
-        if (P->tan_theta_l > 0.0 && dxp != 0.0)
-            cand[2] = (-0.5 * P->width - xp) / dxp;
-        for (int k = 0; k < 3; k++)
-            if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
-                brk[nb++] = cand[k];
-    }
+    if (P->med.tube)
+        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
     ppb_sort_doubles(brk + 1, nb - 1);
     brk[nb++] = lfar;
     double ct = P->cos_theta_l, st = P->light_x;
-    double p_down = ppb_hg_phase(P->g, vx * st - vy * ct);
-    double p_up = ppb_hg_phase(P->g, vx * st + vy * ct);
+    double p_down = ppb_hg_phase(P->med.g, vx * st - vy * ct);
+    double p_up = ppb_hg_phase(P->med.g, vx * st + vy * ct);
     double L = 0.0;
     for (int k = 0; k + 1 < nb && *d < P->d_cap; k++) {
         double la = brk[k], lb = brk[k + 1];
         if (lb <= la)
             continue;
-        double xm = px + 0.5 * (la + lb) * mx;
-        double sigma_t =
-            P->tube ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
-                    : P->sigma_t;
-        double alpha = P->tube
-                           ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
-                           : P->albedo;
-        double db = sigma_t * P->height / ct;
+        double sigma_t, alpha;
+        ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
+        double db = sigma_t * P->med.height / ct;
         double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
         if (P->with_modes) {
             /* pp: the Fresnel slab solution's field, tabulated along this leg's direction
@@ -421,7 +386,7 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
              * beam's coefficient multiplies e^{-(D_b - D)} (ppb_piece_up). Both read the
              * piece's column slab and the albedo nodes at abar, as at n = 1 (ppb_march_ray):
              * db is that column's D_b. */
-            int c = P->ncols > 1 && sigma_t != P->sigma_t;
+            int c = P->ncols > 1 && sigma_t != P->med.sigma_t;
             ppb_mcol col = ppb_column(P, ndir, c);
             double dpp = *d;
             L += ppb_piece(P, map, tabR, tabS, coefC, col, ndir, dirv, vy, px, py, mx, my, la, lb,
@@ -429,7 +394,7 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
             __global const double *cup = coefC + (long)P->ncols * P->nalb * ndir + col.coef_off;
             L += ppb_piece_up(P, map, col, cup, ndir, dirv, px, py, mx, my, la, lb, sigma_t, alpha,
                               db, d);
-        } else if (P->tube && P->tan_theta_l > 0.0)
+        } else if (P->med.tube && P->tan_theta_l > 0.0)
             L += ppb_piece_images(P, px, py, mx, my, vx, vy, la, lb, sigma_t, alpha, d);
         else
             L += ppb_piece_fresnel(P, map, px, py, mx, my, la, lb, sigma_t, alpha, e * p_down,
@@ -452,23 +417,17 @@ inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const do
                                     double px, double py, double wx, double wy, double wz)
 {
     /* pp's tables: variant v of sample dir at dir + v nbase (y mirrored: v & 1, x: v & 2). */
-    int nbase = ndir / (P->with_modes ? (P->tube ? 4 : 2) : 1), var = 0;
-    double n = P->n, nx = ppb_normal_x(surf), ny = ppb_normal_y(surf);
+    int nbase = ndir / (P->with_modes ? (P->med.tube ? 4 : 2) : 1), var = 0;
+    double n = P->med.n, nx = ppb_normal_x(surf), ny = ppb_normal_y(surf);
     double ca = wx * nx + wy * ny, ci = ppb_refract_cos(ca, n);
     double vx = (wx - ca * nx) / n + ci * nx, vy = (wy - ca * ny) / n + ci * ny, vz = wz / n;
     double wt = (1.0 - ppb_fresnel(ca, n)) / (n * n);
-    double sig_min =
-        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
+    double sig_min = ppb_medium_sigma_min(&P->med);
     double W = 1.0, d = 0.0, L = 0.0;
     for (int leg = 0; leg < 4096 && d < P->d_cap && W * exp(-d) > 1e-15; leg++) {
-        double mx = -vx, my = -vy;
-        double ly = my > 0.0 ? -py / my : (my < 0.0 ? (-P->height - py) / my : INFINITY);
-        double lx = INFINITY;
-        if (P->tube)
-            lx = mx > 0.0 ? (0.5 * P->width - px) / mx
-                          : (mx < 0.0 ? (-0.5 * P->width - px) / mx : INFINITY);
-        int side = lx < ly;
-        double lfar = fmax(0.0, fmin(lx, ly)), lcap = (P->d_cap - d) / sig_min;
+        double mx = -vx, my = -vy, l;
+        int face = ppb_exit_face(P->med.tube, P->med.width, P->med.height, px, py, mx, my, &l);
+        double lfar = fmax(0.0, l), lcap = (P->d_cap - d) / sig_min;
         int dirv = dir + var * nbase;
         if (!(lfar <= lcap)) {
             L += W * ppb_leg_fresnel(P, map, tabR, tabS, coefC, ndir, dirv, px, py, vx, vy, vz,
@@ -477,20 +436,13 @@ inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const do
         }
         L += W *
              ppb_leg_fresnel(P, map, tabR, tabS, coefC, ndir, dirv, px, py, vx, vy, vz, lfar, &d);
-        /* Onto the face exactly, then mirrored. */
-        if (side) {
-            px = mx > 0.0 ? 0.5 * P->width : -0.5 * P->width;
-            py += lfar * my;
-            W *= ppb_fresnel(fabs(vx), 1.0 / n);
-            vx = -vx;
-            var ^= 2;
-        } else {
-            px += lfar * mx;
-            py = my > 0.0 ? 0.0 : -P->height;
-            W *= ppb_fresnel(fabs(vy), 1.0 / n);
-            vy = -vy;
-            var ^= 1;
-        }
+        /* Onto the face exactly, then mirrored (the march direction m = -v). */
+        int side = ppb_face_is_side(face);
+        W *= ppb_fresnel(fabs(side ? vx : vy), 1.0 / n);
+        ppb_tube_reflect(face, P->med.width, P->med.height, lfar, &px, &py, &mx, &my);
+        vx = -mx;
+        vy = -my;
+        var ^= side ? 2 : 1;
     }
     return wt * L;
 }
@@ -501,31 +453,24 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
                                __global const double *tabR, __global const double *tabS,
                                __global const double *coefC, __global double *out)
 {
-    int nbins = ppb_bin_count(P.ntheta, P.nphi);
-    int gid = (int)get_global_id(0);
-    int row = P.row0 + gid / nbins, bin = gid % nbins;
-    int seg, surf = ppb_row_surface(row, P.offset, P.nseg, &seg);
+    int nbins = ppb_bin_count(P.ntheta, P.nphi), seg, bin;
+    int surf = ppb_exit_cell((int)get_global_id(0), P.row0, nbins, P.offset, P.nseg, &seg, &bin);
     if (surf < 0)
         return;
     /* pp's tables at n > 1 hold 2 (slab) or 4 (tube) variants of each sample (march_tables.h) */
-    int nvar = P.n > 1.0 && P.with_modes ? (P.tube ? 4 : 2) : 1;
-    int ndir = nvar * ppb_march_ndir(ppb_surface_count(P.tube), nbins, P.nsamp);
-    int npts = P.tube ? P.npts : 1;
+    int nvar = P.med.n > 1.0 && P.with_modes ? (P.med.tube ? 4 : 2) : 1;
+    int ndir = nvar * ppb_bin_sample_count(ppb_surface_count(P.med.tube), nbins, P.nsamp);
+    int ns = ppb_exit_nsamples(&P.med, P.npts, P.nsamp);
     double sum = 0.0;
-    for (int ip = 0; ip < npts; ip++) {
-        double px, py;
-        ppb_segment_sample(P.tube, surf, seg, P.nseg[surf], P.width, P.height, ip, npts, &px, &py);
-        for (int a = 0; a < P.nsamp; a++)
-            for (int b = 0; b < P.nsamp; b++) {
-                double wx, wy, wz;
-                ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
-                int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
-                if (P.n > 1.0)
-                    sum += ppb_march_ray_fresnel(&P, map, tabR, tabS, coefC, ndir, dir, surf, px,
-                                                 py, wx, wy, wz);
-                else
-                    sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, wx, wy);
-            }
+    for (int k = 0; k < ns; k++) {
+        double px, py, w[3];
+        int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
+                                  P.nphi, k, &px, &py, w);
+        if (P.med.n > 1.0)
+            sum += ppb_march_ray_fresnel(&P, map, tabR, tabS, coefC, ndir, dir, surf, px, py, w[0],
+                                         w[1], w[2]);
+        else
+            sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, w[0], w[1]);
     }
-    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
+    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
 }

@@ -1,7 +1,7 @@
 /* march.h: the host side of the ray marcher shared by `pp` and `ss` (paper Sec. 3.4, Fig. 3's
  * rendering process; reference: Bins, Methods): uploads the light maps (maps.h) and the tables
- * (march_tables.h), runs kernels/march.cl over every (segment, bin) cell, and turns the
- * bin-averaged radiance into the totals (reference: Bins). */
+ * (march_tables.h) and runs march.cl over every (segment, bin) cell (reference: Bins); the
+ * totals from the bin radiance are physics/totals.h's. */
 #ifndef PPB_MARCH_H
 #define PPB_MARCH_H
 
@@ -41,11 +41,6 @@ void ppb_marcher_free(ppb_marcher *mr);
 int ppb_march_all(ppb_ocl *ocl, const ppb_scene *sc, const ppb_maps *maps,
                   const ppb_march_tables *tab, const ppb_march_opts *opts, const char *label,
                   int quiet, double *radiance, int *partial, ppb_err *err);
-
-/* R, T, sides: radiance x bin projected solid angle x segment length summed per surface,
- * over the power entering the lit part of S1 (lit width x cos theta_L); ballistic exact. */
-void ppb_march_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
-                      ppb_totals *t);
 
 /* Tau resolution of the tables, nodes per unit optical depth (linear interpolation in tau; the
  * S march reads its table only at piece ends, the R march at every step). */

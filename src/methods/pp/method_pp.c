@@ -8,6 +8,7 @@
 
 #include "base/memory.h"
 #include "methods/pp/march.h"
+#include "physics/totals.h"
 #include "methods/result_check.h"
 
 /* Issue 15: what the pipeline will hold at its peak, estimated before it allocates, against
@@ -76,7 +77,7 @@ int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *
         rc = ppb_radiance_check(cfg->name, out, NULL, err);
     if (!rc) {
         memset(out->se, 0, out->layout.ncells * sizeof *out->se);
-        ppb_march_totals(sc, &out->layout, out->radiance, &out->totals);
+        ppb_bin_totals(sc, &out->layout, out->radiance, &out->totals);
         rc = ppb_totals_check(cfg->name, out, err);
     }
     ppb_maps_free(&maps);

@@ -11,16 +11,16 @@
 #include "base/clock.h"
 #include "base/memory.h"
 #include "base/progress.h"
-#include "kernels/march_params.h"
 #include "kernels/ppb_fresnel.h"
-#include "methods/pp/march.h"
 #include "methods/result_check.h"
 #include "model/metrics.h"
 #include "physics/gmres.h"
+#include "physics/totals.h"
 #include "methods/rte2d/rte2d_grid.h"
 
-_Static_assert(sizeof(ppb_rte_params) == 22 * sizeof(double) + 24 * sizeof(int),
-               "ppb_rte_params: doubles first, an even number of ints, no padding");
+_Static_assert(sizeof(ppb_rte_params) ==
+                   sizeof(ppb_medium) + 13 * sizeof(double) + 22 * sizeof(int),
+               "ppb_rte_params: the medium, doubles, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
 #define RTE_RESTART 30
@@ -114,7 +114,7 @@ static void reflect_inflow(const ppb_rte_grid *G, const double *x, double *B)
     size_t stride = (size_t)G->nf + G->nb;
     int nc = G->nc;
     memset(B, 0, sizeof(double) * nc * G->nb);
-    for (int face = 0; face < (G->P.tube ? 4 : 2); face++) {
+    for (int face = 0; face < (G->P.med.tube ? 4 : 2); face++) {
         int e0 = ppb_moc_edge0(G->nfx, G->P.ny, face), ne = ppb_moc_nedge(G->nfx, G->P.ny, face);
         for (int b = 0; b < nc; b++) {
             const double *row = G->refl + ((size_t)face * nc + b) * nc;
@@ -255,7 +255,7 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
     int nsurf = lo->nsurf, nbins = lo->nbins;
     ex->nsamp = nsamp;
     ex->npts = npts;
-    ex->ndir = ppb_march_ndir(nsurf, nbins, nsamp);
+    ex->ndir = ppb_bin_sample_count(nsurf, nbins, nsamp);
     double *w = malloc(sizeof(double) * 3 * ex->ndir);
     ex->Fx = malloc(sizeof(double) * (size_t)ex->ndir * s->G.nc);
     ex->bx = sc->n > 1.0 ? malloc(sizeof(double) * 4 * (size_t)ex->ndir) : NULL;
@@ -267,9 +267,9 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
         for (int bin = 0; bin < nbins; bin++)
             for (int a = 0; a < nsamp; a++)
                 for (int b = 0; b < nsamp; b++) {
-                    int d = ppb_march_dir_index(surf, bin, a, b, nsamp, nbins);
-                    ppb_march_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[3 * d],
-                                  &w[3 * d + 1], &w[3 * d + 2]);
+                    int d = ppb_bin_sample_index(surf, bin, a, b, nsamp, nbins);
+                    ppb_bin_sample_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[3 * d],
+                                       &w[3 * d + 1], &w[3 * d + 2]);
                     if (sc->n > 1.0) {
                         /* Inside along Snell's direction (the exit kernel maps it the same
                          * way); its mirrors in each face for the wall term. */
@@ -359,7 +359,7 @@ static int rte_memory_check(const ppb_config *cfg, const ppb_layout *lo, int stu
     int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir, vecs = RTE_RESTART + 4 * study;
     double solve = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, vecs);
     double nodes = solve / (8.0 * (r->directions + 10.0) * (vecs + 8)); /* about */
-    double exitb = 8.0 * ppb_march_ndir(lo->nsurf, lo->nbins, nsamp) * nodes * 2.0;
+    double exitb = 8.0 * ppb_bin_sample_count(lo->nsurf, lo->nbins, nsamp) * nodes * 2.0;
     char detail[160];
     snprintf(detail, sizeof detail, "solve %.3g GB, exit source %.3g GB x 2", solve / 1e9,
              exitb / 2e9);
@@ -619,7 +619,7 @@ static int finish_result(rte_solver *s, const ppb_config *cfg, const double *rad
     if (ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
     memset(out->se, 0, lo->ncells * sizeof *out->se);
-    ppb_march_totals(sc, lo, out->radiance, &out->totals);
+    ppb_bin_totals(sc, lo, out->radiance, &out->totals);
     /* R, T, sides from the cell field at the boundaries (rte2d_grid.h), as ppslab. */
     double fl[4];
     ppb_rte_boundary_flux(&s->G, rad, fl);
@@ -662,7 +662,7 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
     if (rte_memory_check(cfg, lo, study != NULL, err) || ppb_ctx_ocl(ctx, &ocl, err))
         return -1;
     int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
-    size_t planes = (size_t)ppb_march_ndir(lo->nsurf, lo->nbins, nsamp);
+    size_t planes = (size_t)ppb_bin_sample_count(lo->nsurf, lo->nbins, nsamp);
     rte_solver s;
     rte_exit ex = {0, 0, 0, NULL, NULL};
     ppb_gmres_basis kb = {0, 0.0, NULL, NULL};

@@ -18,9 +18,9 @@
  *   exponential integrated exactly: alpha e^{-d_1} [J_1 a + (J_2 - J_1)(a / x - 1 + a)],
  *   x = sigma_t h, a = 1 - e^{-x}; exact for a source linear along the step whatever its
  *   optical length (directions close to z cross many mfp in a short planar distance). */
-#include "march_params.h"
 #include "ppb_beam_images.h"
 #include "ppb_fresnel.h"
+#include "ppb_sort.h"
 #include "rte2d_params.h"
 
 /* exp(e_a) phi1(z) with e_b = e_a + z <= 0, in the scaled form where exp(e_a) underflows (as
@@ -62,13 +62,9 @@ inline double rte_wall(const ppb_rte_params *P, __global const double *rad,
                        __global const double *bnd, double px, double py, double mx, double my,
                        double wx, double wy, double lfar, double d)
 {
-    double ly = my > 0.0 ? -py / my : (my < 0.0 ? (-P->height - py) / my : INFINITY);
-    double lx = INFINITY;
-    if (P->tube)
-        lx = mx > 0.0 ? (0.5 * P->width - px) / mx
-                      : (mx < 0.0 ? (-0.5 * P->width - px) / mx : INFINITY);
-    int face = lx < ly ? (mx > 0.0 ? PPB_S4 : PPB_S3) : (my > 0.0 ? PPB_S1 : PPB_S2);
-    double F = ppb_fresnel(fabs(face >= PPB_S3 ? wx : wy), 1.0 / P->n);
+    double l;
+    int face = ppb_exit_face(P->med.tube, P->med.width, P->med.height, px, py, mx, my, &l);
+    double F = ppb_fresnel(fabs(ppb_face_is_side(face) ? wx : wy), 1.0 / P->med.n);
     int slot = (int)bnd[face];
     double qx = px + lfar * mx, qy = py + lfar * my;
     return exp(-d) * F * ppb_rte_lookup(P, rad + (long)slot * ppb_rte_nnodes(P), qx, qy);
@@ -91,9 +87,8 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         mx = 0.0;
     if (fabs(my) < 1e-12)
         my = 0.0;
-    double lfar = ppb_exit_length(P->tube, P->width, P->height, px, py, mx, my);
-    double sig_min =
-        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
+    double lfar = ppb_exit_length(P->med.tube, P->med.width, P->med.height, px, py, mx, my);
+    double sig_min = ppb_medium_sigma_min(&P->med);
     int wall = P->refl && !(lfar > P->d_cap / sig_min);
     lfar = fmax(0.0, fmin(lfar, P->d_cap / sig_min));
     if (lfar <= 0.0)
@@ -104,30 +99,15 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
     brk[nb++] = 0.0;
     /* The boundary layers' lines: inside them the march steps shrink with the rows. */
     if (P->nyl > 0 && my != 0.0) {
-        double ly[2] = {(-P->dlay - py) / my, (-(P->height - P->dlay) - py) / my};
+        double ly[2] = {(-P->dlay - py) / my, (-(P->med.height - P->dlay) - py) / my};
         for (int k = 0; k < 2; k++)
             if (ly[k] > 1e-12 && ly[k] < lfar - 1e-12)
                 brk[nb++] = ly[k];
     }
-    if (P->tube) {
-        double dxp = mx + my * P->tan_theta_l, xp = px + py * P->tan_theta_l;
-        double cand[3] = {-1.0, -1.0, -1.0};
-        if ((P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO) && mx != 0.0)
-            cand[0] = (P->step_x - px) / mx;
-        if (P->step_kind != PPB_STEP_NONE && dxp != 0.0)
-            cand[1] = (P->step_x - xp) / dxp;
-        if (P->tan_theta_l > 0.0 && dxp != 0.0)
-            cand[2] = (-0.5 * P->width - xp) / dxp;
-        for (int k = 0; k < 3; k++)
-            if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
-                brk[nb++] = cand[k];
-    }
-    for (int i = 2; i < nb; i++)
-        for (int k = i; k > 1 && brk[k] < brk[k - 1]; k--) {
-            double s = brk[k];
-            brk[k] = brk[k - 1];
-            brk[k - 1] = s;
-        }
+    /* The step plane and the light lines through S1's shadow edges (ppb_tube.h). */
+    if (P->med.tube)
+        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
+    ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first */
     brk[nb++] = lfar;
 
     double sperp = sqrt(mx * mx + my * my);
@@ -136,15 +116,10 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         double la = brk[k], lb = brk[k + 1], len = lb - la;
         if (len <= 0.0)
             continue;
-        double xm = px + 0.5 * (la + lb) * mx, ym = py + 0.5 * (la + lb) * my;
-        double sigma_t =
-            P->tube ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
-                    : P->sigma_t;
-        double alpha = P->tube
-                           ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
-                           : P->albedo;
+        double xm = px + 0.5 * (la + lb) * mx, ym = py + 0.5 * (la + lb) * my, sigma_t, alpha;
+        ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
         double sum = 0.0;
-        if (P->beam && P->n > 1.0 && P->tube && P->tan_theta_l > 0.0) {
+        if (P->beam && P->med.n > 1.0 && P->med.tube && P->tan_theta_l > 0.0) {
             sum += rte_beam_images(P, cb, px, py, mx, my, la, lb, sigma_t, d);
         } else if (P->beam && C != 0.0) {
             double Dm, Da, Db;
@@ -162,12 +137,12 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
                 double slope = Db - Da;
                 Da -= 0.5 * slope;
                 Db += 0.5 * slope;
-                if (P->n > 1.0) {
+                if (P->med.n > 1.0) {
                     /* The refracted beam and its reflection off S2 (optical depth 2 D_b - D),
                      * every further round trip S2 -> S1 -> S2 summed: 1 / (1 - F_b^2 e^{-2 D_b})
                      * (as march.cl's ppb_piece_fresnel; D_b the column's: the slab, or the
                      * tube at normal incidence, where the beam stays in its column). */
-                    double db = sigma_t * P->height / P->cos_theta_l;
+                    double db = sigma_t * P->med.height / P->cos_theta_l;
                     double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
                     sum += e * C * sigma_t * len *
                            rte_beam_factor(-(d + Da), -(sigma_t * len + Db - Da));
@@ -183,7 +158,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
              * piece's finest row spacing (a layer piece: hyf), so a step crosses no more of a
              * fine row than of a middle one. */
             double dy =
-                (P->nyl > 0 && (-ym < P->dlay || -ym > P->height - P->dlay)) ? P->hyf : P->hy;
+                (P->nyl > 0 && (-ym < P->dlay || -ym > P->med.height - P->dlay)) ? P->hyf : P->hy;
             double ns = fmax(len * sperp / P->hstep, len * fabs(my) * P->hy / (P->hstep * dy));
             int n = max(1, (int)ceil(ns));
             double h = len / n, x = sigma_t * h, a = -expm1(-x), w1 = rte_w1(x, a);
@@ -212,8 +187,8 @@ inline double rte_ray(const ppb_rte_params *P, __global const double *plane, con
                       __global const double *rad, __global const double *bnd, double px, double py,
                       double wx, double wy)
 {
-    if (P->tube && P->step_kind != PPB_STEP_NONE && px == P->step_x && fabs(wx) < 1e-12) {
-        double e = 1e-9 * P->width;
+    if (P->med.tube && P->med.step != PPB_STEP_NONE && px == P->med.step_x && fabs(wx) < 1e-12) {
+        double e = 1e-9 * P->med.width;
         return 0.5 * (rte_ray_side(P, plane, cb, rad, bnd, px - e, py, wx, wy) +
                       rte_ray_side(P, plane, cb, rad, bnd, px + e, py, wx, wy));
     }
@@ -227,44 +202,33 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                            __global const double *rad, __global const double *bnd)
 {
     (void)dirs;
-    int nbins = ppb_bin_count(P.ntheta, P.nphi);
-    int gid = (int)get_global_id(0);
-    int row = P.row0 + gid / nbins, bin = gid % nbins;
-    int seg, surf = ppb_row_surface(row, P.offset, P.nseg, &seg);
+    int nbins = ppb_bin_count(P.ntheta, P.nphi), seg, bin;
+    int surf = ppb_exit_cell((int)get_global_id(0), P.row0, nbins, P.offset, P.nseg, &seg, &bin);
     if (surf < 0)
         return;
     int nn = ppb_rte_nnodes(&P);
-    int npts = P.tube ? P.npts : 1;
+    int ns = ppb_exit_nsamples(&P.med, P.npts, P.nsamp);
     double sum = 0.0;
-    for (int ip = 0; ip < npts; ip++) {
-        double px, py;
-        ppb_segment_sample(P.tube, surf, seg, P.nseg[surf], P.width, P.height, ip, npts, &px, &py);
-        for (int a = 0; a < P.nsamp; a++)
-            for (int b = 0; b < P.nsamp; b++) {
-                double wx, wy, wz;
-                ppb_march_dir(surf, bin, a, b, P.nsamp, P.ntheta, P.nphi, &wx, &wy, &wz);
-                int dir = ppb_march_dir_index(surf, bin, a, b, P.nsamp, nbins);
-                if (P.n > 1.0) {
-                    /* Air-side sample w: inside along Snell's direction, (1 - F) / n^2 times
-                     * the inside radiance (the n^2 law, reference: Medium). */
-                    double v[3] = {wx, wy, wz};
-                    double ca = ppb_inside_dir(surf, P.n, v);
-                    double wt = (1.0 - ppb_fresnel(ca, P.n)) / (P.n * P.n);
-                    double st = P.sin_theta_l, ct = P.cos_theta_l;
-                    double cb[4] = {ppb_hg_phase(P.g, v[0] * st - v[1] * ct),
-                                    ppb_hg_phase(P.g, v[0] * st + v[1] * ct),
-                                    ppb_hg_phase(P.g, -v[0] * st - v[1] * ct),
-                                    ppb_hg_phase(P.g, -v[0] * st + v[1] * ct)};
-                    sum += wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py,
-                                        v[0], v[1]);
-                    continue;
-                }
-                double cb[4] = {ppb_hg_phase(P.g, wx * P.sin_theta_l - wy * P.cos_theta_l), 0.0,
-                                0.0, 0.0};
-                sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, wx, wy);
-            }
+    for (int k = 0; k < ns; k++) {
+        double px, py, v[3];
+        int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
+                                  P.nphi, k, &px, &py, v);
+        if (P.med.n > 1.0) {
+            /* Air-side sample w = v: inside along Snell's direction, (1 - F) / n^2 times the
+             * inside radiance (the n^2 law, reference: Medium). */
+            double ca = ppb_inside_dir(surf, P.med.n, v);
+            double wt = (1.0 - ppb_fresnel(ca, P.med.n)) / (P.med.n * P.med.n);
+            double cb[4];
+            ppb_beam_phases(P.med.g, P.sin_theta_l, P.cos_theta_l, v[0], v[1], cb);
+            sum +=
+                wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py, v[0], v[1]);
+            continue;
+        }
+        double cb[4] = {ppb_hg_phase(P.med.g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l), 0.0,
+                        0.0, 0.0};
+        sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, v[0], v[1]);
     }
-    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / (npts * P.nsamp * P.nsamp);
+    out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
 }
 
 /* ---- The conservative sweep: a flat-source method of characteristics (reference: Methods) ----
@@ -324,19 +288,19 @@ inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, dou
                       double delta, double vk, __global const double *sig, __global const double *Q,
                       __global double *tal, __global double *bout, __global double *scr, int mode)
 {
-    double hw = 0.5 * P->width, p0x = -uy * vk, p0y = ux * vk;
+    double W = P->med.width, H = P->med.height, p0x = -uy * vk, p0y = ux * vk;
+    /* Where the line crosses the lines of S3/S4 (tx) and S1/S2 (ty), ascending in t: it leaves
+     * through the face u moves toward (ppb_tube.h) and came in through the opposite one. */
     double txa = -INFINITY, txb = INFINITY, tya = -INFINITY, tyb = INFINITY;
     if (ux != 0.0) {
-        double a = (-hw - p0x) / ux, b = (hw - p0x) / ux;
-        txa = fmin(a, b);
-        txb = fmax(a, b);
-    } else if (p0x <= -hw || p0x >= hw)
+        txa = -ppb_tube_length_x(W, p0x, -ux);
+        txb = ppb_tube_length_x(W, p0x, ux);
+    } else if (p0x <= ppb_face_line(PPB_S3, W, H) || p0x >= ppb_face_line(PPB_S4, W, H))
         return;
     if (uy != 0.0) {
-        double a = -p0y / uy, b = (-P->height - p0y) / uy;
-        tya = fmin(a, b);
-        tyb = fmax(a, b);
-    } else if (p0y >= 0.0 || p0y <= -P->height)
+        tya = -ppb_tube_length_y(H, p0y, -uy);
+        tyb = ppb_tube_length_y(H, p0y, uy);
+    } else if (p0y >= ppb_face_line(PPB_S1, W, H) || p0y <= ppb_face_line(PPB_S2, W, H))
         return;
     double tin = fmax(txa, tya), tout = fmin(txb, tyb);
     if (!(tout > tin))
@@ -453,12 +417,13 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
     for (int e = 0; e < nb; e++)
         bo[e] = sc[e] = 0.0;
     double wx = dirs[4 * c], wy = dirs[4 * c + 1], s = sqrt(wx * wx + wy * wy);
-    if (!P.tube)
+    if (!P.med.tube)
         moc_slab(&P, &g, wy, sig, q, bi, tal, bo);
     else if (s > 1e-12) {
-        double ux = wx / s, uy = wy / s, hw = 0.5 * P.width;
+        double ux = wx / s, uy = wy / s, hw = 0.5 * P.med.width;
         /* The tracks' offsets v = p . (-u_y, u_x) over the cross-section's corners. */
-        double v1 = -uy * -hw, v2 = -uy * hw, v3 = v1 - ux * P.height, v4 = v2 - ux * P.height;
+        double v1 = -uy * -hw, v2 = -uy * hw, v3 = v1 - ux * P.med.height,
+               v4 = v2 - ux * P.med.height;
         double vmin = fmin(fmin(v1, v2), fmin(v3, v4)), vmax = fmax(fmax(v1, v2), fmax(v3, v4));
         double proj = dmin.x * fabs(uy) + dmin.y * fabs(ux);
         double delta = fmin(P.hstep, proj / PPB_MOC_TRACKS_PER_CELL);

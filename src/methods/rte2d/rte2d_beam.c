@@ -208,8 +208,8 @@ static double term_integral(const ppb_rte_params *P, const beam_term *t, const b
         return 0.0;
     if (!t->cut)
         return piece_integral(P, t, &a);
-    beam_affine left = {P->step_x - t->xe.a, -t->xe.b, -t->xe.c};
-    beam_affine right = {t->xe.a - P->step_x, t->xe.b, t->xe.c};
+    beam_affine left = {P->med.step_x - t->xe.a, -t->xe.b, -t->xe.c};
+    beam_affine right = {t->xe.a - P->med.step_x, t->xe.b, t->xe.c};
     beam_poly l, r;
     poly_clip(&a, left, &l);
     poly_clip(&a, right, &r);
@@ -230,8 +230,8 @@ static double image_right(double x, double s, double W)
 static void image_point(const ppb_rte_params *P, int k, int j, double x, double y, double *xp,
                         double *dp)
 {
-    *xp = k * P->width + ((k & 1) ? -x : x);
-    *dp = (j & 1) ? (j + 1) * P->height + y : j * P->height - y;
+    *xp = k * P->med.width + ((k & 1) ? -x : x);
+    *dp = (j & 1) ? (j + 1) * P->med.height + y : j * P->med.height - y;
 }
 
 /* Optical depth of image (k, j)'s beam to (x, y): sigma_t depth' / cos theta_t, through the
@@ -240,11 +240,12 @@ static double image_depth(const ppb_rte_params *P, int k, int j, double x, doubl
 {
     double xp, dp;
     image_point(P, k, j, x, y, &xp, &dp);
-    if (P->step_kind != PPB_STEP_DENSITY)
-        return P->sigma_t * dp / P->cos_theta_l;
-    double xe = xp - dp * P->tan_theta_l, s = P->step_x, W = P->width;
-    return P->sigma_t * dp / P->cos_theta_l + (P->sigma_t_right - P->sigma_t) / P->sin_theta_l *
-                                                  (image_right(xp, s, W) - image_right(xe, s, W));
+    if (P->med.step != PPB_STEP_DENSITY)
+        return P->med.sigma_t * dp / P->cos_theta_l;
+    double xe = xp - dp * P->tan_theta_l, s = P->med.step_x, W = P->med.width;
+    return P->med.sigma_t * dp / P->cos_theta_l +
+           (P->med.sigma_t_right - P->med.sigma_t) / P->sin_theta_l *
+               (image_right(xp, s, W) - image_right(xe, s, W));
 }
 
 static double term_exponent(const ppb_rte_params *P, const beam_term *t, double x, double y)
@@ -257,36 +258,29 @@ static double term_exponent(const ppb_rte_params *P, const beam_term *t, double 
     return t->kind == TERM_BACK ? -(2.0 * t->db - D) : -D;
 }
 
-/* The lit part of S1: [-W/2, W/2), with a shadow step [-W/2, min(W/2, step_x)). */
-static double lit_hi(const ppb_rte_params *P)
-{
-    double hi = 0.5 * P->width;
-    return P->step_kind == PPB_STEP_SHADOW ? fmin(hi, P->step_x) : hi;
-}
-
 /* A term of ppb_rte_light's beam: x_e = x + y tan theta, lit on S1's lit part in the tube. */
 static beam_term light_term(const ppb_rte_params *P, term_kind kind, int cls, double w)
 {
     beam_term t = {.kind = kind, .cls = cls, .w = w, .xe = {0.0, 1.0, P->tan_theta_l}};
-    t.has_lit = P->tube;
-    t.cut = P->tube && P->step_kind == PPB_STEP_DENSITY;
-    t.lo = -0.5 * P->width;
-    t.hi = lit_hi(P);
+    t.has_lit = P->med.tube;
+    t.cut = P->med.tube && P->med.step == PPB_STEP_DENSITY;
+    t.lo = ppb_face_line(PPB_S3, P->med.width, P->med.height); /* S1's lit part (ppb_tube.h) */
+    t.hi = ppb_tube_lit_hi(&P->med);
     return t;
 }
 
 /* Image tile (k, j): x_e = x' - depth' tan theta_t, affine in (x, y) (ppb_beam_images.h). */
 static beam_term image_term(const ppb_rte_params *P, int k, int j, double w)
 {
-    double tn = P->tan_theta_l, d0 = (j & 1) ? (j + 1) * P->height : j * P->height;
+    double tn = P->tan_theta_l, d0 = (j & 1) ? (j + 1) * P->med.height : j * P->med.height;
     beam_term t = {.kind = TERM_IMAGE, .cls = 2 * (k & 1) + (j & 1), .k = k, .j = j, .w = w};
-    t.xe.a = k * P->width - d0 * tn;
+    t.xe.a = k * P->med.width - d0 * tn;
     t.xe.b = (k & 1) ? -1.0 : 1.0;
     t.xe.c = (j & 1) ? -tn : tn;
     t.has_lit = 1;
-    t.cut = P->step_kind == PPB_STEP_DENSITY;
-    t.lo = -0.5 * P->width;
-    t.hi = lit_hi(P);
+    t.cut = P->med.step == PPB_STEP_DENSITY;
+    t.lo = ppb_face_line(PPB_S3, P->med.width, P->med.height); /* S1's lit part (ppb_tube.h) */
+    t.hi = ppb_tube_lit_hi(&P->med);
     return t;
 }
 
@@ -296,9 +290,8 @@ static beam_term image_term(const ppb_rte_params *P, int k, int j, double w)
  * less than 1e-17 of the first ones. */
 static int image_jmax(const ppb_rte_params *P)
 {
-    double smin =
-        P->step_kind == PPB_STEP_DENSITY ? fmin(P->sigma_t, P->sigma_t_right) : P->sigma_t;
-    double q = P->beam_fb * exp(-smin * P->height / P->cos_theta_l);
+    double smin = ppb_medium_sigma_min(&P->med);
+    double q = P->beam_fb * exp(-smin * P->med.height / P->cos_theta_l);
     if (!(q > 0.0))
         return 4;
     double J = log(1e-17) / log(q);
@@ -310,8 +303,8 @@ static int image_jmax(const ppb_rte_params *P)
 static void sum_images(const ppb_rte_params *P, double sigma_t, const beam_poly *rect,
                        double out[PPB_BEAM_CLASSES])
 {
-    double W = P->width, H = P->height, tn = P->tan_theta_l;
-    if (!(lit_hi(P) > -0.5 * W))
+    double W = P->med.width, H = P->med.height, tn = P->tan_theta_l;
+    if (!(ppb_tube_lit_hi(&P->med) > -0.5 * W))
         return;
     int jmax = image_jmax(P);
     double fj = 1.0;
@@ -332,26 +325,24 @@ void ppb_rte_beam_rect(const ppb_rte_params *P, double x0, double x1, double y0,
 {
     for (int k = 0; k < PPB_BEAM_CLASSES; k++)
         out[k] = 0.0;
-    if (!P->tube) /* slab: per unit width */
+    if (!P->med.tube) /* slab: per unit width */
         x0 = 0.0, x1 = 1.0;
     beam_poly rect = {4, {x0, x1, x1, x0}, {y0, y0, y1, y1}};
     double xm = 0.5 * (x0 + x1);
-    double sigma_t = P->tube
-                         ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
-                         : P->sigma_t;
+    double sigma_t = ppb_medium_sigma_t(&P->med, xm);
     if (!(sigma_t > 0.0))
         return;
-    if (P->n <= 1.0) {
+    if (P->med.n <= 1.0) {
         beam_term t = light_term(P, TERM_LIGHT, PPB_BEAM_PLUS_DOWN, 1.0);
         out[0] = sigma_t * term_integral(P, &t, &rect);
         return;
     }
-    if (P->tube && P->tan_theta_l > 0.0) {
+    if (P->med.tube && P->tan_theta_l > 0.0) {
         sum_images(P, sigma_t, &rect, out);
         return;
     }
     /* The refracted beam and its reflection off S2, every round trip summed (rte2d.cl). */
-    double db = sigma_t * P->height / P->cos_theta_l;
+    double db = sigma_t * P->med.height / P->cos_theta_l;
     double e = P->beam_in / (1.0 - P->beam_fb * P->beam_fb * exp(-2.0 * db));
     beam_term down = light_term(P, TERM_LIGHT, PPB_BEAM_PLUS_DOWN, e);
     beam_term up = light_term(P, TERM_BACK, PPB_BEAM_PLUS_UP, e * P->beam_fb);

@@ -9,6 +9,7 @@
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
 #include "physics/maps.h"
+#include "physics/medium.h"
 #include "physics/phase.h"
 #include "physics/ppsolver.h"
 #include "methods/rte2d/rte2d_beam.h"
@@ -198,8 +199,8 @@ static int grid_reflection(ppb_rte_grid *G, ppb_err *err)
 static int grid_fsr(ppb_rte_grid *G, ppb_err *err)
 {
     const ppb_rte_params *P = &G->P;
-    int split = P->tube && P->nx > P->nl + 1; /* node nl sits on step_x */
-    G->nfx = P->tube ? P->nx + split : 1;
+    int split = P->med.tube && P->nx > P->nl + 1; /* node nl sits on step_x */
+    G->nfx = P->med.tube ? P->nx + split : 1;
     G->nf = G->nfx * P->ny;
     G->nb = ppb_moc_nb(G->nfx, P->ny);
     G->fedge = malloc(sizeof(double) * (G->nfx + 1 + P->ny + 1));
@@ -210,36 +211,32 @@ static int grid_fsr(ppb_rte_grid *G, ppb_err *err)
     if (!G->fedge || !G->fsig || !G->falb || !G->fcol || !G->farea)
         return ppb_fail(err, "rte2d: out of memory (regions)");
     double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
-    if (!P->tube) {
+    if (!P->med.tube) {
         fx[0] = -0.5;
         fx[1] = 0.5;
         G->fcol[0] = 0;
     } else {
         int k = 0;
-        fx[k] = -0.5 * P->width;
+        fx[k] = ppb_face_line(PPB_S3, P->med.width, P->med.height);
         for (int i = 0; i < P->nx; i++) {
             if (split && i == P->nl) { /* the step column, in two */
                 G->fcol[k] = i;
-                fx[++k] = P->step_x;
+                fx[++k] = P->med.step_x;
             }
             G->fcol[k] = i;
             fx[++k] = i + 1 < P->nx ? 0.5 * (ppb_rte_node_x(P, i) + ppb_rte_node_x(P, i + 1))
-                                    : 0.5 * P->width;
+                                    : ppb_face_line(PPB_S4, P->med.width, P->med.height);
         }
     }
     fy[0] = 0.0;
     for (int j = 1; j < P->ny; j++)
         fy[j] = 0.5 * (ppb_rte_node_y(P, j - 1) + ppb_rte_node_y(P, j));
-    fy[P->ny] = -P->height;
+    fy[P->ny] = ppb_face_line(PPB_S2, P->med.width, P->med.height);
     G->dmin[0] = G->dmin[1] = INFINITY;
     for (int k = 0; k < G->nfx; k++) {
         double xm = 0.5 * (fx[k] + fx[k + 1]);
-        G->fsig[k] = P->tube
-                         ? ppb_sigma_t_at(xm, P->step_kind, P->step_x, P->sigma_t, P->sigma_t_right)
-                         : P->sigma_t;
-        G->falb[k] = P->tube
-                         ? ppb_albedo_at(xm, P->step_kind, P->step_x, P->albedo, P->albedo_right)
-                         : P->albedo;
+        G->fsig[k] = ppb_medium_sigma_t(&P->med, xm);
+        G->falb[k] = ppb_medium_albedo(&P->med, xm);
         G->dmin[0] = fmin(G->dmin[0], fx[k + 1] - fx[k]);
     }
     for (int j = 0; j < P->ny; j++) {
@@ -347,7 +344,7 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x)
                 psi[j * G->nfx + k] = r[j * P->nx + G->fcol[k]];
         for (int e = 0; e < G->nb; e++)
             bout[e] = 0.0;
-        for (int face = 0; face < (P->tube ? 4 : 2); face++) {
+        for (int face = 0; face < (P->med.tube ? 4 : 2); face++) {
             int e0 = ppb_moc_edge0(G->nfx, P->ny, face), ne = ppb_moc_nedge(G->nfx, P->ny, face);
             double wn = out_cos(face, G->dir4 + 4 * a), len;
             for (int k = 0; wn > 0.0 && k < ne; k++) {
@@ -411,19 +408,10 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
         return ppb_fail(err, "rte2d: spacing, step and directions must be positive");
     int tube = sc->geometry == PPB_GEOM_TUBE;
     ppb_rte_params *P = &G->P;
-    double th = sc->theta_deg * PPB_PI / 180.0;
-    P->width = sc->width;
-    P->height = sc->height;
-    P->sigma_t = sc->sigma_t;
-    P->sigma_t_right = sc->sigma_t_right;
-    P->albedo = sc->albedo;
-    P->albedo_right = sc->albedo_right;
-    P->step_x = sc->step_x;
-    P->g = sc->g;
+    P->med = ppb_medium_of(sc);
     P->sin_theta_l = ppb_scene_sin_theta_l(sc);
     P->cos_theta_l = ppb_scene_cos_theta_l(sc);
     P->tan_theta_l = ppb_scene_tan_theta_l(sc);
-    P->n = sc->n;
     if (sc->n > 1.0) { /* inside, the refracted beam (ppb_fresnel.h) */
         ppb_fresnel_beam b = ppb_fresnel_beam_in(P->cos_theta_l, sc->n);
         P->sin_theta_l = b.sin_t;
@@ -434,11 +422,8 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
         P->beam_fs = ppb_fresnel(b.sin_t, 1.0 / sc->n);
         P->refl = 1;
     }
-    (void)th;
     P->hstep = hstep;
     P->d_cap = 40.0;
-    P->tube = tube;
-    P->step_kind = tube ? sc->step : PPB_STEP_NONE;
     int nr = 0;
     P->nl = 0;
     P->nx = 1;
@@ -447,7 +432,6 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
         grid_x(sc, spacing, &P->nl, &nr, &P->hxl, &P->hxr);
         P->nx = P->nl + nr + 1;
     }
-    P->height = sc->height;
     grid_y(sc, spacing, P);
     G->nnodes = P->nx * P->ny;
 
@@ -560,14 +544,14 @@ int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, 
 {
     const ppb_rte_params *P = &G->P;
     int m = 2 * G->dirs.n,
-        two = P->tube && (P->step_kind == PPB_STEP_DENSITY || P->step_kind == PPB_STEP_ALBEDO);
+        two = P->med.tube && (P->med.step == PPB_STEP_DENSITY || P->med.step == PPB_STEP_ALBEDO);
     pp_solution *s[2] = {NULL, NULL};
     double tau0[2];
     for (int c = 0; c < 1 + two; c++) {
         double st =
-            c ? (P->step_kind == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t) : sc->sigma_t;
+            c ? (P->med.step == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t) : sc->sigma_t;
         double al =
-            c ? (P->step_kind == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo) : sc->albedo;
+            c ? (P->med.step == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo) : sc->albedo;
         tau0[c] = st * sc->height;
         /* n > 1: the Fresnel slab, on the same snapped partition as the grid's. */
         pp_params pp = {tau0[c], al, sc->g,
@@ -588,7 +572,7 @@ int ppb_rte_initial_pp(const ppb_rte_grid *G, const ppb_scene *sc, double *rad, 
             int node = j * P->nx + i, lit;
             double x = ppb_rte_node_x(P, i), y = ppb_rte_node_y(P, j), D;
             ppb_rte_light(P, x, y, &D, &lit);
-            int c = two && x >= P->step_x;
+            int c = two && x >= P->med.step_x;
             if (lit) {
                 double tau = D * P->cos_theta_l;
                 pp_cell_field(s[c], tau < 0.0 ? 0.0 : (tau > tau0[c] ? tau0[c] : tau), field);
@@ -645,9 +629,10 @@ static double beam_path_absorbed(const ppb_scene *sc, double xe)
     double c = ppb_scene_cos_theta_l(sc), s = ppb_scene_sin_theta_l(sc);
     if (sc->geometry == PPB_GEOM_SLAB)
         return (1.0 - sc->albedo) * (1.0 - exp(-sc->sigma_t * sc->height / c));
+    ppb_medium M = ppb_medium_of(sc);
     double lend = sc->height / c;
-    if (s > 0.0)
-        lend = fmin(lend, (0.5 * sc->width - xe) / s);
+    if (s > 0.0) /* or through S4 first */
+        lend = fmin(lend, ppb_tube_length_x(sc->width, xe, s));
     double ls = lend;
     if (s > 0.0 && xe < sc->step_x && (sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO))
         ls = fmin(lend, (sc->step_x - xe) / s);
@@ -656,9 +641,8 @@ static double beam_path_absorbed(const ppb_scene *sc, double xe)
         double len = seg[k][1] - seg[k][0];
         if (len <= 0.0)
             continue;
-        double xm = xe + 0.5 * (seg[k][0] + seg[k][1]) * s;
-        double st = ppb_sigma_t_at(xm, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-        double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+        double st, al;
+        ppb_piece_medium(&M, xe, s, seg[k][0], seg[k][1], &st, &al);
         sum += (1.0 - al) * exp(-tau) * -expm1(-st * len);
         tau += st * len;
     }
@@ -676,12 +660,8 @@ static double path_absorbed(const ppb_scene *sc, double x_entry, void *arg)
 static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
 {
     const double *fc = arg;
-    double st = sc->geometry == PPB_GEOM_TUBE
-                    ? ppb_sigma_t_at(xe, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right)
-                    : sc->sigma_t;
-    double al = sc->geometry == PPB_GEOM_TUBE
-                    ? ppb_albedo_at(xe, sc->step, sc->step_x, sc->albedo, sc->albedo_right)
-                    : sc->albedo;
+    ppb_medium M = ppb_medium_of(sc); /* slab: no step, sigma_t and alpha everywhere */
+    double st = ppb_medium_sigma_t(&M, xe), al = ppb_medium_albedo(&M, xe);
     double e = exp(-st * sc->height / fc[1]);
     return (1.0 - al) * (1.0 - e) / (1.0 - fc[0] * e);
 }
@@ -694,12 +674,13 @@ static double fresnel_path_absorbed(const ppb_scene *sc, double xe, void *arg)
 static double fresnel_walk_absorbed(const ppb_scene *sc, double x_e, void *arg)
 {
     const ppb_fresnel_beam *b = arg;
+    ppb_medium M = ppb_medium_of(sc);
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
     double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, out = 0.0;
     for (int hit = 0; hit < 100000 && w > 1e-16; hit++) {
-        double ly = dy > 0.0 ? -y / dy : (-H - y) / dy;
-        double lx = dx > 0.0 ? (0.5 * W - x) / dx : (-0.5 * W - x) / dx;
-        double l = fmin(lx, ly), f = lx < ly ? fs : b->f_inside;
+        double l;
+        int face = ppb_exit_face(1, W, H, x, y, dx, dy, &l);
+        double f = ppb_face_is_side(face) ? fs : b->f_inside;
         double cut[3] = {0.0, l, l};
         int nc = 2;
         if ((sc->step == PPB_STEP_ALBEDO || sc->step == PPB_STEP_DENSITY) && dx != 0.0) {
@@ -708,19 +689,14 @@ static double fresnel_walk_absorbed(const ppb_scene *sc, double x_e, void *arg)
                 cut[1] = ls, nc = 3;
         }
         for (int k = 0; k + 1 < nc; k++) {
-            double xm = x + 0.5 * (cut[k] + cut[k + 1]) * dx;
-            double st = ppb_sigma_t_at(xm, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-            double al = ppb_albedo_at(xm, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+            double st, al;
+            ppb_piece_medium(&M, x, dx, cut[k], cut[k + 1], &st, &al);
             double lost = -expm1(-st * (cut[k + 1] - cut[k]));
             out += w * (1.0 - al) * lost;
             w *= 1.0 - lost;
         }
         w *= f;
-        x += l * dx, y += l * dy;
-        if (lx < ly)
-            dx = -dx, x = dx < 0.0 ? 0.5 * W : -0.5 * W;
-        else
-            dy = -dy, y = dy > 0.0 ? -H : 0.0;
+        ppb_tube_reflect(face, W, H, l, &x, &y, &dx, &dy);
     }
     return out;
 }

@@ -26,7 +26,7 @@
 #ifndef PPB_RTE2D_PARAMS_H
 #define PPB_RTE2D_PARAMS_H
 
-#include "ppb_conventions.h"
+#include "ppb_tube.h"
 
 #ifdef __OPENCL_VERSION__
 #define PPB_RTE_GMEM __global
@@ -94,21 +94,18 @@ PPB_FN int ppb_moc_nedge(int nfx, int ny, int face)
  * (-sin, down), (-sin, up). */
 #define PPB_RTE_BND 11
 
-/* Parameters of one launch. All doubles first, then an even number of ints (host asserts). */
+/* Parameters of one launch. The medium block, then all doubles, then an even number of ints
+ * (host asserts). */
 typedef struct ppb_rte_params {
-    double width, height;
-    double sigma_t, sigma_t_right, albedo, albedo_right, step_x;
-    double g;                                     /* HG asymmetry (the exit march's beam term) */
-    double sin_theta_l, cos_theta_l, tan_theta_l; /* light incidence */
+    ppb_medium med;                               /* the cross-section and the medium */
+    double sin_theta_l, cos_theta_l, tan_theta_l; /* light incidence (at n > 1 inside) */
     double hxl, hxr, hy;                          /* node spacings left/right of the step, in y */
     double hyf, dlay;                             /* y: boundary-layer spacing and depth */
     double hstep;                                 /* march step length in the x-y plane, mfp */
     double d_cap;                                 /* optical distance where a march stops */
-    double n;       /* refractive index (reference: Medium); the light fields above are inside */
     double beam_in; /* n > 1: perpendicular irradiance of the refracted beam (ppb_fresnel.h) */
     double beam_fb; /* n > 1: F the beam meets at S2 and S1 from inside */
     double beam_fs; /* n > 1: F the beam meets at S3 and S4 from inside (oblique light) */
-    int tube, step_kind;
     int nx, ny, nl; /* nodes in x (nl cells left of the split) and y */
     int ncell;      /* sweep: direction cells marched */
     int beam;       /* 1: add the direct beam's first scattering */
@@ -129,9 +126,9 @@ PPB_FN int ppb_rte_nnodes(const ppb_rte_params *P)
 /* x of node column i. */
 PPB_FN double ppb_rte_node_x(const ppb_rte_params *P, int i)
 {
-    if (!P->tube)
+    if (!P->med.tube)
         return 0.0;
-    return i <= P->nl ? -0.5 * P->width + i * P->hxl : P->step_x + (i - P->nl) * P->hxr;
+    return i <= P->nl ? -0.5 * P->med.width + i * P->hxl : P->med.step_x + (i - P->nl) * P->hxr;
 }
 
 /* Depth below S1 (or above S2) of a boundary-layer node k rows from the face: hyf (2^k - 1).
@@ -148,7 +145,7 @@ PPB_FN double ppb_rte_node_y(const ppb_rte_params *P, int j)
         return -ppb_rte_layer_t(P, j);
     if (j <= P->nyl + P->nym)
         return -(P->dlay + (j - P->nyl) * P->hy);
-    return -(P->height - ppb_rte_layer_t(P, P->ny - 1 - j));
+    return -(P->med.height - ppb_rte_layer_t(P, P->ny - 1 - j));
 }
 
 /* The layer row k = floor(log2(u)) of u = t / hyf + 1 >= 1, clamped to [0, nyl - 1]: by
@@ -177,14 +174,14 @@ PPB_RTE_HOT int ppb_rte_layer_row(const ppb_rte_params *P, double u)
 PPB_RTE_HOT void ppb_rte_row(const ppb_rte_params *P, double y, int *j, double *ty)
 {
     double t = -y;
-    t = t < 0.0 ? 0.0 : (t > P->height ? P->height : t);
+    t = t < 0.0 ? 0.0 : (t > P->med.height ? P->med.height : t);
     if (P->nyl > 0 && t < P->dlay) {
         int k = ppb_rte_layer_row(P, t / P->hyf + 1.0);
         double t0 = ppb_rte_layer_t(P, k);
         *j = k;
         *ty = (t - t0) / (P->hyf * (double)(1 << k));
-    } else if (P->nyl > 0 && t > P->height - P->dlay) {
-        double u = P->height - t; /* height above S2 */
+    } else if (P->nyl > 0 && t > P->med.height - P->dlay) {
+        double u = P->med.height - t; /* height above S2 */
         int k = ppb_rte_layer_row(P, u / P->hyf + 1.0);
         double u1 = ppb_rte_layer_t(P, k + 1);
         *j = P->ny - 2 - k;
@@ -202,8 +199,8 @@ PPB_RTE_HOT void ppb_rte_row(const ppb_rte_params *P, double y, int *j, double *
 /* Fractional node column of x (tube), clamped to the grid. */
 PPB_RTE_HOT double ppb_rte_fx(const ppb_rte_params *P, double x)
 {
-    double f = (P->nl == P->nx - 1 || x < P->step_x) ? (x + 0.5 * P->width) / P->hxl
-                                                     : P->nl + (x - P->step_x) / P->hxr;
+    double f = (P->nl == P->nx - 1 || x < P->med.step_x) ? (x + 0.5 * P->med.width) / P->hxl
+                                                         : P->nl + (x - P->med.step_x) / P->hxr;
     return f < 0.0 ? 0.0 : (f > P->nx - 1 ? P->nx - 1 : f);
 }
 
@@ -234,27 +231,26 @@ PPB_RTE_HOT double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM do
 PPB_FN void ppb_rte_light(const ppb_rte_params *P, double x, double y, double *D, int *lit)
 {
     double t = -y < 0.0 ? 0.0 : -y, len = t / P->cos_theta_l;
-    if (!P->tube) {
-        *D = P->sigma_t * len;
+    if (!P->med.tube) {
+        *D = P->med.sigma_t * len;
         *lit = 1;
         return;
     }
     double xp = x - t * P->tan_theta_l;
-    *lit = xp >= -0.5 * P->width - 1e-12 * P->width &&
-           (P->step_kind != PPB_STEP_SHADOW || xp < P->step_x);
-    if (P->step_kind != PPB_STEP_DENSITY) {
-        *D = P->sigma_t * len;
+    *lit = ppb_tube_lit_at(&P->med, xp, 1e-12 * P->med.width);
+    if (P->med.step != PPB_STEP_DENSITY) {
+        *D = P->med.sigma_t * len;
         return;
     }
     /* The path's horizontal span is [xp, x]; the part left of the step has sigma_t. */
     double fl;
     if (x - xp <= 0.0)
-        fl = x < P->step_x ? 1.0 : 0.0;
+        fl = x < P->med.step_x ? 1.0 : 0.0;
     else {
-        double s = P->step_x < xp ? xp : (P->step_x > x ? x : P->step_x);
+        double s = P->med.step_x < xp ? xp : (P->med.step_x > x ? x : P->med.step_x);
         fl = (s - xp) / (x - xp);
     }
-    *D = len * (P->sigma_t * fl + P->sigma_t_right * (1.0 - fl));
+    *D = len * (P->med.sigma_t * fl + P->med.sigma_t_right * (1.0 - fl));
 }
 
 #endif

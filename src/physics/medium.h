@@ -1,0 +1,16 @@
+/* medium.h: the host's one packer of the medium block every kernel receives
+ * (kernels/ppb_medium.h; reference: Medium, Geometry).
+ *
+ * ppb_medium_of fills it from the scene: the cross-section, both sides of the step, n and g; the
+ * step's kind is PPB_STEP_NONE in slab mode (a slab config with a step is refused, reference:
+ * Medium). march.c, rte2d_grid.c and method_mc.c embed its result in their launch parameters,
+ * and the host's own walks through the tube (ppb_tube.h) read it. */
+#ifndef PPB_PHYSICS_MEDIUM_H
+#define PPB_PHYSICS_MEDIUM_H
+
+#include "kernels/ppb_tube.h"
+#include "model/scene.h"
+
+ppb_medium ppb_medium_of(const ppb_scene *sc);
+
+#endif
