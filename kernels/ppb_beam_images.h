@@ -1,6 +1,6 @@
 /* ppb_beam_images.h: the direct beam's first scattering along a ray piece, coded once for the
  * ray marchers of `ss` and `pp` (march.cl) and of `rte2d` (rte2d.cl) (reference: Methods;
- * issue 18 for n > 1).
+ * Medium for n > 1).
  *
  * Owns: the closed form of the beam's first scattering over a step along which both optical
  * depths are linear (ppb_beam_step), and, at n > 1 in the tube at oblique incidence, the
@@ -30,7 +30,7 @@ inline double ppb_phi1(double z)
 /* The direct beam's factor exp(e_a) phi1(z) over a step whose exponent runs from e_a to
  * e_b = e_a + z <= 0, times C sigma_t h (in the association the march always used). As written,
  * exp(e_a) phi1(z) is 0 x inf once e_a underflows while z overflows (a grazing beam in a thick
- * medium marched towards the light: e_a ~ -D, z ~ +D; issue 15's NaN); the scaled form exp(e_b) (1
+ * medium marched towards the light: e_a ~ -D, z ~ +D; the NaN); the scaled form exp(e_b) (1
  * - e^{-z}) / z is the same number without either. It is taken only below e_a = -700, where
  * exp(e_a) leaves the normal range: since e_b <= 0 bounds z by -e_a, neither factor can overflow
  * above that threshold, and the direct form keeps its bits there. */

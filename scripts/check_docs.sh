@@ -13,7 +13,9 @@
 #     heading of the reference;
 #   - `ppbench --help` does not point to docs/reference.md;
 #   - any file of the repository links to ../shared (a path outside any clone), or a document or
-#     comment the reference replaced still cites SPEC.md.
+#     comment the reference replaced still cites SPEC.md;
+#   - a comment or document cites a tracker's issue number ("issue 14"), which a reader of the
+#     repository cannot follow: cite docs/reference.md or the literature.
 # PPBENCH selects the binary (default ./ppbench); TMPDIR where the runs go.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -126,6 +128,12 @@ cited=$( (ls README.md results/*.md configs/README.md docs/*.md
   sort -u)
 if out=$(printf '%s\n' "$cited" | xargs -d '\n' grep -nIE 'SPEC(\.md| [0-9])'); then
   echo "check_docs: SPEC.md (outside this repository) is still cited; cite docs/reference.md:"
+  echo "$out"
+  fail=1
+fi
+
+if out=$(printf '%s\n' "$cited" | xargs -d '\n' grep -nIiE '\bissues? [0-9]+\b'); then
+  echo "check_docs: a tracker's issue number is cited (a clone has no tracker):"
   echo "$out"
   fail=1
 fi

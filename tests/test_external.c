@@ -1,4 +1,4 @@
-/* Methods from outside (issue 17; docs/external.md), through the built binary ($PPBENCH):
+/* Methods from outside (docs/external.md), through the built binary ($PPBENCH):
  * - `ppbench scene` writes scene.json whose sample points and bins are the conventions' own:
  *   checked against kernels/ppb_conventions.h (the point count of the layout, the bin index of
  *   every averaging direction as the Monte Carlo tallies bin it, w_k summing to pi -- reference:

@@ -1,4 +1,4 @@
-/* Hostile and mistaken input to the config reader and the sweep grid (issue 14, part "input"):
+/* Hostile and mistaken input to the config reader and the sweep grid (part "input"):
  * each test reproduces a defect of the earlier code and checks the fixed behaviour. Bad input
  * is refused before any work starts, with exit code 2 and a message naming file:line: [section]
  * key (or the --set option). Expected values are the literal text of each config (its lines,

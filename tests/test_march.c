@@ -209,7 +209,7 @@ static double slab_error(const double *rad, const pp_solution *sol, const ppb_sc
     return worst;
 }
 
-/* Issue 5: in slab mode `pp` re-integrates the solver's exact source along each ray, so it must
+/* In slab mode `pp` re-integrates the solver's exact source along each ray, so it must
  * return the solver's own exit radiance (within 0.5%). With the S table the march is exact for
  * the slab's linear D, so the bound is far tighter in practice (printed). */
 static void test_pp_slab_reproduces_solver(void **state)

@@ -1,4 +1,4 @@
-/* test_mc.c: the photon Monte Carlo reference (issue 4): chi-square tests of the kernel's HG and
+/* test_mc.c: the photon Monte Carlo reference: chi-square tests of the kernel's HG and
  * azimuth samplers, the vector Fresnel code against the scalar one, the semi-infinite albedo and
  * the roulette balance, the ballistic beam, published slab values, single scattering against its
  * closed form, bit-identity across work-group sizes, chunkings and shards, seeds, the tube's mirror
@@ -666,7 +666,7 @@ static void test_vector_fresnel_matches_scalar(void **state)
 }
 
 /* The kernel bins an exit in float vectors and sends a lane to the scalar double code only
- * where float cannot decide (issue 21): checked against the conventions' own binning
+ * where float cannot decide: checked against the conventions' own binning
  * (ppb_segment_of, ppb_dir_bin with atan2, in the kernel's double) on 4096 x lanes exits per
  * layout, a quarter of them put on a theta, phi or segment edge each, at 8 and 2 lanes, in
  * the tube at the study's bins, at odd bin counts, at the largest bins and segments the config

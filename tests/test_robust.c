@@ -1,4 +1,4 @@
-/* Robustness over the keys' whole ranges (issue 15): every method, tube and slab, on the grid
+/* Robustness over the keys' whole ranges: every method, tube and slab, on the grid
  * of the issue, albedo {0, 0.01, 0.5, 0.95, 0.999, 1} x g {-0.95, -0.5, 0, 0.5, 0.95} x H
  * {1e-3, 0.1, 1, 100, 1e3} x theta_L {0, 45, 80, 89} (600 points per geometry), at coarse
  * settings (bins, segments, solver directions, albedo nodes, map and march resolution,
@@ -463,7 +463,7 @@ static void test_image_series_cost(void **state)
 }
 
 /* The experiment's result arrays are checked against [run] memory_limit before any is allocated
- * (issue 15): mp alone on the coarse tube holds one result of ncells radiances and standard
+ *: mp alone on the coarse tube holds one result of ncells radiances and standard
  * errors, 16 ncells bytes (expected value from the layout); a limit 1 % below that refuses the
  * run with the estimate in the message, one 1 % above lets it run. */
 static void test_result_memory_checked(void **state)

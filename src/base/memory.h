@@ -1,4 +1,4 @@
-/* memory.h: the memory limit of a run (issue 15): what a method may allocate, and the check a
+/* memory.h: the memory limit of a run: what a method may allocate, and the check a
  * method makes with its own estimate before it allocates anything, so that a point too large
  * for the machine is refused with the estimate in the message instead of growing until the
  * allocator or the OpenCL runtime fails (or the machine swaps). */

@@ -1,5 +1,5 @@
 /* result_check.h: what every deterministic method's output is checked for before it is written
- * (issue 15): no NaN or inf (the method fails with where it happened, nothing is written for
+ *: no NaN or inf (the method fails with where it happened, nothing is written for
  * it), no negative radiance (clamped to 0, counted and reported on stderr: a clamp is never
  * silent), and the energy sum R + T + sides + ballistic within a tolerance of at most 1
  * (reported when above; the values stay as computed: where a model is poor, as pp off the centre

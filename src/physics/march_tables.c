@@ -13,7 +13,7 @@
 #include "kernels/march_params.h"
 #include "kernels/ppb_fresnel.h"
 
-/* Direction sample `dir` in the table order of ppb_bin_sample_index. At n > 1 (issue 18) the
+/* Direction sample `dir` in the table order of ppb_bin_sample_index. At n > 1 the
  * tables hold nvar variants of every sample, variant v at dir + v ndir_base: the air-side sample
  * mapped inside by Snell (kernels/ppb_fresnel.h: ppb_inside_dir), mirrored in y when v & 1 and in
  * x when v & 2: the directions of the viewing ray's legs after its reflections (march.cl). */

@@ -29,7 +29,7 @@
  *   angular detail finer than a cell (single scattering, the HG peak) is kept.
  * - Energy: rows of P conserve exactly (phase.h), so R + T + absorbed + ballistic = 1 holds to
  *   rounding for the cell field; the totals come from the cell field at the faces.
- * - Refractive boundaries, n > 1 (issue 18; reference: Keys): every Fresnel path is skipped at
+ * - Refractive boundaries, n > 1 (reference: Keys): every Fresnel path is skipped at
  *   n = 1, which stays the code above bit for bit. At n > 1:
  *   - Boundary conditions (paper Sec. 3.2's smooth faces): at each face the light of an
  *     outgoing cell reflects into its mirror cell with the cell-averaged reflectance
@@ -116,7 +116,7 @@ void pp_source_coeffs(const pp_solution *s, const double w[3], double *a, double
 /* The same modes a_k(w) with the beams' whole coefficients, single scattering included: J's
  * coefficient of exp(-tau/mu0) (*down) and of exp(-(tau0 - tau)/mu0) (*up, the beam reflected
  * at S2; 0 at n = 1): J = sum_k a_k e_k + down e^{-tau/mu0} + up e^{-(tau0-tau)/mu0} + a_lin tau
- * (issue 18: the marcher at n > 1). */
+ * (the marcher at n > 1). */
 void pp_source_beams(const pp_solution *s, const double w[3], double *a, double *down, double *up);
 double pp_source_linear(const pp_solution *s); /* a_lin: 0 unless alpha = 1 */
 double pp_source_direct(const pp_solution *s, double tau, const double w[3]);

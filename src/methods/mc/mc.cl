@@ -5,7 +5,7 @@
  * x = step_x), scatters by Henyey-Greenstein, loses weight by implicit capture (w *= alpha) with
  * unbiased Russian roulette (applied at every event past an event cap, kernels/mc_params.h, so
  * no photon can run forever), and leaves at its first boundary crossing when n = 1. At n > 1
- * (issue 18) it enters refracted with weight 1 - F(theta_L) and at every boundary hit is
+ * it enters refracted with weight 1 - F(theta_L) and at every boundary hit is
  * reflected specularly with probability F(cos theta_i) or leaves refracted into air, the exit
  * binned by its air-side direction (ppb_mc_boundaries). Its exit weight goes into integer
  * fixed-point tallies (kernels/mc_params.h), so sums do not depend on the order of the atomic
@@ -82,7 +82,7 @@ typedef struct ppb_mc_vctr {
 
 /* Each 32-bit word rides in the low half of a 64-bit lane, so that a round is two 32 x 32 ->
  * 64-bit multiplies (vpmuludq, which reads only the low halves), two shifts for the high words
- * and the XORs, with nothing repacked into 32-bit lanes (issue 21: repacking the products'
+ * and the XORs, with nothing repacked into 32-bit lanes (repacking the products'
  * halves, vpmulld for the low words and two permutes for the high ones, made a round half
  * again as long; PoCL's vector mul_hi, in 16-bit pieces, was worse still). The high halves
  * carry garbage that no low half ever sees: XOR is bitwise and the multiplies read the low
@@ -133,7 +133,7 @@ inline int ppb_mc_segment(const ppb_mc_params *p, int surf, float x, float y)
 }
 
 /* The phi-bin edges e_k = k pi / nphi, k = 1 .. nphi - 1, as (cos e_k, sin e_k): computed once
- * per work-item so that binning an exit needs no atan2 (issue 21: atan2 was a fifth of the
+ * per work-item so that binning an exit needs no atan2 (atan2 was a fifth of the
  * kernel's time). */
 typedef struct ppb_mc_edges {
     double c[PPB_MC_MAX_PHI], s[PPB_MC_MAX_PHI];
@@ -212,7 +212,7 @@ inline ulong ppb_mc_hsum(const vulong *v)
     return sum;
 }
 
-/* Cell-tally additions waiting to be made, flushed PPB_MC_PEND at a time (issue 21: the lock
+/* Cell-tally additions waiting to be made, flushed PPB_MC_PEND at a time (the lock
  * add of each exit, made at once, was a sixth of the kernel's time, stalled behind the step's
  * pending stores and the cell's cache miss). Each cell is prefetched when its addition is
  * queued (ppb_mc_tally), so that its miss overlaps the steps until the flush (a load there
@@ -286,8 +286,8 @@ inline int ppb_mc_low_lane(uint bits)
     return 31 - (int)clz(bits & (0u - bits));
 }
 
-/* The state of every lane as vectors, which stay in registers from step to step (issue 21:
- * kept in private arrays, it was loaded and stored whole every step and written lane by lane
+/* The state of every lane as vectors, which stay in registers from step to step (kept
+ * in private arrays, it was loaded and stored whole every step and written lane by lane
  * at every photon's start, and the vector loads that followed those scalar stores stalled). A
  * lane whose photon has finished keeps its final state (done; masked out of every update) until
  * ppb_mc_refill tallies and replaces it, together with the other finished lanes. */
@@ -311,7 +311,7 @@ typedef struct ppb_mc_queue {
 } ppb_mc_queue;
 
 /* The entry words of the photons m0 + j P, j = 0 .. LANES - 1, into w, by one vector Philox
- * (issue 21: a scalar one per photon was a tenth of the kernel's time, one on all lanes at
+ * (a scalar one per photon was a tenth of the kernel's time, one on all lanes at
  * every refill 7%). */
 PPB_MC_HOT void ppb_mc_entry_words(const ppb_mc_params *p, const ppb_mc_queue *q, ulong m0, uint *w)
 {
@@ -399,8 +399,8 @@ inline size_t ppb_mc_exit_cell(const ppb_mc_params *p, const ppb_mc_edges *e, in
 /* Cell (row and bin, before the tally's offset) of every lane's exit as it would be binned
  * now, in float vectors, and where float cannot decide (a value within its rounding of a segment,
  * theta or phi edge) a lane flag: that lane is binned by the scalar double code
- * (ppb_mc_segment, ppb_mc_dir_bin) instead, so every bin is the one that code gives (issue 21:
- * binning exit by exit in scalar code was half of the kernel's time). The bounds: each float
+ * (ppb_mc_segment, ppb_mc_dir_bin) instead, so every bin is the one that code gives (binning
+ * exit by exit in scalar code was half of the kernel's time). The bounds: each float
  * quantity below is a few roundings (relative 2^-24 each) of values of magnitude <= 1 times
  * nseg or ntheta, so within 2e-7 nseg, 2e-7 ntheta and 3e-7 of the double one (itself within
  * 1e-15); the margins are ten times that and more, so outside them both sides of every edge
@@ -526,7 +526,7 @@ PPB_MC_HOT vdouble ppb_mc_vfresnel(vdouble cos_i, vdouble cos_t, double n_rel)
  * once. With probability F(cos theta_i) (r, the step's unused fourth word) it is reflected
  * specularly and flies on (its *left cleared); else it leaves along the refracted air-side
  * direction (tangential components times n, Snell), which ppb_mc_tally bins. Total internal
- * reflection has F = 1. In double, as ppb_fresnel.h (issue 21: that scalar code lane by lane,
+ * reflection has F = 1. In double, as ppb_fresnel.h (that scalar code lane by lane,
  * through memory, was a quarter of the kernel's time at n = 1.4). */
 PPB_MC_HOT void ppb_mc_boundaries(const ppb_mc_params *p, ppb_mc_state *s, vint *left, vint side,
                                   vuint r)
@@ -661,7 +661,7 @@ PPB_MC_HOT void ppb_mc_step(const ppb_mc_params *p, ppb_mc_state *s, const float
  * its work-item j being the q-th of the batch, q = (w / batches) L + j, which takes the q-th,
  * (q + P)-th, ... of them. A work-group then stays inside one batch, so the cell tallies it
  * updates are one batch's slice, and consecutive work-groups, which a CPU runs at the same time
- * on its cores, update different slices (issue 21: two cores adding into the same lines of one
+ * on its cores, update different slices (two cores adding into the same lines of one
  * slice pass them back and forth). A work-item's totals are summed privately with one atomic
  * per total at the end. Which work-item or lane traces a photon never changes the photon's
  * path, and integer sums do not depend on their order, so any global size, work-group size,

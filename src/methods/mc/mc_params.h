@@ -30,7 +30,7 @@ typedef uint32_t ppb_u32;
 #define PPB_MC_ROULETTE_W 1e-3f
 #define PPB_MC_ROULETTE_M 8.0f
 
-/* Event cap (issue 15): past PPB_MC_EVENT_CAP scatterings every further interaction is a
+/* Event cap: past PPB_MC_EVENT_CAP scatterings every further interaction is a
  * roulette with the same survival probability 1 / PPB_MC_ROULETTE_M and weight factor, whatever
  * the weight. Roulette is unbiased wherever it is applied, so the estimate keeps its
  * expectation; what changes is the work: a photon that would wander on (at albedo 1 in a thick

@@ -31,7 +31,7 @@ uint64_t ppb_mc_scene_fingerprint(const ppb_scene *sc)
                      sc->segments_top, sc->segments_side, sc->sigma_t, sc->albedo, sc->g, sc->step,
                      sc->step_x, sc->sigma_t_right, sc->albedo_right, sc->theta_deg, sc->ntheta,
                      sc->nphi);
-    /* n joins the text only where it acts (issue 18), so n = 1 fingerprints are those of before. */
+    /* n joins the text only where it acts, so n = 1 fingerprints are those of before. */
     if (sc->n > 1.0 && n > 0 && n < (int)sizeof buf)
         n += snprintf(buf + n, sizeof buf - (size_t)n, " n=%.17g", sc->n);
     return ppb_hash64(buf, n < (int)sizeof buf ? (size_t)n : sizeof buf - 1);
@@ -422,7 +422,7 @@ void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int onc
     st->capture = C.mean, st->capture_se = C.se;
     st->roulette = net, st->roulette_se = dof > 0 ? sqrt(ss_net / dof) : 0;
     st->events_per_photon = E.mean;
-    /* The beam's specular reflection at entry is exact, not tallied (issue 18). */
+    /* The beam's specular reflection at entry is exact, not tallied. */
     st->mean.specular = sc->n > 1.0 ? ppb_fresnel(ppb_scene_cos_theta_l(sc), sc->n) : 0.0;
     if (once) {
         /* mc1 holds only the once-scattered exits: what it does not hold is not "absorbed"

@@ -60,7 +60,7 @@ static ppb_mc_params make_params(const ppb_config *cfg)
     ppb_scene_light_dir(sc, wl);
     float entry_weight = 1.0f;
     if (sc->n > 1.0) {
-        /* The beam enters refracted (Snell) with 1 - F; F is the specular total (issue 18). At
+        /* The beam enters refracted (Snell) with 1 - F; F is the specular total. At
          * n = 1 nothing here runs, so the photons are those of before bit for bit. */
         double cos_l = ppb_scene_cos_theta_l(sc);
         wl[0] = wl[0] / sc->n;
@@ -148,7 +148,7 @@ static int device_shape(const ppb_ocl *ocl, mc_shape *shape, ppb_err *err)
                                             sizeof width, &width, NULL),
                             "clGetDeviceInfo(CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT)", err))
         return -1;
-    /* issue 21: 16 lanes on PoCL's AVX-512 device take 10-15% less CPU time than 8 */
+    /* 16 lanes on PoCL's AVX-512 device take 10-15% less CPU time than 8 */
     shape->lanes = cpu ? (width >= 16 ? 16 : 8) : 2;
     /* $PPBENCH_MC_LANES (2, 4, 8 or 16) overrides the lane count: tests/test_mc.c checks that
      * it never changes a tally, and benchmarks compare widths with it. */
@@ -232,7 +232,7 @@ static int create_buffers(mc_run *r, ppb_err *err)
 /* Work-group size 0 means ppbench picks (device_shape): 64 work-items on a GPU; 1 on a CPU,
  * where PoCL then compiles the work-item as it stands, its state in registers from step to
  * step, while a larger group runs its work-items in a loop that keeps every value carried
- * from one step to the next in per-work-item arrays, stored each step (issue 21: a fifth of
+ * from one step to the next in per-work-item arrays, stored each step (a fifth of
  * the kernel's time at 64). Either keeps a group inside one batch. A size the user asked for
  * is never shrunk silently. */
 static int pick_workgroup(const ppb_config *cfg, const ppb_ocl *ocl, const mc_shape *shape,
@@ -454,7 +454,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
     ppb_mc_tallies t;
-    /* Issue 15: the tallies live three times (host, its copy read back for noise checks, the
+    /* The tallies live three times (host, its copy read back for noise checks, the
      * device buffer), each batches x 2 tallies x cells of 8 bytes; estimated first. */
     double tally = (double)cfg->mc.batches * PPB_MC_NTALLY *
                    (double)ppb_scene_layout(&cfg->scene).ncells * sizeof(uint64_t);

@@ -231,7 +231,7 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
     return L;
 }
 
-/* ---- refractive boundaries (n > 1, issue 18; reference: Methods, `ss`) ----
+/* ---- refractive boundaries (n > 1; reference: Methods, `ss`) ----
  * `ss` only (with_modes = 0). Inside, the once-scattered source is the refracted beam and its
  * unscattered reflections: down the beam D (direction w_t, optical depth D from the maps), up
  * the beam reflected at S2 (direction w_t mirrored in y, optical depth 2 D_b - D with D_b the

@@ -11,7 +11,7 @@
 #include "physics/totals.h"
 #include "methods/result_check.h"
 
-/* Issue 15: what the pipeline will hold at its peak, estimated before it allocates, against
+/* What the pipeline will hold at its peak, estimated before it allocates, against
  * the run's memory limit: the maps and the tables twice (host and device copy), the tables'
  * build scratch and the radiance buffer. */
 static int pp_memory_check(const ppb_config *cfg, int with_modes, ppb_err *err)
@@ -72,7 +72,7 @@ int ppb_pp_pipeline(ppb_run_ctx *ctx, ppb_result *out, int with_modes, ppb_err *
         .table = cfg->pp.table, .step = cfg->pp.step, .telescope = 1, .npts = cfg->samples_seg};
     rc = ppb_march_all(ocl, sc, &maps, tab, &opts, out->method, ctx->quiet, out->radiance,
                        &out->partial, err);
-    /* Issue 15: nothing non-finite is written, negative radiance is clamped with a count. */
+    /* Nothing non-finite is written, negative radiance is clamped with a count. */
     if (!rc)
         rc = ppb_radiance_check(cfg->name, out, NULL, err);
     if (!rc) {

@@ -81,7 +81,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
     double mx = -wx, my = -wy;
     /* A direction in a wall's plane must run along it: the cells centred at phi = pi/2 have
      * wx = cos(pi/2) ~ 6e-17, not 0, and that sign made lfar = 0 at the nodes of S3 alone, so
-     * those cells carried no radiance there and S3 came out ~1 % below S4 (issue 19). A planar
+     * those cells carried no radiance there and S3 came out ~1 % below S4. A planar
      * component under 1e-12 moves the ray under 4e-11 mfp before d_cap stops it. */
     if (fabs(mx) < 1e-12)
         mx = 0.0;
@@ -129,7 +129,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
                 /* D is linear along a piece, but not continuous at its ends: at normal incidence
                  * it jumps where the ray crosses a density step, and an end on the step plane
                  * took the other side's slope (S2 came out 2.5 % low left of the step and 5 %
-                 * high right of it, issue 19). So D at the ends is extrapolated from the piece's
+                 * high right of it). So D at the ends is extrapolated from the piece's
                  * points at 1/4 and 3/4, exact for a linear D. */
                 double l1 = la + 0.25 * len, l2 = la + 0.75 * len;
                 ppb_rte_light(P, px + l1 * mx, py + l1 * my, &Da, &la_lit);

@@ -38,7 +38,7 @@ static void grid_x(const ppb_scene *sc, double spacing, int *nl, int *nr, double
 /* y rows (rte2d_params.h): under S1 and over S2 a boundary layer of RTE_LAYER_LEVELS rows,
  * spacing / 16 doubling to spacing / 2 (depth 15/16 spacing), the middle at about spacing;
  * uniform when the layers would not leave a middle of at least one spacing. Chosen on the nodal
- * scheme rte2d had before its flat-source regions (issue 19: at spacing 0.1 the layers took its
+ * scheme rte2d had before its flat-source regions (at spacing 0.1 the layers took its
  * conservation error from -4.7e-3 to -3.3e-3, six levels gained nothing more); the regions are
  * the nodes' dual cells, so the layers refine them as well, where a grazing cell's radiance
  * rises from 0 within |mu| mfp. */
@@ -70,7 +70,7 @@ static void grid_y(const ppb_scene *sc, double spacing, ppb_rte_params *P)
  * 3.5e-3 at 128 cells per hemisphere (1.4e-2 at 32), and shadow_step's S4 came out 0.70 % above
  * the 4e8-photon Monte Carlo (0.27 % with the factor 0.99827; the sides' total +0.36 % -> +0.11 %
  * in uniform_g0_normal). y is left as it is: there the cells are the slab solver's own, and
- * scaling it too took S1 from -0.06 % to -0.25 % against the Monte Carlo (issue 19). */
+ * scaling it too took S1 from -0.06 % to -0.25 % against the Monte Carlo. */
 static void lateral_scale(ppb_rte_grid *G)
 {
     double s2 = 0.0;

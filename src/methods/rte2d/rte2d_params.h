@@ -14,7 +14,7 @@
  * hyf, 2 hyf, .., 2^(nyl-1) hyf (depth dlay = hyf (2^nyl - 1)), the middle nym rows of hy
  * (nyl = 0: uniform; ppb_rte_node_y): the scattered light of a direction rises from 0 at a face
  * within about |mu| mfp, so the source has a boundary layer as thin as the most grazing cell's
- * |mu| (issue 19, measured on the nodal scheme rte2d had before its flat-source regions: the
+ * |mu| (measured on the nodal scheme rte2d had before its flat-source regions: the
  * layers mattered, x much less). The flat-source regions of the sweep are the nodes' dual cells
  * (rte2d_grid.h), so the layers refine them too. In x the nodes are uniform on
  * [-W/2, step_x] (nl cells) and on [step_x, W/2] (nr cells), sharing the node at step_x, so the
