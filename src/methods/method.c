@@ -128,7 +128,5 @@ int ppb_method_sum(ppb_run_ctx *ctx, ppb_result *out,
     if (rc)
         return -1;
     ppb_progress_end(&pr, (double)out->layout.ncells);
-    ppb_result probe = *out;
-    ppb_totals_complete(&probe.totals);
-    return ppb_totals_check(ctx->cfg->name, &probe, err);
+    return ppb_totals_check_completed(ctx->cfg->name, out, err);
 }

@@ -64,3 +64,14 @@ int ppb_totals_check(const char *name, ppb_result *r, ppb_err *err)
                 name, r->method, sum);
     return 0;
 }
+
+int ppb_totals_check_completed(const char *name, ppb_result *r, ppb_err *err)
+{
+    ppb_result probe = *r;
+    ppb_totals_complete(&probe.totals);
+    int rc = ppb_totals_check(name, &probe, err);
+    double absorbed = r->totals.absorbed;
+    r->totals = probe.totals;
+    r->totals.absorbed = absorbed;
+    return rc;
+}

@@ -1,6 +1,8 @@
 /* medium.c: the medium block from the scene (medium.h). */
 #include "physics/medium.h"
 
+#include <math.h>
+
 ppb_medium ppb_medium_of(const ppb_scene *sc)
 {
     int tube = sc->geometry == PPB_GEOM_TUBE;
@@ -18,4 +20,29 @@ ppb_medium ppb_medium_of(const ppb_scene *sc)
         .tube = tube,
     };
     return m;
+}
+
+int ppb_lit_pieces(const ppb_scene *sc, ppb_lit_piece piece[2])
+{
+    double xa = -0.5 * sc->width, xb = 0.5 * sc->width;
+    if (sc->step == PPB_STEP_SHADOW)
+        xb = fmin(xb, sc->step_x);
+    double cut[3] = {xa, xb, xb};
+    int n = 1, npiece = 0;
+    if ((sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO) && sc->step_x > xa &&
+        sc->step_x < xb) {
+        cut[1] = sc->step_x;
+        n = 2;
+    }
+    for (int i = 0; i < n; i++) {
+        if (!(cut[i + 1] > cut[i]))
+            continue;
+        double x = 0.5 * (cut[i] + cut[i + 1]); /* the piece's coefficients: at its entry points */
+        ppb_lit_piece *p = &piece[npiece++];
+        p->xa = cut[i];
+        p->xb = cut[i + 1];
+        p->sigma_t = ppb_sigma_t_at(x, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
+        p->albedo = ppb_albedo_at(x, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
+    }
+    return npiece;
 }

@@ -13,4 +13,15 @@
 
 ppb_medium ppb_medium_of(const ppb_scene *sc);
 
+/* A piece of S1's lit strip over which the medium is one (reference: Light, Medium): [xa, xb],
+ * and sigma_t and albedo at its entry points. */
+typedef struct ppb_lit_piece {
+    double xa, xb, sigma_t, albedo;
+} ppb_lit_piece;
+
+/* S1's lit strip (the tube's top, ended at a shadow step), cut where a density or albedo step
+ * inside it changes the medium: at most two pieces, the empty ones left out; returns how many.
+ * The diffusion models integrate their profiles over it (mp, burley). */
+int ppb_lit_pieces(const ppb_scene *sc, ppb_lit_piece piece[2]);
+
 #endif

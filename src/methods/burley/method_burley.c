@@ -31,6 +31,7 @@
 #include "methods/result_check.h"
 #include "physics/diffuse_exit.h"
 #include "physics/maps.h"
+#include "physics/medium.h"
 #include "physics/ppsolver.h"
 
 #define BURLEY_MAX_THETA 64
@@ -97,28 +98,13 @@ static int piece_profile(const ppb_config *cfg, double sigma_t, double albedo, b
 /* The lit strip, cut at the step when the medium changes there: at most two pieces (mp's). */
 static int burley_pieces(const ppb_config *cfg, burley_piece piece[2], int *npiece, ppb_err *err)
 {
-    const ppb_scene *sc = &cfg->scene;
-    double xa = -0.5 * sc->width, xb = 0.5 * sc->width;
-    if (sc->step == PPB_STEP_SHADOW)
-        xb = fmin(xb, sc->step_x);
-    double cut[3] = {xa, xb, xb};
-    int n = 1;
-    if ((sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO) && sc->step_x > xa &&
-        sc->step_x < xb) {
-        cut[1] = sc->step_x;
-        n = 2;
-    }
-    *npiece = 0;
-    for (int i = 0; i < n; i++) {
-        if (!(cut[i + 1] > cut[i]))
-            continue;
-        double x = 0.5 * (cut[i] + cut[i + 1]);
-        burley_piece *p = &piece[(*npiece)++];
-        p->xa = cut[i];
-        p->xb = cut[i + 1];
-        double st = ppb_sigma_t_at(x, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-        double al = ppb_albedo_at(x, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
-        if (piece_profile(cfg, st, al, p, err))
+    ppb_lit_piece lit[2];
+    *npiece = ppb_lit_pieces(&cfg->scene, lit);
+    for (int i = 0; i < *npiece; i++) {
+        burley_piece *p = &piece[i];
+        p->xa = lit[i].xa;
+        p->xb = lit[i].xb;
+        if (piece_profile(cfg, lit[i].sigma_t, lit[i].albedo, p, err))
             return -1;
     }
     return 0;
@@ -225,11 +211,7 @@ int ppb_method_burley(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     out->totals.specular = ex.specular;
     if (ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
-    ppb_totals t = out->totals;
-    ppb_totals_complete(&t);
-    ppb_result probe = *out;
-    probe.totals = t;
-    return ppb_totals_check(cfg->name, &probe, err);
+    return ppb_totals_check_completed(cfg->name, out, err);
 }
 
 int ppb_burley_check(const ppb_config *cfg, ppb_err *err)

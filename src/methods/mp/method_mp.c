@@ -39,6 +39,7 @@
 #include "methods/result_check.h"
 #include "physics/diffuse_exit.h"
 #include "physics/maps.h"
+#include "physics/medium.h"
 #include "methods/mp/multipole.h"
 
 /* The boundary terms at n > 1 (file comment); fresnel = 0 at n = 1, where none applies. */
@@ -84,28 +85,14 @@ static int mp_pieces(const ppb_config *cfg, const mp_boundary *bd, mp_piece piec
                      ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
-    double xa = -0.5 * sc->width, xb = 0.5 * sc->width;
-    if (sc->step == PPB_STEP_SHADOW)
-        xb = fmin(xb, sc->step_x);
-    double cut[3] = {xa, xb, xb};
-    int n = 1;
-    if ((sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO) && sc->step_x > xa &&
-        sc->step_x < xb) {
-        cut[1] = sc->step_x;
-        n = 2;
-    }
-    *npiece = 0;
-    for (int i = 0; i < n; i++) {
-        if (!(cut[i + 1] > cut[i]))
-            continue;
-        double x = 0.5 * (cut[i] + cut[i + 1]); /* the piece's coefficients: at its entry points */
-        mp_piece *p = &piece[(*npiece)++];
-        p->xa = cut[i];
-        p->xb = cut[i + 1];
-        double st = ppb_sigma_t_at(x, sc->step, sc->step_x, sc->sigma_t, sc->sigma_t_right);
-        double al = ppb_albedo_at(x, sc->step, sc->step_x, sc->albedo, sc->albedo_right);
-        if (ppb_multipole_init_boundary(&p->mp, st, al, sc->g, sc->height, cfg->mp.pairs, bd->A,
-                                        bd->cos_t, err))
+    ppb_lit_piece lit[2];
+    *npiece = ppb_lit_pieces(sc, lit);
+    for (int i = 0; i < *npiece; i++) {
+        mp_piece *p = &piece[i];
+        p->xa = lit[i].xa;
+        p->xb = lit[i].xb;
+        if (ppb_multipole_init_boundary(&p->mp, lit[i].sigma_t, lit[i].albedo, sc->g, sc->height,
+                                        cfg->mp.pairs, bd->A, bd->cos_t, err))
             return -1;
         if (bd->fresnel) { /* the sources 1/sigma_t' along the refracted beam */
             double shift = bd->sin_t / p->mp.sigma_t_reduced;
@@ -251,11 +238,7 @@ int ppb_method_mp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         ppb_progress_end(&pr, nseg);
     if (rc || ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
-    ppb_totals t = out->totals;
-    ppb_totals_complete(&t);
-    ppb_result probe = *out;
-    probe.totals = t;
-    return ppb_totals_check(cfg->name, &probe, err);
+    return ppb_totals_check_completed(cfg->name, out, err);
 }
 
 int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
