@@ -7,9 +7,10 @@
 #              draws the error maps, linear between the stops in sRGB).
 mcolor(m) = m eq 'mc' ? '#000000' : m eq 'mc1' ? '#7f7f7f' : m eq 'pp' ? '#0072B2' : \
             m eq 'ss' ? '#009E73' : m eq 'mp' ? '#D55E00' : m eq 'mp+ss' ? '#CC79A7' : \
-            m eq 'rte2d' ? '#E69F00' : m eq 'external' ? '#56B4E9' : '#999999'
+            m eq 'rte2d' ? '#E69F00' : m eq 'burley' ? '#882255' : \
+            m eq 'burley+ss' ? '#44AA99' : m eq 'external' ? '#56B4E9' : '#999999'
 mpoint(m) = m eq 'mc' ? 7 : m eq 'mc1' ? 6 : m eq 'pp' ? 5 : m eq 'ss' ? 9 : m eq 'mp' ? 11 : \
-            m eq 'mp+ss' ? 13 : m eq 'rte2d' ? 4 : 1
+            m eq 'mp+ss' ? 13 : m eq 'rte2d' ? 4 : m eq 'burley' ? 8 : m eq 'burley+ss' ? 10 : 1
 viridis = "set palette defined (0 '#440154', 1 '#482878', 2 '#3E4989', 3 '#31688E', \
   4 '#26828E', 5 '#1F9E89', 6 '#35B779', 7 '#6DCD59', 8 '#B4DE2C', 9 '#FDE725')"
 coolwarm = "set palette defined (-50 '#3B4CC0', 0 '#DDDDDD', 50 '#B40426')"
