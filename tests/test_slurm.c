@@ -168,11 +168,15 @@ static void test_scripts_run(void **state)
 static void test_config_copy(void **state)
 {
     (void)state;
-    /* Axes in the file's order, light before medium, which is not the key table's. */
-    const char *cfg_path = cli_config("slurm-copy", "[experiment]\nname = copy\nmethods = mc, mp\n"
+    /* Axes in the file's order, light before medium, which is not the key table's; an external
+     * method's section, [method.m2], comes back as itself (it was written as [method] with a key
+     * m2.command, which does not load: "unknown section"). */
+    const char *cfg_path = cli_config("slurm-copy", "[experiment]\nname = copy\n"
+                                                    "methods = mc, mp, m2\n"
                                                     "[light]\ntheta_deg = 45, 0, 30\n"
                                                     "[medium]\ng = 0.1:0.3:0.1\nalbedo = 0.7\n"
-                                                    "[mc]\nphotons = 123456789\nseed = 42\n");
+                                                    "[mc]\nphotons = 123456789\nseed = 42\n"
+                                                    "[method.m2]\ncommand = m2 {scene} {out}\n");
     ppb_config cfg, back;
     ppb_grid *grid = ppb_grid_new(), *gback = ppb_grid_new();
     ppb_err err = {{0}};

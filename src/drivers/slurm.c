@@ -220,8 +220,13 @@ char *ppb_slurm_config_text(const ppb_config *cfg, const ppb_grid *grid, const c
         next = nl ? nl + 1 : line + strlen(line);
         if (nl)
             *nl = '\0';
-        char *dot = strchr(line, '.'), *eq = strstr(line, " = ");
-        if (!dot || !eq || dot > eq)
+        /* The key is after the last dot before " = ": an external method's lines are
+         * "method.NAME.key", its section [method.NAME]. */
+        char *eq = strstr(line, " = "), *dot = NULL;
+        for (char *p = line; eq && p < eq; p++)
+            if (*p == '.')
+                dot = p;
+        if (!dot || !eq)
             continue;
         if (axis_of_line(grid, line, (size_t)(eq - line)))
             continue;
