@@ -25,7 +25,7 @@ TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 LIB   := $(BUILD)/libppbench.a
 BIN   ?= ppbench
 
-.PHONY: all deps test test-physics layers methods-check docs unit asan bench perf format format-check clean
+.PHONY: all deps test test-long layers methods-check docs unit asan bench perf format format-check clean
 all: $(BIN)
 
 # Dependencies first: the pkg-config flags are only asked for once the packages are there.
@@ -82,21 +82,22 @@ $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
 # PPBENCH_CACHE set empty: no Monte Carlo reference cache (the user's default one included), so
 # every suite traces what it runs: a changed Monte Carlo shows, whatever was cached before;
 # the cache's own tests give their directories explicitly.
-# The physics validations against independent references that take minutes (adding-doubling
-# and the Monte Carlo at n > 1, rte2d against ppslab and the Monte Carlo, Chandrasekhar's
-# H-function, the multipole's closed forms) are `make test-physics`, which CI runs after
-# `make test` (.ci/run), so that `make test` stays within 8 minutes on a 2-core machine.
-PHYSICS_TESTS := $(patsubst %,$(BUILD)/tests/%,test_fresnel test_rte2d test_rte2d_beam \
-                   test_burley test_multipole)
-UNIT_TESTS    := $(filter-out $(PHYSICS_TESTS),$(TESTS))
+# What takes minutes is `make test-long`, which CI runs after `make test` (.ci/run), so that
+# `make test` stays within 8 minutes on a 2-core machine: the physics validations against
+# independent references (adding-doubling and the Monte Carlo at n > 1, rte2d against ppslab and
+# the Monte Carlo, Chandrasekhar's H-function, the multipole's closed forms), the robustness
+# grid with its thin, grazing, n = 2.5 corner, and the newcomer's path from a fresh clone.
+LONG_TESTS := $(patsubst %,$(BUILD)/tests/%,test_fresnel test_rte2d test_rte2d_beam \
+                test_burley test_multipole test_robust)
+UNIT_TESTS := $(filter-out $(LONG_TESTS),$(TESTS))
 run-suites = @mkdir -p $(BUILD)/tmp; fail=0; for t in $(1); do \
 	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) PPB_VERSION_FILE=$(CURDIR)/$(BUILD)/version.txt \
 	    PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp $$t || fail=1; \
 	done; exit $$fail
 unit: $(BIN) $(UNIT_TESTS)
 	$(call run-suites,$(UNIT_TESTS))
-test-physics: $(BIN) $(PHYSICS_TESTS)
-	$(call run-suites,$(PHYSICS_TESTS))
+test-long: $(BIN) $(LONG_TESTS) test-newcomer
+	$(call run-suites,$(LONG_TESTS))
 
 # The layer check first: it reads includes only and fails in a second. Then the reference's
 # check (docs/reference.md against what a few tiny runs write, a few seconds).
@@ -107,7 +108,7 @@ test: layers methods-check docs unit
 # check, partial external methods (tests/test_study_loop.sh, about 20 s); the newcomer's whole
 # path from a fresh clone (tests/test_newcomer.sh: a clone, its build, every study case scored).
 .PHONY: test-study-loop test-newcomer
-test: test-study-loop test-newcomer
+test: test-study-loop
 test-study-loop: $(BIN)
 	@mkdir -p $(BUILD)/tmp
 	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp bash tests/test_study_loop.sh
@@ -133,7 +134,7 @@ asan:
 	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 	$(MAKE) BUILD=build-asan BIN=build-asan/ppbench OPT="-O1 -g" \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" \
-	  unit test-physics
+	  unit test-long
 
 bench: $(BIN)
 	@bash scripts/bench.sh $(if $(QUICK),--quick)

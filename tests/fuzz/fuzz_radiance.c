@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "fuzz_util.h"
-#include "methods/method_external.h"
+#include "methods/external/method_external.h"
 #include "methods/result_check.h"
 #include "model/config.h"
 #include "model/result.h"
