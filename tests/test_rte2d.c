@@ -543,12 +543,12 @@ static void test_grid_convergence(void **state)
         ppb_result_free(&r[k]);
 }
 
-/* rte2d's convergence criterion (docs/reference.md: Methods, `rte2d`), on the study's first case (uniform_g0_normal: the 10 x 3
- * tube, g = 0, normal light, every default of the study): halving the grid (spacing 0.1 -> 0.05
- * and the track spacing and march step 0.05 -> 0.025), halving the direction cells' solid angle
- * (128 -> 256 per hemisphere), and both at once each change every summary cell (rms_rel against
- * the defaults) by less than 0.3 %. The reference for each is the finer solution itself: a
- * converged scheme's defaults are within that of it. */
+/* rte2d's convergence criterion (docs/reference.md: Methods, `rte2d`), on the study's first case
+ * (uniform_g0_normal: the 10 x 3 tube, g = 0, normal light, every default of the study): halving
+ * the grid (spacing 0.1 -> 0.05 and the track spacing and march step 0.05 -> 0.025), halving the
+ * direction cells' solid angle (128 -> 256 per hemisphere), and both at once each change every
+ * summary cell (rms_rel against the defaults) by less than 0.3 %. The reference for each is the
+ * finer solution itself: a converged scheme's defaults are within that of it. */
 static void test_study_convergence(void **state)
 {
     (void)state;
