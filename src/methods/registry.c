@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "methods/bdipole/method_bdipole.h"
 #include "methods/burley/method_burley.h"
 #include "methods/external/method_external.h"
 #include "methods/mc/method_mc.h"
@@ -68,6 +69,15 @@ static const ppb_method methods[] = {
      .summary = "Christensen-Burley profile plus single scattering",
      .run = run_sum,
      .sum_of = (const char *const[]){"burley", "ss", NULL}},
+    {.id = "bdipole",
+     .summary = "d'Eon's better dipole (Grosjean's D, exact Fresnel moments)",
+     .run = ppb_method_bdipole,
+     .check = ppb_bdipole_check,
+     .section = "bdipole"},
+    {.id = "bdipole+ss",
+     .summary = "d'Eon's better dipole plus single scattering",
+     .run = run_sum,
+     .sum_of = (const char *const[]){"bdipole", "ss", NULL}},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,
