@@ -142,6 +142,8 @@ static const key_def keys[] = {
      "burley: quadrature nodes per profile length d = mfp / s over the lit strip"},
     {"burley", "directions", K_INT, PPB_NOT_MC_KEY, F(burley.directions), 2, 2000, "334", NULL,
      "burley: direction cells per hemisphere of the slab solve that gives A (and twice as many)"},
+    {"pbd", "nodes", K_INT, PPB_NOT_MC_KEY, F(pbd.nodes), 2, 16, "6", NULL,
+     "pbd: Gauss-Legendre nodes per panel of the strip's x and z integrals"},
     {"rte2d", "spacing", K_REAL, PPB_NOT_MC_KEY, F(rte2d.spacing), 0.005, 10, "0.1", NULL,
      "rte2d: grid node spacing over the cross-section, mfp"},
     {"rte2d", "directions", K_INT, PPB_NOT_MC_KEY, F(rte2d.directions), 2, 2000, "128", NULL,
