@@ -31,7 +31,8 @@ void ppb_pbd_profile_init(ppb_pbd_profile *p, const ppb_pbd_table *t, double sig
 double ppb_pbd_sr(const ppb_pbd_profile *p, double r);
 
 /* 2 pi int_h^inf Sr(r) r dr: the flux through a plane at distance h >= 0 from the entry point;
- * Gauss-Legendre on each spline interval, exact for the cubic but where the clamp at 0 cuts. */
+ * 4-point Gauss-Legendre on 64 sub-panels of each spline interval: exact for the cubic, and
+ * close where the clamp at 0 cuts it (a kink, far out where the spline dips below 0). */
 double ppb_pbd_plane(const ppb_pbd_profile *p, double h);
 
 /* int_{-inf}^{inf} Sr(sqrt(rho^2 + z^2)) dz, rho >= 0: the line of entry points along z. Panels
