@@ -9,6 +9,7 @@
 #include "methods/mc/method_mc.h"
 #include "methods/mc/perf_mc.h"
 #include "methods/mp/method_mp.h"
+#include "methods/pbd/method_pbd.h"
 #include "methods/pp/method_pp.h"
 #include "methods/pp/method_ss.h"
 #include "methods/pp/perf_march.h"
@@ -78,6 +79,11 @@ static const ppb_method methods[] = {
      .summary = "d'Eon's better dipole plus single scattering",
      .run = run_sum,
      .sum_of = (const char *const[]){"bdipole", "ss", NULL}},
+    {.id = "pbd",
+     .summary = "photon beam diffusion (pbrt-v4's tabulated profile, single scattering included)",
+     .run = ppb_method_pbd,
+     .check = ppb_pbd_check,
+     .section = "pbd"},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,

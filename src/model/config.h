@@ -65,6 +65,9 @@ typedef struct ppb_burley_settings {
 typedef struct ppb_bdipole_settings {
     int samples; /* quadrature nodes per 1 / sigma_tr over the lit strip */
 } ppb_bdipole_settings;
+typedef struct ppb_pbd_settings {
+    int nodes; /* Gauss-Legendre nodes per panel of the strip's x and z integrals */
+} ppb_pbd_settings;
 
 typedef struct ppb_rte2d_settings {
     double spacing;  /* grid node spacing over the cross-section, mfp */
@@ -115,6 +118,7 @@ typedef struct ppb_config {
     ppb_mp_settings mp;
     ppb_burley_settings burley;
     ppb_bdipole_settings bdipole;
+    ppb_pbd_settings pbd;
     ppb_rte2d_settings rte2d;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
