@@ -45,9 +45,10 @@ static int key_text(ppb_run_ctx *ctx, long long chunk, int with_device, FILE *f,
     for (int k = 0; k < ppb_config_nkeys(); k++) {
         ppb_key_info info;
         ppb_config_key_info(k, &info);
-        if (info.mc == PPB_MC_KEY && !(info.keyed_when_set && ppb_config_key_at_default(cfg, k)))
-            ppb_config_write_key(cfg, k, f);
-        else if (info.mc != PPB_NOT_MC_KEY)
+        if (info.mc == PPB_MC_KEY) {
+            if (!(info.keyed_when_set && ppb_config_key_at_default(cfg, k)))
+                ppb_config_write_key(cfg, k, f);
+        } else if (info.mc != PPB_NOT_MC_KEY)
             return ppb_fail(err,
                             "mc: key %s.%s: the key table does not say whether it changes "
                             "the Monte Carlo",
