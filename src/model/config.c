@@ -70,9 +70,6 @@ typedef struct key_def {
     const char *def;
     const enum_name *enums; /* K_ENUM: the value names */
     const char *help;
-    /* 1: a PPB_MC_KEY key that joins the cache's key only away from its default (config.h,
-     * ppb_key_info); 0 for every key but those added after references were shipped. */
-    int keyed_when_set;
 } key_def;
 
 #define F(field) offsetof(ppb_config, field)
@@ -96,9 +93,9 @@ static const key_def keys[] = {
     {"tube", "segments_side", K_INT, PPB_MC_KEY, F(scene.segments_side), 1, 4096, "36", NULL,
      "segments of S3 and S4"},
     {"medium", "material", K_MATERIAL, PPB_MC_KEY, F(material), 0, 0, "none", NULL,
-     "a measured medium (`ppbench materials`) that sets sigma_t, albedo, g and n, or none", 1},
+     "a measured medium (`ppbench materials`) that sets sigma_t, albedo, g and n, or none"},
     {"medium", "channel", K_ENUM, PPB_MC_KEY, F(channel), 0, 0, "g", channel_names,
-     "the material's colour channel", 1},
+     "the material's colour channel"},
     {"medium", "sigma_t", K_REAL, PPB_MC_KEY, F(scene.sigma_t), 1e-3, 1000, "1", NULL,
      "extinction, 1/mfp (left of the step)"},
     {"medium", "albedo", K_REAL, PPB_MC_KEY, F(scene.albedo), 0, 1, "0.95", NULL,
@@ -176,6 +173,12 @@ static const key_def keys[] = {
      "the machine's memory"},
 };
 #undef F
+
+/* The PPB_MC_KEY keys that join the cache's key only away from their defaults (config.h,
+ * ppb_key_info.keyed_when_set): added after references were traced and shipped, and at their
+ * defaults changing nothing, so those references keep their keys. */
+static const char *const keyed_when_set[] = {"medium.material", "medium.channel"};
+
 #define NKEYS ((int)(sizeof keys / sizeof keys[0]))
 _Static_assert(sizeof keys / sizeof keys[0] <= PPB_MAX_KEYS, "raise PPB_MAX_KEYS");
 
@@ -1491,7 +1494,10 @@ void ppb_config_key_info(int key, ppb_key_info *info)
     info->def = k->def;
     for (int i = 0; k->enums && k->enums[i].name && i < 15; i++)
         info->enums[i] = k->enums[i].name;
-    info->keyed_when_set = k->keyed_when_set;
+    char name[128];
+    snprintf(name, sizeof name, "%s.%s", k->section, k->key);
+    for (size_t i = 0; i < sizeof keyed_when_set / sizeof keyed_when_set[0]; i++)
+        info->keyed_when_set |= strcmp(name, keyed_when_set[i]) == 0;
 }
 
 int ppb_config_key_at_default(const ppb_config *cfg, int key)
