@@ -250,6 +250,27 @@ static void test_config_material(void **state)
     assert_close(cfg.scene.n, 1.3, 0);
 }
 
+/* A key beside the material that states the material's own value is accepted (provenance.txt
+ * holds every resolved key, and `ppbench score` reads it back as --set options), another value
+ * is refused. */
+static void test_restated_value(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    ppb_err err;
+    const char *path = tu_config("material_restated", "[experiment]\nunit = mm\n");
+    const char *same[] = {"medium.material=skimmilk", "medium.sigma_t=1.2225", "medium.g=0",
+                          "medium.n=1.3", "medium.albedo=0.99795501022494892"};
+    if (ppb_config_load_sets(&cfg, NULL, path, same, 5, &err))
+        fail_msg("%s", err.msg);
+    assert_rel(cfg.scene.sigma_t, 1.2225, 1e-15);
+    const char *other[] = {"medium.material=skimmilk", "medium.sigma_t=1.2226"};
+    assert_int_equal(ppb_config_load_sets(&cfg, NULL, path, other, 2, &err), -1);
+    assert_non_null(strstr(err.msg,
+                           "--set medium.sigma_t: given together with material = "
+                           "skimmilk (--set medium.material), which sets it to 1.2224999"));
+}
+
 /* config.ini (ppb_config_write_ini) leaves the material's keys as comments, so it loads back
  * into the same medium. */
 static void test_ini_round_trip(void **state)
@@ -292,7 +313,7 @@ static void test_errors(void **state)
         {"with_albedo_set", "material = apple\n", "--set medium.albedo=0.5",
          "--set medium.albedo: given together with material = apple"},
         {"channel_alone", "channel = r\n", "",
-         ":4: [medium] channel: selects a colour channel of a [medium] material, and none"},
+         ":4: [medium] channel: r selects a colour channel of a [medium] material, and none"},
         {"g_out_of_range", "material = merlot\nchannel = r\n", "",
          ":4: [medium] material: merlot's r channel has g = 0.974, outside the range [-0.95, "
          "0.95]"},
@@ -383,11 +404,17 @@ static void test_shipped_reference_kept(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_jensen_printed),       cmocka_unit_test(test_jensen_pbrt_rows),
-        cmocka_unit_test(test_narasimhan_copies),    cmocka_unit_test(test_rows_sane),
-        cmocka_unit_test(test_medium_of_channel),    cmocka_unit_test(test_config_material),
-        cmocka_unit_test(test_ini_round_trip),       cmocka_unit_test(test_errors),
-        cmocka_unit_test(test_cache_paths_distinct), cmocka_unit_test(test_shipped_reference_kept),
+        cmocka_unit_test(test_jensen_printed),
+        cmocka_unit_test(test_jensen_pbrt_rows),
+        cmocka_unit_test(test_narasimhan_copies),
+        cmocka_unit_test(test_rows_sane),
+        cmocka_unit_test(test_medium_of_channel),
+        cmocka_unit_test(test_config_material),
+        cmocka_unit_test(test_ini_round_trip),
+        cmocka_unit_test(test_restated_value),
+        cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_cache_paths_distinct),
+        cmocka_unit_test(test_shipped_reference_kept),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1023,44 +1023,47 @@ static const char *const material_keys[] = {"sigma_t", "albedo", "g", "n"};
 
 /* [medium] material and channel: the medium's sigma_t, albedo, g and n from the table
  * (model/materials.h), each checked against its own key's range; refused with a key that sets
- * any of them, without unit = mm, and a channel without a material. */
+ * any of them to another value, without unit = mm, and a channel without a material. */
 static int apply_material(ppb_config *cfg, ppb_err *err)
 {
     char where[256];
     const ppb_material *m = ppb_material_find(cfg->material);
     if (!m) {
-        if (key_given(cfg, "medium", "channel"))
+        /* Written configs (config.ini, provenance.txt) hold every key, the default channel
+         * too: only another channel is refused. */
+        if (cfg->channel != PPB_CH_G)
             return ppb_config_key_fail(cfg, "medium", "channel", err,
-                                       "selects a colour channel of a [medium] material, and "
-                                       "none is given");
+                                       "%s selects a colour channel of a [medium] material, and "
+                                       "none is given",
+                                       enum_value_name(channel_names, cfg->channel));
         return 0;
     }
-    for (size_t j = 0; j < sizeof material_keys / sizeof material_keys[0]; j++)
-        if (key_given(cfg, "medium", material_keys[j]))
-            return ppb_config_key_fail(
-                cfg, "medium", material_keys[j], err,
-                "given together with material = %s (%s), which sets it: remove one of the two",
-                m->name, origin_of(cfg, "medium", "material", where, sizeof where));
     if (cfg->unit != PPB_UNIT_MM)
         return ppb_config_key_fail(cfg, "medium", "material", err,
                                    "a material's coefficients are per mm: set [experiment] unit = "
                                    "mm, and give the tube's sizes in mm (unit = mfp from %s)",
                                    origin_of(cfg, "experiment", "unit", where, sizeof where));
     ppb_scene *sc = &cfg->scene;
-    double v[4];
+    double v[4], *dst[4] = {&sc->sigma_t, &sc->albedo, &sc->g, &sc->n};
     ppb_material_medium(m, (ppb_channel)cfg->channel, &v[0], &v[1], &v[2], &v[3]);
     for (int j = 0; j < 4; j++) {
         const key_def *k = &keys[find_key("medium", material_keys[j])];
+        /* A key given beside the material is refused unless it states the material's own value
+         * (provenance.txt, which `ppbench score` reads back, holds every resolved key). */
+        if (key_given(cfg, "medium", k->key) && *dst[j] != v[j])
+            return ppb_config_key_fail(
+                cfg, "medium", k->key, err,
+                "given together with material = %s (%s), which sets it to %.17g: remove one of "
+                "the two",
+                m->name, origin_of(cfg, "medium", "material", where, sizeof where), v[j]);
         if (v[j] < k->min || v[j] > k->max)
             return ppb_config_key_fail(
                 cfg, "medium", "material", err,
                 "%s's %s channel has %s = %g, outside the range [%g, %g] the methods take", m->name,
                 enum_value_name(channel_names, cfg->channel), k->key, v[j], k->min, k->max);
     }
-    sc->sigma_t = v[0];
-    sc->albedo = v[1];
-    sc->g = v[2];
-    sc->n = v[3];
+    for (int j = 0; j < 4; j++)
+        *dst[j] = v[j];
     return 0;
 }
 

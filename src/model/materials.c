@@ -12,9 +12,9 @@
  *    sigma_s (1 - g) instead, tests/test_materials.c checks the two agree); sigma_a as pbrt-v4
  *    carries it (to 5 significant digits; Mitsuba's are the same rounded to 5 decimals). Names
  *    as pbrt-v4's ("Budweiser Beer", "Orange Powder"; Mitsuba: "Budweiser Beder", "Orange Juice
- *    Powder"). */
-/* Jensen's rows: g = 0, the paper giving only the reduced scattering (ppb_material_medium).
- * Narasimhan's rows: n = 1.33, water's, Mitsuba 0.6's value (the paper measures no index). */
+ *    Powder").
+ * Jensen's rows have g = 0, the paper giving only the reduced scattering (ppb_material_medium);
+ * Narasimhan's n = 1.33, water's, Mitsuba 0.6's value (the paper measures no index). */
 /* clang-format off */
 static const ppb_material table[] = {
     /* Jensen, Marschner, Levoy, Hanrahan 2001, "A Practical Model for Subsurface Light
