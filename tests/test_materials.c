@@ -271,6 +271,30 @@ static void test_restated_value(void **state)
                            "skimmilk (--set medium.material), which sets it to 1.2224999"));
 }
 
+/* A sweep keeps the material at every grid point; a swept key the material sets is refused,
+ * also when its first value is the material's (potato's g is 0). */
+static void test_sweep(void **state)
+{
+    (void)state;
+    ppb_config cfg, pt;
+    ppb_grid *grid = ppb_grid_new();
+    ppb_err err;
+    assert_non_null(grid);
+    const char *path =
+        tu_config("material_sweep", "[experiment]\nunit = mm\n[tube]\nwidth = 5, "
+                                    "10\n[medium]\nmaterial = potato\nchannel = b\n");
+    if (ppb_config_load_grid(&cfg, grid, path, &err) || ppb_config_point(&cfg, grid, 1, &pt, &err))
+        fail_msg("%s", err.msg);
+    assert_close(pt.scene.width, 10, 0);
+    assert_rel(pt.scene.sigma_t, 0.55 + 0.12, 1e-15); /* Jensen's potato, blue */
+    path = tu_config("material_sweep_g", "[experiment]\nunit = mm\n[medium]\nmaterial = "
+                                         "potato\ng = 0, 0.5\n");
+    assert_int_equal(ppb_config_load_grid(&cfg, grid, path, &err), -1);
+    assert_non_null(
+        strstr(err.msg, ":5: [medium] g: swept together with material = potato (line 4)"));
+    ppb_grid_free(grid);
+}
+
 /* config.ini (ppb_config_write_ini) leaves the material's keys as comments, so it loads back
  * into the same medium. */
 static void test_ini_round_trip(void **state)
@@ -412,6 +436,7 @@ int main(void)
         cmocka_unit_test(test_config_material),
         cmocka_unit_test(test_ini_round_trip),
         cmocka_unit_test(test_restated_value),
+        cmocka_unit_test(test_sweep),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_cache_paths_distinct),
         cmocka_unit_test(test_shipped_reference_kept),

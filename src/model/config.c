@@ -1020,6 +1020,7 @@ static int key_given(const ppb_config *cfg, const char *section, const char *key
 
 /* The keys a material sets (reference: Materials). */
 static const char *const material_keys[] = {"sigma_t", "albedo", "g", "n"};
+static int set_by_material(const ppb_config *cfg, int k);
 
 /* [medium] material and channel: the medium's sigma_t, albedo, g and n from the table
  * (model/materials.h), each checked against its own key's range; refused with a key that sets
@@ -1065,6 +1066,19 @@ static int apply_material(ppb_config *cfg, ppb_err *err)
     for (int j = 0; j < 4; j++)
         *dst[j] = v[j];
     return 0;
+}
+
+/* apply_material, and a sweep over a key the material sets refused whatever its first value. */
+static int apply_material_grid(ppb_config *cfg, const ppb_grid *grid, ppb_err *err)
+{
+    char where[256];
+    for (int a = 0; grid && ppb_material_find(cfg->material) && a < grid->naxes; a++)
+        if (set_by_material(cfg, grid->axes[a].key))
+            return ppb_config_key_fail(
+                cfg, keys[grid->axes[a].key].section, keys[grid->axes[a].key].key, err,
+                "swept together with material = %s (%s), which sets it: remove one of the two",
+                cfg->material, origin_of(cfg, "medium", "material", where, sizeof where));
+    return apply_material(cfg, err);
 }
 
 /* Checks that involve more than one key; each names the key it fails and where the other
@@ -1175,7 +1189,7 @@ int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_
 {
     if (read_file(cfg, grid, path, err))
         return -1;
-    return apply_material(cfg, err) ? -1 : validate(cfg, err);
+    return apply_material_grid(cfg, grid, err) ? -1 : validate(cfg, err);
 }
 
 int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)
@@ -1209,7 +1223,7 @@ int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, co
 {
     if (override(cfg, grid, section, key, value, err))
         return -1;
-    return apply_material(cfg, err) ? -1 : validate(cfg, err);
+    return apply_material_grid(cfg, grid, err) ? -1 : validate(cfg, err);
 }
 
 int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const char *value,
@@ -1272,7 +1286,7 @@ int ppb_config_load_sets(ppb_config *cfg, ppb_grid *grid, const char *path, cons
         if (override(cfg, grid, section, key, eq + 1, err))
             return -1;
     }
-    return apply_material(cfg, err) ? -1 : validate(cfg, err);
+    return apply_material_grid(cfg, grid, err) ? -1 : validate(cfg, err);
 }
 
 int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, ppb_config *out,
