@@ -30,6 +30,12 @@
  * no decision, which the table's test refuses (tests/test_cache_keys.c). */
 typedef enum ppb_mc_key { PPB_MC_KEY = 1, PPB_NOT_MC_KEY = 2 } ppb_mc_key;
 
+/* The length unit of a config (reference: Materials): every length is in it and every
+ * coefficient per it. mfp: the study's, the reference medium's mean free path (sigma_t = 1 is
+ * that medium); mm: a measured material's, whose coefficients are per mm. The numbers the
+ * methods receive are the same either way: the unit says how to read them. */
+typedef enum ppb_unit { PPB_UNIT_MFP = 0, PPB_UNIT_MM = 1 } ppb_unit;
+
 #define PPB_MAX_METHODS 16
 #define PPB_MAX_KEYS    64
 
@@ -111,8 +117,11 @@ typedef struct ppb_config {
     int nmethods;
     char methods[PPB_MAX_METHODS][32]; /* ids as written; methods/registry.h checks them */
     ppb_scene scene;
-    int samples_dir; /* directions per bin axis for deterministic methods (n x n per bin) */
-    int samples_seg; /* points per segment for deterministic methods */
+    int unit;          /* ppb_unit */
+    char material[32]; /* a row of model/materials.h by name, or "none" */
+    int channel;       /* ppb_channel: the material's colour channel */
+    int samples_dir;   /* directions per bin axis for deterministic methods (n x n per bin) */
+    int samples_seg;   /* points per segment for deterministic methods */
     ppb_mc_settings mc;
     ppb_pp_settings pp;
     ppb_mp_settings mp;
@@ -194,9 +203,16 @@ typedef struct ppb_key_info {
     double min, max;
     const char *def;       /* the default as written in the table */
     const char *enums[16]; /* an enum key's value names, NULL-terminated; else enums[0] NULL */
+    /* 1: a PPB_MC_KEY key that joins the reference cache's key only when it is not at its
+     * default (ppb_config_key_at_default), because at its default it changes nothing: a key
+     * added after references were traced and shipped, which keep their keys. */
+    int keyed_when_set;
 } ppb_key_info;
 int ppb_config_nkeys(void);
 void ppb_config_key_info(int key, ppb_key_info *info);
+
+/* 1 when key k holds its default value in cfg (its written value is the default's). */
+int ppb_config_key_at_default(const ppb_config *cfg, int key);
 
 /* Key k's line of ppb_config_write_resolved ("section.key = value\n", the canonical form). */
 void ppb_config_write_key(const ppb_config *cfg, int key, FILE *out);
