@@ -13,8 +13,13 @@
 #include "base/progress.h"
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
+#include "model/config.h"
 #include "physics/directions.h"
 #include "physics/phase.h"
+
+_Static_assert(PP_DELTA_M_OFF == (int)PPB_DELTA_M_OFF && PP_DELTA_M_ON == (int)PPB_DELTA_M_ON &&
+                   PP_DELTA_M_AUTO == (int)PPB_DELTA_M_AUTO,
+               "[pp] delta_m's values are the solver's");
 
 #define RESONANCE_GAP    1e-7  /* |lambda mu0 - 1| below this moves mu0 */
 #define CONSERVATIVE_EPS 1e-13 /* 1 - alpha below this is alpha = 1 */
