@@ -66,7 +66,8 @@ static double ad_error(const pp_solution *s, const ad_case *c, double *dr, doubl
  * within 1.5e-3 (measured worst 1.40e-3: g 0.95, albedo 0.9999, tau0 10, n 1), and the worst
  * case at least 5 times better than off (measured 6.3). The 2e-4 the reference allows (its own
  * quadrature orders agree within 9e-5, the csv's _alt columns) is not reached: what is left
- * is the cells' discretisation, which falls as 1/directions (at 1000 cells: 3.7e-3 off). Energy:
+ * is the cells' discretisation, which falls as 1/directions (at 1000 cells: 3.7e-3 off, 6.6e-4
+ * with delta-M). Energy:
  * R + T + absorbed + ballistic + specular = 1 to rounding with delta-M too (the corrected
  * matrix's rows still sum to 1); the beam is not scaled, so `ballistic` is the unscattered
  * light's closed form (at normal incidence the geometric series of test_fresnel.c). */
@@ -134,6 +135,15 @@ static void test_deltam_modes(void **state)
         pp_free(paper), pp_free(aut);
     }
     assert_false(pp_delta_m_wanted(PP_DELTA_M_ON, -0.9)); /* a backward peak: not this */
+    /* albedo 1 (the conservative modes, built on the corrected matrix): nothing absorbed */
+    pp_params c = {3.0, 1.0, 0.95, 0.8, 60};
+    assert_int_equal(pp_solve_delta_m(&c, 1.0, PP_DELTA_M_ON, NULL, &on, NULL, &err), 0);
+    double R, T, B;
+    pp_totals(on, &R, &T, &B);
+    assert_close(R + T + B, 1.0, 1e-10);
+    assert_close(B, exp(-3.0 / 0.8), 1e-15);
+    assert_true(pp_delta_m(on) > 0.0);
+    pp_free(on);
 }
 
 /* The phase blocks a solve shares (the march's tables at several albedos) carry the forward

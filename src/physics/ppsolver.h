@@ -71,7 +71,9 @@
  *   1988) and `ballistic` stays the unscattered light. Measured against adding-doubling
  *   (tests/test_deltam.c): scaling the beam too, or truncating HG to HG(g') with g' = (g - f) /
  *   (1 - f), f = g^M, made the thin slabs worse (HG(g') misplaces the higher moments, the
- *   scaled beam counts the cells' forward part twice) and did not help the thick ones. */
+ *   scaled beam counts the cells' forward part twice) and did not help the thick ones. With it
+ *   the 108 cases of g 0.7-0.95 are within 1.4e-3 at 334 cells (8.9e-3 without), 6.6e-4 at
+ *   1000 (3.7e-3): the rest is the cells' discretisation, falling as 1 / directions. */
 #ifndef PPB_PPSOLVER_H
 #define PPB_PPSOLVER_H
 
