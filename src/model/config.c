@@ -53,6 +53,8 @@ static const enum_name unit_names[] = {{PPB_UNIT_MFP, "mfp"}, {PPB_UNIT_MM, "mm"
 static const enum_name channel_names[] = {
     {PPB_CH_R, "r"},     {PPB_CH_G, "g"},    {PPB_CH_B, "b"}, {PPB_CH_R, "red"},
     {PPB_CH_G, "green"}, {PPB_CH_B, "blue"}, {0, NULL}};
+static const enum_name delta_m_names[] = {
+    {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 
 /* An enum key is stored as an int (ppb_scene.geometry is a ppb_geometry). */
 _Static_assert(sizeof(ppb_geometry) == sizeof(int), "enum keys are stored as int");
@@ -148,6 +150,8 @@ static const key_def keys[] = {
      "albedo nodes of the tables (Sec. 3.3)"},
     {"pp", "map_res", K_INT, PPB_NOT_MC_KEY, F(pp.map_res), 1, 4096, "64", NULL,
      "cells per mfp of the optical-depth and albedo maps"},
+    {"pp", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(pp.delta_m), 0, 0, "auto", delta_m_names,
+     "slab solver's delta-M for forward-peaked HG: off, on, auto = on where g >= 0.6"},
     {"mp", "pairs", K_INT, PPB_NOT_MC_KEY, F(mp.pairs), 0, 200, "10", NULL,
      "dipole pairs beyond the first (0 = dipole)"},
     {"mp", "samples", K_INT, PPB_NOT_MC_KEY, F(mp.samples), 1, 256, "16", NULL,

@@ -56,7 +56,11 @@ typedef struct ppb_pp_settings {
     double step;    /* ray-march step length, mfp */
     int albedos;    /* albedo nodes of the tables (Sec. 3.3) */
     int map_res;    /* cells per mfp of the D(x) and average-albedo maps */
+    int delta_m;    /* PPB_DELTA_M_*: the slab solver's delta-M (ppslab and the march) */
 } ppb_pp_settings;
+
+/* [pp] delta_m; the values of PP_DELTA_M_* (physics/ppsolver.h, which asserts it). */
+typedef enum { PPB_DELTA_M_OFF = 0, PPB_DELTA_M_ON = 1, PPB_DELTA_M_AUTO = 2 } ppb_delta_m;
 
 typedef struct ppb_mp_settings {
     int pairs;   /* dipole pairs beyond the first (multipole) */
