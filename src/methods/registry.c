@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "methods/burley/method_burley.h"
+#include "methods/dirpole/method_dirpole.h"
 #include "methods/external/method_external.h"
 #include "methods/mc/method_mc.h"
 #include "methods/mc/perf_mc.h"
@@ -68,6 +69,15 @@ static const ppb_method methods[] = {
      .summary = "Christensen-Burley profile plus single scattering",
      .run = run_sum,
      .sum_of = (const char *const[]){"burley", "ss", NULL}},
+    {.id = "dirpole",
+     .summary = "directional dipole (Frisvad, Hachisuka & Kjeldsen 2014)",
+     .run = ppb_method_dirpole,
+     .check = ppb_dirpole_check,
+     .section = "dirpole"},
+    {.id = "dirpole+ss",
+     .summary = "directional dipole plus single scattering",
+     .run = run_sum,
+     .sum_of = (const char *const[]){"dirpole", "ss", NULL}},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,

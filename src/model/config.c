@@ -142,6 +142,9 @@ static const key_def keys[] = {
      "burley: quadrature nodes per profile length d = mfp / s over the lit strip"},
     {"burley", "directions", K_INT, PPB_NOT_MC_KEY, F(burley.directions), 2, 2000, "334", NULL,
      "burley: direction cells per hemisphere of the slab solve that gives A (and twice as many)"},
+    {"dirpole", "samples", K_INT, PPB_NOT_MC_KEY, F(dirpole.samples), 1, 256, "16", NULL,
+     "dirpole: quadrature nodes per diffusion length 1/sigma_tr along the strip and per unit of "
+     "t along z = q sinh t"},
     {"rte2d", "spacing", K_REAL, PPB_NOT_MC_KEY, F(rte2d.spacing), 0.005, 10, "0.1", NULL,
      "rte2d: grid node spacing over the cross-section, mfp"},
     {"rte2d", "directions", K_INT, PPB_NOT_MC_KEY, F(rte2d.directions), 2, 2000, "128", NULL,

@@ -62,6 +62,10 @@ typedef struct ppb_burley_settings {
     int directions; /* direction cells per hemisphere of the slab solve that gives A */
 } ppb_burley_settings;
 
+typedef struct ppb_dirpole_settings {
+    int samples; /* nodes per diffusion length along the strip and per unit of t along z */
+} ppb_dirpole_settings;
+
 typedef struct ppb_rte2d_settings {
     double spacing;  /* grid node spacing over the cross-section, mfp */
     int directions;  /* direction cells per hemisphere */
@@ -110,6 +114,7 @@ typedef struct ppb_config {
     ppb_pp_settings pp;
     ppb_mp_settings mp;
     ppb_burley_settings burley;
+    ppb_dirpole_settings dirpole;
     ppb_rte2d_settings rte2d;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
