@@ -120,9 +120,9 @@ double ppb_dirpole_exitance(const ppb_dirpole *p, const double x[3], const doubl
 #define REACH 40.0 /* sigma_tr r beyond which e^(-sigma_tr r) < 5e-18 */
 #define GL_Z  8
 #define GL_X  10
-/* Where the strip holds u = 0, its panels halve down to 1e-6 of the usual stop: the line
+/* Where the strip holds u = 0, its panels halve down to 1e-2 of the usual stop: the line
  * integral is not smooth there. */
-#define STOP_KINK 1e-6
+#define STOP_KINK 1e-2
 
 /* The decay rate that sets where the integrals stop: sigma_tr, or 1e-4 / D where nothing is
  * absorbed (the real and virtual sources' difference then falls like r^-3, and the plane
