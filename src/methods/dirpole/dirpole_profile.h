@@ -47,15 +47,17 @@ double ppb_dirpole_exitance(const ppb_dirpole *p, const double x[3], const doubl
 
 /* The exitance integrated over the line of entry points (x_i, 0, z), z over the whole axis, for
  * an exit point at (x_i + u, v, 0) with outward normal no (the entry normal is S1's, +y):
- * 2 int_0^inf over z = q sinh t, q = sqrt(u^2 + v^2 + l^2) (l the sources' smallest offset
- * from the exit point), Gauss-Legendre panels of 8 nodes, `samples` nodes per unit of t, out
- * to where sigma_tr r > 40 (e^-40). */
+ * 2 int_0^inf over z = q sinh t, q = min(sqrt(u^2 + v^2 + l^2), |u|) (l the sources' smallest
+ * offset from the exit point; |u| because the integrand is not smooth at u = z = 0: d_r holds
+ * r, not r^2, and n_i* turns over where x_o lies below x_i), Gauss-Legendre panels of 8 nodes,
+ * `samples` nodes per unit of t, out to where sigma_tr r > 40 (e^-40). */
 double ppb_dirpole_line(const ppb_dirpole *p, double u, double v, const double no[3], int samples);
 
 /* int over u in [ua, ub] of line(u, v): an exit point at (x, v) and entry points at x - u on S1.
  * 10-point Gauss-Legendre panels halving toward the nearest point of [ua, ub] (u = 0 when it is
- * inside) down to a quarter of its distance sqrt(u^2 + v^2 + l^2) from the sources, then panels
- * of at most 10 / (samples sigma_tr) out to where sigma_tr sqrt(u^2 + v^2) > 40. */
+ * inside) down to a quarter of its distance sqrt(u^2 + v^2 + l^2) from the sources (a hundredth
+ * of that toward u = 0, where the line is not smooth), then panels of at most
+ * 10 / (samples sigma_tr) out to where sigma_tr sqrt(u^2 + v^2) > 40. */
 double ppb_dirpole_strip(const ppb_dirpole *p, double ua, double ub, double v, const double no[3],
                          int samples);
 
