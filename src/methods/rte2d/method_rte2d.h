@@ -36,6 +36,7 @@ typedef struct ppb_rte2d_stats {
     int record_rungs;  /* K = 0: rungs of the refinement study (rte2d_refinements.csv) */
     int record_sweeps; /* its sweeps (not in sweeps) */
     double t_record;   /* seconds it took (in t_total) */
+    double delta_f;    /* delta-M's truncated fraction f (0: off, or not applied) */
 } ppb_rte2d_stats;
 
 /* The refinement study of a converged run (reference: rte2d_refinements.csv): run where the

@@ -83,6 +83,16 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
                       ppb_rte_grid *G, ppb_err *err);
 void ppb_rte_grid_free(ppb_rte_grid *G);
 
+/* Delta-M (Wiscombe 1977; reference: Methods, `rte2d`): the phase function p_g taken as
+ * f delta + (1 - f) p_g* with g* = (g - f) / (1 - f), the HG the cells transport (the same first
+ * moment, so the same sigma_s (1 - g)), f = g^L the part of the forward peak beyond the
+ * Legendre order L = sqrt(2 directions) that 2 directions cells over the sphere resolve (as
+ * DISORT's f = g^(2N) for 2N streams). *out = sc with g*, and in every medium of a step
+ * sigma_t' = (1 - alpha f) sigma_t, alpha' = alpha (1 - f) / (1 - alpha f) (sigma_a kept, the
+ * delta part counted as unscattered). Returns f; 0 with *out = sc where the scaled media cannot
+ * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. */
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out);
+
 /* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building. */
 double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart);
 
