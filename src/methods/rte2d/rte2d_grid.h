@@ -7,7 +7,8 @@
  * energy exactly and the slab limit is ppslab's own discrete-ordinates system). Why cells and not
  * Legendre moments: they are what ppslab and pp already use (slab mode then differs from
  * ppslab by the spatial discretisation alone), the same code serves every g in [-0.95, 0.95]
- * (the HG peak is integrated cell by cell, no truncation of its expansion), and the exit
+ * (the HG peak is integrated cell by cell, no truncation of its expansion; what of a peak
+ * narrower than a cell the cells blur, delta-M takes out, ppb_rte_delta_m), and the exit
  * radiance keeps angular detail finer than a cell through the cell integrals F_j(w) of
  * phase.h (source-function integration, as ppsolver.h). The set-up is symmetric in z, so a cell
  * and its z mirror (pp_dirs_zmirror) carry the same radiance and march the same planar ray: only
