@@ -55,6 +55,7 @@ static const enum_name channel_names[] = {
     {PPB_CH_G, "green"}, {PPB_CH_B, "blue"}, {0, NULL}};
 static const enum_name delta_m_names[] = {
     {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
+static const enum_name on_off_names[] = {{0, "off"}, {1, "on"}, {0, NULL}};
 
 /* An enum key is stored as an int (ppb_scene.geometry is a ppb_geometry). */
 _Static_assert(sizeof(ppb_geometry) == sizeof(int), "enum keys are stored as int");
@@ -177,6 +178,9 @@ static const key_def keys[] = {
      "rte2d: relative residual at which the solve stops"},
     {"rte2d", "refinements", K_INT, PPB_NOT_MC_KEY, F(rte2d.refinements), 0, 10000, "0", NULL,
      "rte2d: K steps of Eq. 5 from I_pp (1 = the paper's method on the grid); 0 = converge"},
+    {"rte2d", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.delta_m), 0, 0, "on", on_off_names,
+     "rte2d: delta-M scaling of the forward peak the direction cells cannot resolve, with the "
+     "single-scattering correction of the exit radiance"},
     {"output", "dir", K_PATH, PPB_NOT_MC_KEY, F(out_dir), 0, 0, "", NULL,
      "output directory; default results/<name>"},
     {"run", "memory_limit", K_REAL, PPB_NOT_MC_KEY, F(memory_limit), 0, 1e6, "0", NULL,

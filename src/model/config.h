@@ -88,6 +88,7 @@ typedef struct ppb_rte2d_settings {
     double step;     /* march step in the x-y plane, mfp */
     double tol;      /* relative residual of the converged solve */
     int refinements; /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
+    int delta_m;     /* 1: delta-M scaling with the single-scattering correction (TMS) */
 } ppb_rte2d_settings;
 
 /* A method defined by the config itself: a section [method.NAME] with `command` (a shell

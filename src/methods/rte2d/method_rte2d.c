@@ -19,7 +19,7 @@
 #include "methods/rte2d/rte2d_grid.h"
 
 _Static_assert(sizeof(ppb_rte_params) ==
-                   sizeof(ppb_medium) + 13 * sizeof(double) + 22 * sizeof(int),
+                   sizeof(ppb_medium) + 15 * sizeof(double) + 22 * sizeof(int),
                "ppb_rte_params: the medium, doubles, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
@@ -636,20 +636,48 @@ static void print_run(const ppb_config *cfg, const ppb_rte2d_stats *st,
 {
     fprintf(stderr,
             "%s: rte2d: %d nodes x %d cells, %d sweeps (%.2f s each), residual %.2g, "
-            "refinement study to K = %d (%d sweeps, %.1f s), %.1f s\n",
+            "refinement study to K = %d (%d sweeps, %.1f s), delta-M f %.3g, %.1f s\n",
             cfg->name, st->nodes, st->cells, st->sweeps,
             st->sweeps ? st->t_sweeps / st->sweeps : 0.0, st->resid,
             st->record_rungs ? study->K[st->record_rungs - 1] : 0, st->record_sweeps, st->t_record,
-            st->t_total);
+            st->delta_f, st->t_total);
 }
+
+/* The solve of a converged or K-step run on the config cfg (under delta-M the scaled one),
+ * the beam's first scattering along the exit rays with phase g_ss and weight ss_w. */
+static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, double ss_w,
+                       ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
 
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err)
 {
-    double t0 = ppb_now();
     const ppb_config *cfg = ctx->cfg;
+    if (!cfg->rte2d.delta_m)
+        return rte2d_solve(ctx, cfg, cfg->scene.g, 1.0, out, stats, err);
+    /* Delta-M (ppb_rte_delta_m): the whole solve on the scaled medium, so the grid, the beam's
+     * collisions (attenuated with sigma_t'), I_pp, the walls and the ballistic total are the
+     * scaled problem's and its balance closes; the exit rays' first scattering then takes the
+     * exact phase, p_g / (1 - f) times sigma_s' = sigma_s p_g (TMS). */
+    ppb_config *dc = malloc(sizeof *dc);
+    if (!dc)
+        return ppb_fail(err, "rte2d: out of memory");
+    *dc = *cfg;
+    double f = ppb_rte_delta_m(&cfg->scene, cfg->rte2d.directions, &dc->scene);
+    ppb_rte2d_stats st;
+    int rc = rte2d_solve(ctx, dc, cfg->scene.g, 1.0 / (1.0 - f), out, &st, err);
+    if (stats)
+        *stats = st;
+    free(dc);
+    return rc;
+}
+
+static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, double ss_w,
+                       ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err)
+{
+    double t0 = ppb_now();
     const ppb_layout *lo = &out->layout;
     ppb_rte2d_stats st;
     memset(&st, 0, sizeof st);
+    st.delta_f = ss_w > 1.0 ? 1.0 - 1.0 / ss_w : 0.0;
     /* The study follows a converged solve where the run writes extra outputs: the result
      * carries it (ppb_result.extra), a sweep point makes none. */
     ppb_rte2d_study *study = NULL;
@@ -673,6 +701,8 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
         solver_free(&s);
         return -1;
     }
+    s.G.P.ss_g = g_ss;
+    s.G.P.ss_w = ss_w;
     double *rad = malloc(sizeof(double) * s.nvec), *b = malloc(sizeof(double) * s.nvec);
     double *ipp = study ? malloc(sizeof(double) * s.nvec) : NULL; /* kept for the ladder */
     int rc = (rad && b && (!study || ipp)) ? 0 : ppb_fail(err, "rte2d: out of memory");

@@ -8,7 +8,9 @@
  * where J is the converged scattered-light source per unit scattering coefficient (bilinear in
  * the nodes, each node its dual region's average, rte2d_params.h) and C E the direct beam's
  * first scattering, exact: E = lit exp(-D) with D linear along each piece, C = p(w.w_L) (as
- * `ss`).
+ * `ss`). Under delta-M (reference: Methods, `rte2d`) sigma_t, alpha and g are the scaled ones
+ * and C = p_g(w.w_L) / (1 - f) with the medium's own g (P.ss_g, P.ss_w): the truncated phase's
+ * first scattering replaced by the exact one's (Nakajima and Tanaka 1988, TMS).
  *
  * The ray is cut into pieces where sigma_t, alpha or D's slope change or the light is cut off
  * (the step plane x = step_x, the light lines x' = step_x and x' = -W/2), as march.cl cuts them.
@@ -219,13 +221,16 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
             double ca = ppb_inside_dir(surf, P.med.n, v);
             double wt = (1.0 - ppb_fresnel(ca, P.med.n)) / (P.med.n * P.med.n);
             double cb[4];
-            ppb_beam_phases(P.med.g, P.sin_theta_l, P.cos_theta_l, v[0], v[1], cb);
+            ppb_beam_phases(P.ss_g, P.sin_theta_l, P.cos_theta_l, v[0], v[1], cb);
+            for (int c = 0; c < 4; c++)
+                cb[c] *= P.ss_w;
             sum +=
                 wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py, v[0], v[1]);
             continue;
         }
-        double cb[4] = {ppb_hg_phase(P.med.g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l), 0.0,
-                        0.0, 0.0};
+        double cb[4] = {
+            P.ss_w * ppb_hg_phase(P.ss_g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l), 0.0, 0.0,
+            0.0};
         sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, v[0], v[1]);
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;

@@ -400,6 +400,22 @@ double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int re
     return 8.0 * (nodes * nc * (restart + 8) + 4.0 * directions * directions);
 }
 
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out)
+{
+    *out = *sc;
+    double f = sc->g > 0.0 ? pow(sc->g, sqrt(2.0 * directions)) : 0.0;
+    int albedo_step = sc->geometry == PPB_GEOM_TUBE && sc->step == PPB_STEP_ALBEDO &&
+                      sc->albedo_right != sc->albedo;
+    if (!(f >= 1e-12) || albedo_step)
+        return 0.0;
+    out->g = (sc->g - f) / (1.0 - f);
+    out->sigma_t = (1.0 - sc->albedo * f) * sc->sigma_t;
+    out->sigma_t_right = (1.0 - sc->albedo * f) * sc->sigma_t_right;
+    out->albedo = sc->albedo * (1.0 - f) / (1.0 - sc->albedo * f);
+    out->albedo_right = sc->albedo_right * (1.0 - f) / (1.0 - sc->albedo_right * f); /* unused */
+    return f;
+}
+
 int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep,
                       ppb_rte_grid *G, ppb_err *err)
 {
@@ -424,6 +440,8 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     }
     P->hstep = hstep;
     P->d_cap = 40.0;
+    P->ss_g = sc->g; /* the caller's under delta-M (ppb_rte_delta_m) */
+    P->ss_w = 1.0;
     int nr = 0;
     P->nl = 0;
     P->nx = 1;

@@ -7,7 +7,8 @@
  * energy exactly and the slab limit is ppslab's own discrete-ordinates system). Why cells and not
  * Legendre moments: they are what ppslab and pp already use (slab mode then differs from
  * ppslab by the spatial discretisation alone), the same code serves every g in [-0.95, 0.95]
- * (the HG peak is integrated cell by cell, no truncation of its expansion), and the exit
+ * (the HG peak is integrated cell by cell, no truncation of its expansion; what of a peak
+ * narrower than a cell the cells blur, delta-M takes out, ppb_rte_delta_m), and the exit
  * radiance keeps angular detail finer than a cell through the cell integrals F_j(w) of
  * phase.h (source-function integration, as ppsolver.h). The set-up is symmetric in z, so a cell
  * and its z mirror (pp_dirs_zmirror) carry the same radiance and march the same planar ray: only
@@ -82,6 +83,16 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x);
 int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep,
                       ppb_rte_grid *G, ppb_err *err);
 void ppb_rte_grid_free(ppb_rte_grid *G);
+
+/* Delta-M (Wiscombe 1977; reference: Methods, `rte2d`): the phase function p_g taken as
+ * f delta + (1 - f) p_g* with g* = (g - f) / (1 - f), the HG the cells transport (the same first
+ * moment, so the same sigma_s (1 - g)), f = g^L the part of the forward peak beyond the
+ * Legendre order L = sqrt(2 directions) that 2 directions cells over the sphere resolve (as
+ * DISORT's f = g^(2N) for 2N streams). *out = sc with g*, and in every medium of a step
+ * sigma_t' = (1 - alpha f) sigma_t, alpha' = alpha (1 - f) / (1 - alpha f) (sigma_a kept, the
+ * delta part counted as unscattered). Returns f; 0 with *out = sc where the scaled media cannot
+ * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. */
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out);
 
 /* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building. */
 double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart);

@@ -106,6 +106,9 @@ typedef struct ppb_rte_params {
     double beam_in; /* n > 1: perpendicular irradiance of the refracted beam (ppb_fresnel.h) */
     double beam_fb; /* n > 1: F the beam meets at S2 and S1 from inside */
     double beam_fs; /* n > 1: F the beam meets at S3 and S4 from inside (oblique light) */
+    double ss_g;    /* exit: g of the beam's first scattering along the ray (the medium's own g
+                       under delta-M, whose med.g is the truncated one: reference: Methods) */
+    double ss_w;    /* exit: its weight, 1 / (1 - f) under delta-M (sigma_s' / (1 - f) = sigma_s) */
     int nx, ny, nl; /* nodes in x (nl cells left of the split) and y */
     int ncell;      /* sweep: direction cells marched */
     int beam;       /* 1: add the direct beam's first scattering */
