@@ -296,7 +296,9 @@ static void test_study_configs(void **state)
                                   "uniform_g0_normal_n14",
                                   "uniform_g0_oblique_n14",
                                   "uniform_gm05_normal_n14",
-                                  "uniform_gp05_normal_n14"};
+                                  "uniform_gp05_normal_n14",
+                                  "realistic_g09_normal_n14",
+                                  "realistic_g08_step_oblique_n14"};
     FILE *list = fopen(PPB_SOURCE_DIR "/configs/study.list", "r");
     assert_non_null(list);
     char line[128];

@@ -506,7 +506,7 @@ static void test_study_configs(void **state)
         ppb_result_free(&out);
         ppb_ctx_close(&ctx);
     }
-    assert_int_equal(configs, 11);
+    assert_int_equal(configs, 13); /* every case of configs/study.list */
 }
 
 static void test_slab_mode(void **state)

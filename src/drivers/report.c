@@ -638,6 +638,90 @@ static void write_opening(FILE *f, const char *dir, const case_data *cd, int nca
             100 * nlo, 100 * nhi);
 }
 
+/* The ranking: per method (the wide table's columns) and per surface cell, the median over the
+ * cases of rms_excess in percent, its rank among the methods at that cell (1: lowest), and at
+ * how many cases the method is the best at that cell. Cases a method did not run in are left
+ * out of its median; the reference methods (mc) have no summary rows and never appear. */
+static const char *const rank_cells[] = {"R_x0", "T_x0", "S1_all", "S2_all", "S3_all", "S4_all"};
+enum { NRANK_CELLS = sizeof rank_cells / sizeof rank_cells[0] };
+
+static double method_median(const char *const *cases, const case_data *cd, int ncases,
+                            const char *method, const char *cell)
+{
+    double v[256];
+    int n = 0;
+    (void)cases;
+    for (int c = 0; c < ncases && n < 256; c++) {
+        const summary_row *r = find_row(&cd[c], method, cell);
+        if (r && isfinite(r->excess))
+            v[n++] = r->excess;
+    }
+    if (n == 0)
+        return NAN;
+    qsort(v, (size_t)n, sizeof v[0], cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* How many cases name `method` the lowest rms_excess at `cell` among the columns. */
+static int method_wins(const case_data *cd, int ncases, char cols[][32], int ncols,
+                       const char *method, const char *cell)
+{
+    int wins = 0;
+    for (int c = 0; c < ncases; c++) {
+        const char *best = NULL;
+        double lo = INFINITY;
+        for (int j = 0; j < ncols; j++) {
+            const summary_row *r = find_row(&cd[c], cols[j], cell);
+            if (r && r->excess < lo) {
+                lo = r->excess;
+                best = cols[j];
+            }
+        }
+        wins += best && !strcmp(best, method);
+    }
+    return wins;
+}
+
+static void write_ranking(FILE *f, const char *const *cases, const case_data *cd, int ncases)
+{
+    char cols[MAX_COLS][32];
+    int ncols = table_methods(cd, ncases, cols);
+    double med[MAX_COLS][NRANK_CELLS];
+    for (int j = 0; j < ncols; j++)
+        for (int k = 0; k < NRANK_CELLS; k++)
+            med[j][k] = method_median(cases, cd, ncases, cols[j], rank_cells[k]);
+    fprintf(f, "## Ranking
+
+");
+    fprintf(f, "Every method per surface: the median over the %d cases of the excess RMS "
+               "(rms_excess, percent) at the Table 2 cells and over each whole surface, its "
+               "rank among the methods at that cell (1 = closest to the Monte Carlo), and in "
+               "brackets at how many cases it is the best there.\n\n| method |",
+            ncases);
+    for (int k = 0; k < NRANK_CELLS; k++)
+        fprintf(f, " %s |", rank_cells[k]);
+    fprintf(f, "\n|---|");
+    for (int k = 0; k < NRANK_CELLS; k++)
+        fprintf(f, "---|");
+    fputc('\n', f);
+    for (int j = 0; j < ncols; j++) {
+        fprintf(f, "| %s |", cols[j]);
+        for (int k = 0; k < NRANK_CELLS; k++) {
+            if (isnan(med[j][k])) {
+                fprintf(f, " - |");
+                continue;
+            }
+            int rank = 1;
+            for (int i = 0; i < ncols; i++)
+                rank += !isnan(med[i][k]) && med[i][k] < med[j][k];
+            fprintf(f, " %.1f (#%d) [%d] |", 100 * med[j][k], rank,
+                    method_wins(cd, ncases, cols, ncols, cols[j], rank_cells[k]));
+        }
+        fputc('\n', f);
+    }
+    fputc('\n', f);
+}
+
 /* README.md into rf->f[2], closed (not yet in place). */
 static int write_readme(const char *dir, const char *const *cases, const case_data *cd, int ncases,
                         report_files *rf, ppb_err *err)
@@ -658,6 +742,7 @@ static int write_readme(const char *dir, const char *const *cases, const case_da
                "table2.md) give the same rows one per method, with `excess` = "
                "sqrt(rms^2 - noise^2), the RMS with the noise removed.\n\n");
     write_wide_table(f, cases, cd, ncases);
+    write_ranking(f, cases, cd, ncases);
     write_noise(f, cases, cd, ncases);
     snprintf(path, sizeof path, "%s/notes.md", dir);
     copy_file(f, path);
