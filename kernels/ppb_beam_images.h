@@ -115,7 +115,7 @@ inline double ppb_beam_images(const ppb_beam_tube *B, const double *cb, double p
                               double mx, double my, double la, double lb, double sigma_t, double d0)
 {
     double W = B->med.width, H = B->med.height, ct = B->cos_t, tn = B->tan_t;
-    double lo = -0.5 * W, hi = ppb_tube_lit_hi(&B->med); /* S1's lit part */
+    double lo = ppb_tube_lit_lo(&B->med), hi = ppb_tube_lit_hi(&B->med); /* S1's lit part */
     if (!(hi > lo))
         return 0.0;
     /* Image j's beam has come at least j H / cos theta_t, through the lesser sigma_t at worst;

@@ -100,6 +100,11 @@ static const key_def keys[] = {
      "albedo for x >= step_x (step = albedo)"},
     {"light", "theta_deg", K_REAL, PPB_MC_KEY, F(scene.theta_deg), 0, 89, "0", NULL,
      "incidence angle from the S1 normal, degrees"},
+    {"light", "x0", K_REAL, PPB_MC_KEY, F(scene.light_x0), -500, 500, "0", NULL,
+     "centre of the lit strip of S1 (searchlight; needs width >= 0), mfp"},
+    {"light", "width", K_REAL, PPB_MC_KEY, F(scene.light_width), -1, 1000, "-1", NULL,
+     "width of the lit strip of S1, mfp: -1 = the whole face, 0 = a line along z at x0 "
+     "(docs/reference.md: Light)"},
     {"bins", "theta", K_INT, PPB_MC_KEY, F(scene.ntheta), 1, 64, "8", NULL,
      "theta bins (equal projected solid angle)"},
     {"bins", "phi", K_INT, PPB_MC_KEY, F(scene.nphi), 1, 64, "8", NULL,
@@ -955,6 +960,48 @@ static const char *origin_of(const ppb_config *cfg, const char *section, const c
     return buf;
 }
 
+/* The searchlight's strip (reference: Light): width -1 (the whole face) or >= 0, on S1, in the
+ * tube, not with a shadow step (the strip would be cut by it: refused rather than intersected,
+ * so the lit part is always one strip), and x0 only with a strip. */
+static int validate_strip(const ppb_config *cfg, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    char where[1200];
+    double w = sc->light_width, x0 = sc->light_x0, half = 0.5 * sc->width;
+    if (w < 0.0 && w != -1.0)
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "the strip's width must be >= 0, or -1 for the whole face");
+    if (w < 0.0) {
+        if (x0 != 0.0)
+            return ppb_config_key_fail(
+                cfg, "light", "x0", err,
+                "x0 places a searchlight's strip: give [light] width >= 0 too (width from %s)",
+                origin_of(cfg, "light", "width", where, sizeof where));
+        return 0;
+    }
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return ppb_config_key_fail(
+            cfg, "light", "width", err,
+            "a searchlight needs the tube (docs/reference.md, Light; geometry = slab from %s)",
+            origin_of(cfg, "experiment", "geometry", where, sizeof where));
+    if (sc->step == PPB_STEP_SHADOW)
+        return ppb_config_key_fail(
+            cfg, "light", "width", err,
+            "a searchlight and a shadow step do not combine (docs/reference.md, Light; step from "
+            "%s): light the strip you want with x0 and width",
+            origin_of(cfg, "medium", "step", where, sizeof where));
+    int on_s1 = w > 0.0 ? x0 - 0.5 * w >= -half && x0 + 0.5 * w <= half : fabs(x0) < half;
+    if (!on_s1)
+        return ppb_config_key_fail(
+            cfg, "light", w > 0.0 ? "width" : "x0", err,
+            "the lit %s [x0 - width/2, x0 + width/2] = [%g, %g] must lie on S1 [%g, %g]%s "
+            "(x0 from %s, tube width from %s)",
+            w > 0.0 ? "strip" : "line", x0 - 0.5 * w, x0 + 0.5 * w, -half, half,
+            w > 0.0 ? "" : ", inside it", origin_of(cfg, "light", "x0", where, sizeof where),
+            origin_of(cfg, "tube", "width", where + 600, sizeof where - 600));
+    return 0;
+}
+
 /* Checks that involve more than one key; each names the key it fails and where the other
  * one was set. */
 static int validate(const ppb_config *cfg, ppb_err *err)
@@ -981,7 +1028,7 @@ static int validate(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "step_x", err,
             "the step must lie inside the tube (|step_x| < width / 2 = %g, width from %s)",
             0.5 * sc->width, origin_of(cfg, "tube", "width", where, sizeof where));
-    return 0;
+    return validate_strip(cfg, err);
 }
 
 static void base_name(const char *path, char *out, size_t cap)

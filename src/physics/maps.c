@@ -170,7 +170,11 @@ double ppb_beam_depth(const ppb_scene *sc, double xe)
 double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *width)
 {
     ppb_medium M = ppb_medium_of(sc);
-    double a = ppb_face_line(PPB_S3, sc->width, sc->height), b = ppb_tube_lit_hi(&M);
+    double a = ppb_tube_lit_lo(&M), b = ppb_tube_lit_hi(&M);
+    if (ppb_scene_lit_line(sc)) { /* a line of unit strength: f at it (ppb_scene_lit_measure) */
+        *width = 1.0;
+        return f(sc, a, arg);
+    }
     *width = b > a ? b - a : 0.0;
     if (b <= a)
         return 0.0;
@@ -203,9 +207,10 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
 double ppb_lit_midpoint_sum(const ppb_scene *sc, ppb_entry_fn f, void *arg, int np, double *width)
 {
     ppb_medium M = ppb_medium_of(sc);
-    double a = ppb_face_line(PPB_S3, sc->width, sc->height), hi = ppb_tube_lit_hi(&M);
-    *width = hi > a ? hi - a : 0.0;
-    if (!(hi > a))
+    double a = ppb_tube_lit_lo(&M), hi = ppb_tube_lit_hi(&M);
+    int line = ppb_scene_lit_line(sc); /* np points all on the line, of measure 1 */
+    *width = line ? 1.0 : (hi > a ? hi - a : 0.0);
+    if (!(hi > a) && !line)
         return 0.0;
     double sum = 0.0;
     for (int i = 0; i < np; i++)

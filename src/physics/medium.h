@@ -19,9 +19,10 @@ typedef struct ppb_lit_piece {
     double xa, xb, sigma_t, albedo;
 } ppb_lit_piece;
 
-/* S1's lit strip (the tube's top, ended at a shadow step), cut where a density or albedo step
- * inside it changes the medium: at most two pieces, the empty ones left out; returns how many.
- * The diffusion models integrate their profiles over it (mp, burley). */
+/* S1's lit strip (ppb_scene_lit_range: the tube's top, ended at a shadow step, or a
+ * searchlight's strip), cut where a density or albedo step inside it changes the medium: at most
+ * two pieces, the empty ones left out; returns how many. A line searchlight is one piece with
+ * xa == xb. The diffusion models integrate their profiles over it (mp, burley). */
 int ppb_lit_pieces(const ppb_scene *sc, ppb_lit_piece piece[2]);
 
 #endif

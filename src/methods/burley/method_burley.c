@@ -219,5 +219,9 @@ int ppb_burley_check(const ppb_config *cfg, ppb_err *err)
     if (cfg->scene.ntheta > BURLEY_MAX_THETA)
         return ppb_config_key_fail(cfg, "bins", "theta", err, "burley: bins.theta = %d above %d",
                                    cfg->scene.ntheta, BURLEY_MAX_THETA);
+    if (ppb_scene_lit_line(&cfg->scene)) /* its strip integral has no line kernel yet */
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "burley: a line searchlight (width = 0) is refused: the profile "
+                                   "is integrated over a strip; use width > 0");
     return 0;
 }

@@ -713,6 +713,16 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
     return rc;
 }
 
+int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
+{
+    if (ppb_scene_lit_line(&cfg->scene))
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "rte2d: a line searchlight (width = 0) is refused: the beam's "
+                                   "first scattering is integrated over cells, where a line is a "
+                                   "delta; use a strip (width > 0)");
+    return 0;
+}
+
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     return ppb_rte2d_run(ctx, out, NULL, err);
