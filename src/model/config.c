@@ -45,6 +45,7 @@ static const enum_name step_names[] = {{PPB_STEP_NONE, "none"},
                                        {PPB_STEP_ALBEDO, "albedo"},
                                        {PPB_STEP_SHADOW, "shadow"},
                                        {0, NULL}};
+static const enum_name lit_names[] = {{0, "face"}, {1, "strip"}, {0, NULL}};
 static const enum_name table_names[] = {{PPB_TABLE_R, "R"}, {PPB_TABLE_S, "S"}, {0, NULL}};
 
 /* An enum key is stored as an int (ppb_scene.geometry is a ppb_geometry). */
@@ -100,11 +101,13 @@ static const key_def keys[] = {
      "albedo for x >= step_x (step = albedo)"},
     {"light", "theta_deg", K_REAL, PPB_MC_KEY, F(scene.theta_deg), 0, 89, "0", NULL,
      "incidence angle from the S1 normal, degrees"},
+    {"light", "lit", K_ENUM, PPB_MC_KEY, F(scene.searchlight), 0, 0, "face", lit_names,
+     "the lit part of S1: the whole face (x < step_x with step = shadow), or a searchlight's "
+     "strip (x0, width; tube only; docs/reference.md: Light)"},
     {"light", "x0", K_REAL, PPB_MC_KEY, F(scene.light_x0), -500, 500, "0", NULL,
-     "centre of the lit strip of S1 (searchlight; needs width >= 0), mfp"},
-    {"light", "width", K_REAL, PPB_MC_KEY, F(scene.light_width), -1, 1000, "-1", NULL,
-     "width of the lit strip of S1, mfp: -1 = the whole face, 0 = a line along z at x0 "
-     "(docs/reference.md: Light)"},
+     "centre of the strip (lit = strip), mfp"},
+    {"light", "width", K_REAL, PPB_MC_KEY, F(scene.light_width), 0, 1000, "1", NULL,
+     "width of the strip (lit = strip), mfp; 0 = a line along z at x0"},
     {"bins", "theta", K_INT, PPB_MC_KEY, F(scene.ntheta), 1, 64, "8", NULL,
      "theta bins (equal projected solid angle)"},
     {"bins", "phi", K_INT, PPB_MC_KEY, F(scene.nphi), 1, 64, "8", NULL,
@@ -960,33 +963,31 @@ static const char *origin_of(const ppb_config *cfg, const char *section, const c
     return buf;
 }
 
-/* The searchlight's strip (reference: Light): width -1 (the whole face) or >= 0, on S1, in the
- * tube, not with a shadow step (the strip would be cut by it: refused rather than intersected,
- * so the lit part is always one strip), and x0 only with a strip. */
+/* The searchlight's strip (reference: Light): in the tube, on S1, not with a shadow step (the
+ * strip would be cut by it: refused rather than intersected, so the lit part is always one
+ * strip), and x0, width only with lit = strip. */
 static int validate_strip(const ppb_config *cfg, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
-    char where[1200];
+    char where[600], where2[600];
     double w = sc->light_width, x0 = sc->light_x0, half = 0.5 * sc->width;
-    if (w < 0.0 && w != -1.0)
-        return ppb_config_key_fail(cfg, "light", "width", err,
-                                   "the strip's width must be >= 0, or -1 for the whole face");
-    if (w < 0.0) {
-        if (x0 != 0.0)
+    if (!sc->searchlight) {
+        if (x0 != 0.0 || w != 1.0)
             return ppb_config_key_fail(
-                cfg, "light", "x0", err,
-                "x0 places a searchlight's strip: give [light] width >= 0 too (width from %s)",
-                origin_of(cfg, "light", "width", where, sizeof where));
+                cfg, "light", x0 != 0.0 ? "x0" : "width", err,
+                "x0 and width place a searchlight's strip: give [light] lit = strip too (lit from "
+                "%s)",
+                origin_of(cfg, "light", "lit", where, sizeof where));
         return 0;
     }
     if (sc->geometry == PPB_GEOM_SLAB)
         return ppb_config_key_fail(
-            cfg, "light", "width", err,
+            cfg, "light", "lit", err,
             "a searchlight needs the tube (docs/reference.md, Light; geometry = slab from %s)",
             origin_of(cfg, "experiment", "geometry", where, sizeof where));
     if (sc->step == PPB_STEP_SHADOW)
         return ppb_config_key_fail(
-            cfg, "light", "width", err,
+            cfg, "light", "lit", err,
             "a searchlight and a shadow step do not combine (docs/reference.md, Light; step from "
             "%s): light the strip you want with x0 and width",
             origin_of(cfg, "medium", "step", where, sizeof where));
@@ -998,7 +999,7 @@ static int validate_strip(const ppb_config *cfg, ppb_err *err)
             "(x0 from %s, tube width from %s)",
             w > 0.0 ? "strip" : "line", x0 - 0.5 * w, x0 + 0.5 * w, -half, half,
             w > 0.0 ? "" : ", inside it", origin_of(cfg, "light", "x0", where, sizeof where),
-            origin_of(cfg, "tube", "width", where + 600, sizeof where - 600));
+            origin_of(cfg, "tube", "width", where2, sizeof where2));
     return 0;
 }
 

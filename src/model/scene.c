@@ -67,7 +67,7 @@ void ppb_scene_light_dir(const ppb_scene *sc, double w[3])
 
 int ppb_scene_searchlight(const ppb_scene *sc)
 {
-    return sc->geometry == PPB_GEOM_TUBE && sc->light_width >= 0.0;
+    return sc->geometry == PPB_GEOM_TUBE && sc->searchlight;
 }
 
 int ppb_scene_lit_line(const ppb_scene *sc)

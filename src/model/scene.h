@@ -25,8 +25,10 @@ typedef struct ppb_scene {
     int step; /* PPB_STEP_* */
     double step_x, sigma_t_right, albedo_right;
     double theta_deg; /* light incidence from the S1 normal */
-    /* The lit strip of S1 (reference: Light): centre light_x0, width light_width; width < 0 is
-     * the whole face (x < step_x with a shadow step), width 0 a line along z at light_x0. */
+    /* S1's lit part (reference: Light): searchlight 0 (zero-initialised: the default) lights the
+     * whole face (x < step_x with a shadow step); 1 the strip of centre light_x0 and width
+     * light_width, a line along z at light_x0 when light_width = 0. */
+    int searchlight;
     double light_x0, light_width;
     int ntheta, nphi;
 } ppb_scene;
