@@ -5,9 +5,9 @@
  * (the step's kind and position, both sides' sigma_t and albedo, n, g) into the launch
  * parameters of march.cl, rte2d.cl and mc.cl (embedded as their `med` member), and the medium's
  * values at a point, and S1's lit part (reference: Light: the whole face, the face left of a shadow
- * step, or a searchlight's strip; ppb_tube.h reads it). The host fills it in one place, ppb_medium_of (src/physics/medium.h).
- * `step` here is always the density/albedo/shadow step's kind (PPB_STEP_*); a march's step
- * length is its params' `ds`.
+ * step, or a searchlight's strip; ppb_tube.h reads it). The host fills it in one place,
+ * ppb_medium_of (src/physics/medium.h). `step` here is always the density/albedo/shadow step's kind
+ * (PPB_STEP_*); a march's step length is its params' `ds`.
  *
  * Plain C that is also OpenCL C, like ppb_conventions.h. Doubles first, then an even number of
  * ints, so host and device agree on the layout (96 bytes) without packing attributes. */

@@ -214,8 +214,8 @@ static void run(ppb_config *cfg, const char *id, ppb_result *r)
     if (ppb_result_init(r, id, &lo, &err))
         fail_msg("%s", err.msg);
     ppb_run_ctx ctx = {.cfg = cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
-    int rc = strcmp(id, "ss") == 0 ? ppb_method_ss(&ctx, r, &err)
-                                   : ppb_rte2d_run(&ctx, r, NULL, &err);
+    int rc =
+        strcmp(id, "ss") == 0 ? ppb_method_ss(&ctx, r, &err) : ppb_rte2d_run(&ctx, r, NULL, &err);
     if (rc)
         fail_msg("%s: %s", id, err.msg);
 }
@@ -320,8 +320,8 @@ static void test_rte2d_matches_mc(void **state)
     print_message("strip [-0.5, 1.5] at 30 deg: rte2d vs mc chi2 %.1f over %d bins, p = %.3g; "
                   "R %.5f vs %.5f +- %.5f, T %.5f vs %.5f +- %.5f, sides %.5f vs %.5f +- %.5f, "
                   "absorbed %.5f vs %.5f; rte2d balance %.2g\n",
-                  chi2, dof, p, t->R, m->R, se->R, t->T, m->T, se->T, t->sides, m->sides,
-                  se->sides, t->absorbed, m->absorbed, bal);
+                  chi2, dof, p, t->R, m->R, se->R, t->T, m->T, se->T, t->sides, m->sides, se->sides,
+                  t->absorbed, m->absorbed, bal);
     assert_true(dof > 500);
     assert_lt(1e-4, p);
     assert_close(t->R, m->R, 4 * se->R);
@@ -346,10 +346,11 @@ static void test_ss_matches_mc1(void **state)
     const ppb_totals *m = &r.once.mean, *se = &r.once.se;
     int dof;
     double chi2 = chi2_of(&s, &r.mc1, PPB_S1, PPB_S2 + 1, &dof), p = tu_chi2_pvalue(chi2, dof);
-    print_message("strip [-0.5, 1.5] at 30 deg: ss vs mc1 chi2 %.1f over %d S1 and S2 bins, p = %.3g; "
-                  "R %.5f vs %.5f +- %.5f, T %.5f vs %.5f +- %.5f, sides %.5f vs %.5f +- %.5f\n",
-                  chi2, dof, p, s.totals.R, m->R, se->R, s.totals.T, m->T, se->T, s.totals.sides,
-                  m->sides, se->sides);
+    print_message(
+        "strip [-0.5, 1.5] at 30 deg: ss vs mc1 chi2 %.1f over %d S1 and S2 bins, p = %.3g; "
+        "R %.5f vs %.5f +- %.5f, T %.5f vs %.5f +- %.5f, sides %.5f vs %.5f +- %.5f\n",
+        chi2, dof, p, s.totals.R, m->R, se->R, s.totals.T, m->T, se->T, s.totals.sides, m->sides,
+        se->sides);
     assert_true(dof > 200);
     assert_lt(1e-4, p);
     assert_close(s.totals.R, m->R, 4 * se->R + 3e-3 * m->R);
@@ -388,12 +389,9 @@ static void test_line_is_narrow_strip_limit(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_keys),
-        cmocka_unit_test(test_lit_part),
-        cmocka_unit_test(test_ballistic),
-        cmocka_unit_test(test_rte2d_matches_mc),
-        cmocka_unit_test(test_ss_matches_mc1),
-        cmocka_unit_test(test_line_is_narrow_strip_limit),
+        cmocka_unit_test(test_keys),           cmocka_unit_test(test_lit_part),
+        cmocka_unit_test(test_ballistic),      cmocka_unit_test(test_rte2d_matches_mc),
+        cmocka_unit_test(test_ss_matches_mc1), cmocka_unit_test(test_line_is_narrow_strip_limit),
     };
     return cmocka_run_group_tests(tests, open_device, close_device);
 }

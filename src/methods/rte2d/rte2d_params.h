@@ -226,8 +226,9 @@ PPB_RTE_HOT double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM do
 
 /* The exact direct beam at (x, y), y <= 0 (reference: Light): the ray toward the light meets
  * S1's plane at x' = x + y tan(theta_L); the point is lit when x' lies on S1's lit part
- * (ppb_tube_lit_at: >= -W/2, left of a shadow step, or in a searchlight's strip). D = optical depth of that path through the piecewise-constant
- * medium, continued where unlit (the caller multiplies by lit). Slab: sigma_t |y| / cos. */
+ * (ppb_tube_lit_at: >= -W/2, left of a shadow step, or in a searchlight's strip). D = optical depth
+ * of that path through the piecewise-constant medium, continued where unlit (the caller multiplies
+ * by lit). Slab: sigma_t |y| / cos. */
 PPB_FN void ppb_rte_light(const ppb_rte_params *P, double x, double y, double *D, int *lit)
 {
     double t = -y < 0.0 ? 0.0 : -y, len = t / P->cos_theta_l;
