@@ -1,7 +1,7 @@
 /* test_searchlight.c: the searchlight light (reference: Light; `[light] lit = strip`, x0, width),
  * each check with its source:
- * - the keys and their refusals (a strip off S1, with a shadow step, in a slab, x0 without
- *   lit = strip; pp's strip, a line in ss, mp, burley and rte2d): the reference's rules;
+ * - the keys and their refusals (a strip off S1, with a shadow step, in a slab; pp's strip, a
+ *   line in ss, mp, burley and rte2d): the reference's rules;
  * - S1's lit part, the power entering, the diffusion models' pieces, the kernels' lit test and
  *   light-line breaks: the definitions of reference: Light, by hand;
  * - the ballistic fraction of a strip and of a line near S4 at oblique light: Beer-Lambert along
@@ -96,7 +96,6 @@ static void test_keys(void **state)
     expect_refused("line_off", SETS("light.width=0", "light.x0=5"), "light.x0: the lit line");
     expect_refused("strip_shadow", SETS("medium.step=shadow"), "do not combine");
     expect_refused("strip_slab", SETS("experiment.geometry=slab"), "needs the tube");
-    expect_refused("x0_face", SETS("light.lit=face"), "x0: x0 and width place");
     expect_refused("strip_pp", SETS("experiment.methods=mc, pp"), "pp: a searchlight");
     const char *line_refusers[] = {"ss", "mp", "burley", "rte2d", "mp+ss"};
     for (int i = 0; i < 5; i++) {

@@ -965,21 +965,14 @@ static const char *origin_of(const ppb_config *cfg, const char *section, const c
 
 /* The searchlight's strip (reference: Light): in the tube, on S1, not with a shadow step (the
  * strip would be cut by it: refused rather than intersected, so the lit part is always one
- * strip), and x0, width only with lit = strip. */
+ * strip). x0 and width are read with lit = strip only. */
 static int validate_strip(const ppb_config *cfg, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     char where[600], where2[600];
     double w = sc->light_width, x0 = sc->light_x0, half = 0.5 * sc->width;
-    if (!sc->searchlight) {
-        if (x0 != 0.0 || w != 1.0)
-            return ppb_config_key_fail(
-                cfg, "light", x0 != 0.0 ? "x0" : "width", err,
-                "x0 and width place a searchlight's strip: give [light] lit = strip too (lit from "
-                "%s)",
-                origin_of(cfg, "light", "lit", where, sizeof where));
-        return 0;
-    }
+    if (!sc->searchlight)
+        return 0; /* x0 and width unused, as step_x without a step */
     if (sc->geometry == PPB_GEOM_SLAB)
         return ppb_config_key_fail(
             cfg, "light", "lit", err,
