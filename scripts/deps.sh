@@ -36,7 +36,9 @@ fi
 [ ${#missing[@]} -eq 0 ] && exit 0
 
 mapfile -t missing < <(printf '%s\n' "${missing[@]}" | sort -u)
-cmd="apt-get install -y --no-install-recommends ${missing[*]}"
+# Two builds at once (make -j, worktrees side by side) would race for dpkg's lock: the second
+# waits for it rather than failing (and for our own lock first, so one install runs at a time).
+cmd="apt-get -o DPkg::Lock::Timeout=900 install -y --no-install-recommends ${missing[*]}"
 if [ "$(id -u)" -ne 0 ]; then
   echo "ppbench: missing packages: ${missing[*]}" >&2
   echo "ppbench: install them with: sudo apt-get update && sudo $cmd" >&2
@@ -44,5 +46,7 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 echo "ppbench: installing ${missing[*]}" >&2
 export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq >&2
+exec 9>/var/lock/ppbench-deps.lock
+flock -w 1800 9 || { echo "ppbench: another install holds /var/lock/ppbench-deps.lock" >&2; exit 1; }
+apt-get -o DPkg::Lock::Timeout=900 update -qq >&2
 $cmd >&2

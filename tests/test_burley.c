@@ -53,6 +53,31 @@ static void test_k0_tables(void **state)
     assert_close(ppb_bessel_k0(800.0), 0.0, 1e-300);
 }
 
+static void test_k1_tables(void **state)
+{
+    (void)state;
+    /* K1 at the same points, 18 digits from mpmath's besselk(1, x) at 30 digits (pip install
+     * mpmath; an independent arbitrary-precision implementation): each branch and both switch
+     * points (2 and 20). */
+    static const double table[][2] = {
+        {1e-6, 999999.999992784324},      {0.1, 9.85384478087060557},
+        {0.5, 1.65644112000330089},       {1.0, 0.601907230197234575},
+        {1.5, 0.277387800456843816},      {1.999, 0.140049842077109663},
+        {2.0, 0.139865881816522427},      {2.001, 0.139682188301767555},
+        {2.5, 0.0738908163477470636},     {3.0, 0.0401564311281941844},
+        {5.0, 0.00404461344545216421},    {10.0, 1.86487734538255846e-5},
+        {19.99, 5.94372291903156996e-10}, {20.0, 5.88305796955703818e-10},
+        {20.01, 5.82301297907223455e-10}, {30.0, 2.16773200189154942e-14},
+        {50.0, 3.44410222671755561e-23}};
+    double worst = 0;
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++)
+        worst = fmax(worst, fabs(ppb_bessel_k1(table[i][0]) / table[i][1] - 1));
+    print_message("K1: largest relative error over the table %.2e\n", worst);
+    assert_lt(worst, 1e-14);
+    assert_true(isinf(ppb_bessel_k1(0.0)));
+    assert_close(ppb_bessel_k1(INFINITY), 0.0, 0.0);
+}
+
 /* int_a^b f by 10-point Gauss-Legendre panels halving toward a from b (down to 1e-15 of b - a),
  * then uniform panels: an independent quadrature of the profile's singular integrands. */
 typedef double (*fn1)(double x, const void *arg);
@@ -489,6 +514,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_k0_tables),
+        cmocka_unit_test(test_k1_tables),
         cmocka_unit_test(test_profile_plane_integral),
         cmocka_unit_test(test_line_kernel),
         cmocka_unit_test(test_strip_quadrature),

@@ -66,8 +66,23 @@ static void change_key(ppb_config *cfg, int k)
         snprintf(cand[n++], 64, "/elsewhere/other");
     }
     ppb_err err;
+    /* [medium] material takes a name of the table and unit = mm (a key that alone changes
+     * nothing, so a hit by this same test); channel also needs a material, so its change comes
+     * with one here: that each channel has its own reference is test_materials.c's
+     * (test_cache_paths_distinct, every material and channel). */
+    ppb_config pre = *cfg;
+    int material = strcmp(in.section, "medium") == 0 && strcmp(in.key, "material") == 0;
+    if (material || (strcmp(in.section, "medium") == 0 && strcmp(in.key, "channel") == 0)) {
+        if (ppb_config_set(&pre, "experiment", "unit", "mm", &err) ||
+            (!material && ppb_config_set(&pre, "medium", "material", "skimmilk", &err)))
+            fail_msg("%s", err.msg);
+        if (material) {
+            n = 0;
+            snprintf(cand[n++], 64, "skimmilk");
+        }
+    }
     for (int i = 0; i < n; i++) {
-        ppb_config c = *cfg;
+        ppb_config c = pre;
         if (ppb_config_set(&c, in.section, in.key, cand[i], &err))
             continue;
         key_line(&c, k, after, sizeof after);

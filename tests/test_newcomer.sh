@@ -50,7 +50,8 @@ t0=$(date +%s.%N)
 ./ppbench study-score --quiet --set mc.photons=2e4 --out "$t/score" "$t/mine.ini" 2> "$t/score.err" \
   || { cat "$t/score.err"; fail "study-score failed"; }
 secs=$(echo "$(date +%s.%N) - $t0" | bc)
-grep -q 'study-score: 11 of 11 cases scored in .* 0 photons traced' "$t/score.err" \
+ncase=$(wc -l < configs/study.list)
+grep -q "study-score: $ncase of $ncase cases scored in .* 0 photons traced" "$t/score.err" \
   || { cat "$t/score.err"; fail "not every case scored with 0 photons traced"; }
 while read -r c; do
   p=$t/score/$c/provenance.txt
@@ -77,5 +78,5 @@ while read -r c; do
       off($4, $9) < -1e-5 { print; bad = 1 } END { exit bad }' \
     || fail "$c: --radiance-dir scored the file differently"
 done < configs/study.list
-echo "test_newcomer: --radiance-dir: the same scores ($(grep '^study-score: 11' "$t/rd.err"))"
+echo "test_newcomer: --radiance-dir: the same scores ($(grep '^study-score: ' "$t/rd.err"))"
 echo "test_newcomer: passed"

@@ -30,6 +30,7 @@
 #include "physics/ppsolver.h"
 #include "model/config.h"
 #include "model/grid.h"
+#include "model/materials.h"
 #include "runtime/ocl.h"
 
 #ifndef PPB_VERSION
@@ -583,6 +584,13 @@ static int cmd_keys(const cli *c)
     return EXIT_OK;
 }
 
+static int cmd_materials(const cli *c)
+{
+    (void)c;
+    ppb_materials_write(stdout);
+    return EXIT_OK;
+}
+
 static int cmd_version(const cli *c)
 {
     (void)c;
@@ -885,6 +893,9 @@ static const command commands[] = {
      "PPBENCH_DEVICE=pthread ppbench devices", 0, 0, cmd_devices},
     {"keys", NULL, 0, "print every config key with its default and range", "ppbench keys", 0, 0,
      cmd_keys},
+    {"materials", NULL, 0,
+     "print the measured media `[medium] material` takes, with\ntheir sources (per mm)",
+     "ppbench materials", 0, 0, cmd_materials},
     {"perf", NULL, 0, "benchmarks: solver, ray marcher, Monte Carlo", "ppbench perf --device 0",
      OPT_DEVICE, 0, cmd_perf},
     {"study-score", "[CONFIG]", 0,

@@ -10,8 +10,10 @@
 /* The units and conventions of the conventions of docs/reference.md (Medium to Metrics) in words,
  * for a reader who has only this file. */
 static const char *const conventions[][2] = {
-    {"lengths", "mean free paths of the left medium (sigma_t = 1 there by default); positions "
-                "(x, y) in the tube's cross-section, z along the tube (uniform)"},
+    {"lengths", "in the config's length unit: mean free paths of the left medium (sigma_t = 1 "
+                "there by default), or mm for a measured material ([experiment] unit = mm), "
+                "every coefficient per that unit; positions (x, y) in the tube's cross-section, "
+                "z along the tube (uniform)"},
     {"geometry", "tube: x in [-W/2, W/2], y in [-H, 0], infinite along z; S1 top (y = 0), S2 "
                  "bottom (y = -H), S3 left (x = -W/2), S4 right (x = W/2); slab: only S1 and S2, "
                  "W infinite, segment 0 and s = 0"},

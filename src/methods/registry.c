@@ -3,11 +3,13 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "methods/bdipole/method_bdipole.h"
 #include "methods/burley/method_burley.h"
 #include "methods/external/method_external.h"
 #include "methods/mc/method_mc.h"
 #include "methods/mc/perf_mc.h"
 #include "methods/mp/method_mp.h"
+#include "methods/pbd/method_pbd.h"
 #include "methods/pp/method_pp.h"
 #include "methods/pp/method_ss.h"
 #include "methods/pp/perf_march.h"
@@ -68,6 +70,20 @@ static const ppb_method methods[] = {
      .summary = "Christensen-Burley profile plus single scattering",
      .run = run_sum,
      .sum_of = (const char *const[]){"burley", "ss", NULL}},
+    {.id = "bdipole",
+     .summary = "d'Eon's better dipole (Grosjean's D, exact Fresnel moments)",
+     .run = ppb_method_bdipole,
+     .check = ppb_bdipole_check,
+     .section = "bdipole"},
+    {.id = "bdipole+ss",
+     .summary = "d'Eon's better dipole plus single scattering",
+     .run = run_sum,
+     .sum_of = (const char *const[]){"bdipole", "ss", NULL}},
+    {.id = "pbd",
+     .summary = "photon beam diffusion (pbrt-v4's tabulated profile, single scattering included)",
+     .run = ppb_method_pbd,
+     .check = ppb_pbd_check,
+     .section = "pbd"},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,

@@ -16,8 +16,9 @@
 #include <unistd.h>
 
 #include "kernels/march_params.h"
+#include "model/materials.h"
 
-typedef enum { K_INT, K_LLONG, K_REAL, K_ENUM, K_NAME, K_PATH, K_METHODS } key_type;
+typedef enum { K_INT, K_LLONG, K_REAL, K_ENUM, K_NAME, K_PATH, K_METHODS, K_MATERIAL } key_type;
 
 /* What `ppbench keys` calls each type. */
 static const char *const type_names[] = {
@@ -28,6 +29,7 @@ static const char *const type_names[] = {
     [K_NAME] = "name",
     [K_PATH] = "path",
     [K_METHODS] = "list of method ids",
+    [K_MATERIAL] = "material name",
 };
 
 /* The names of an enum key's values, each paired with its C enum value, so that parsing,
@@ -47,6 +49,13 @@ static const enum_name step_names[] = {{PPB_STEP_NONE, "none"},
                                        {0, NULL}};
 static const enum_name lit_names[] = {{0, "face"}, {1, "strip"}, {0, NULL}};
 static const enum_name table_names[] = {{PPB_TABLE_R, "R"}, {PPB_TABLE_S, "S"}, {0, NULL}};
+static const enum_name unit_names[] = {{PPB_UNIT_MFP, "mfp"}, {PPB_UNIT_MM, "mm"}, {0, NULL}};
+/* The first name of a value is the one written; the others are accepted too. */
+static const enum_name channel_names[] = {
+    {PPB_CH_R, "r"},     {PPB_CH_G, "g"},    {PPB_CH_B, "b"}, {PPB_CH_R, "red"},
+    {PPB_CH_G, "green"}, {PPB_CH_B, "blue"}, {0, NULL}};
+static const enum_name delta_m_names[] = {
+    {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 
 /* An enum key is stored as an int (ppb_scene.geometry is a ppb_geometry). */
 _Static_assert(sizeof(ppb_geometry) == sizeof(int), "enum keys are stored as int");
@@ -73,6 +82,9 @@ static const key_def keys[] = {
      "experiment name; default: the config file's base name"},
     {"experiment", "geometry", K_ENUM, PPB_MC_KEY, F(scene.geometry), 0, 0, "tube", geometry_names,
      "the tube (docs/reference.md: Geometry), or the infinite slab of thickness `height`"},
+    {"experiment", "unit", K_ENUM, PPB_NOT_MC_KEY, F(unit), 0, 0, "mfp", unit_names,
+     "the length unit (docs/reference.md: Materials): mfp, or mm (a material's); the numbers "
+     "are the same either way"},
     {"experiment", "methods", K_METHODS, PPB_NOT_MC_KEY, F(methods), 0, 0, "mc, pp, ss, mp, mp+ss",
      NULL, "method ids, comma-separated (`ppbench --help` lists them)"},
     {"tube", "width", K_REAL, PPB_MC_KEY, F(scene.width), 0.01, 1000, "10", NULL,
@@ -83,6 +95,10 @@ static const key_def keys[] = {
      "segments of S1 and S2"},
     {"tube", "segments_side", K_INT, PPB_MC_KEY, F(scene.segments_side), 1, 4096, "36", NULL,
      "segments of S3 and S4"},
+    {"medium", "material", K_MATERIAL, PPB_MC_KEY, F(material), 0, 0, "none", NULL,
+     "a measured medium (`ppbench materials`) that sets sigma_t, albedo, g and n, or none"},
+    {"medium", "channel", K_ENUM, PPB_MC_KEY, F(channel), 0, 0, "g", channel_names,
+     "the material's colour channel"},
     {"medium", "sigma_t", K_REAL, PPB_MC_KEY, F(scene.sigma_t), 1e-3, 1000, "1", NULL,
      "extinction, 1/mfp (left of the step)"},
     {"medium", "albedo", K_REAL, PPB_MC_KEY, F(scene.albedo), 0, 1, "0.95", NULL,
@@ -142,6 +158,8 @@ static const key_def keys[] = {
      "albedo nodes of the tables (Sec. 3.3)"},
     {"pp", "map_res", K_INT, PPB_NOT_MC_KEY, F(pp.map_res), 1, 4096, "64", NULL,
      "cells per mfp of the optical-depth and albedo maps"},
+    {"pp", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(pp.delta_m), 0, 0, "auto", delta_m_names,
+     "slab solver's delta-M for forward-peaked HG: off, on, auto = on where g >= 0.6"},
     {"mp", "pairs", K_INT, PPB_NOT_MC_KEY, F(mp.pairs), 0, 200, "10", NULL,
      "dipole pairs beyond the first (0 = dipole)"},
     {"mp", "samples", K_INT, PPB_NOT_MC_KEY, F(mp.samples), 1, 256, "16", NULL,
@@ -150,6 +168,10 @@ static const key_def keys[] = {
      "burley: quadrature nodes per profile length d = mfp / s over the lit strip"},
     {"burley", "directions", K_INT, PPB_NOT_MC_KEY, F(burley.directions), 2, 2000, "334", NULL,
      "burley: direction cells per hemisphere of the slab solve that gives A (and twice as many)"},
+    {"bdipole", "samples", K_INT, PPB_NOT_MC_KEY, F(bdipole.samples), 1, 256, "16", NULL,
+     "bdipole: quadrature nodes per 1 / sigma_tr over the lit strip"},
+    {"pbd", "nodes", K_INT, PPB_NOT_MC_KEY, F(pbd.nodes), 2, 16, "6", NULL,
+     "pbd: Gauss-Legendre nodes per panel of the strip's x and z integrals"},
     {"rte2d", "spacing", K_REAL, PPB_NOT_MC_KEY, F(rte2d.spacing), 0.005, 10, "0.1", NULL,
      "rte2d: grid node spacing over the cross-section, mfp"},
     {"rte2d", "directions", K_INT, PPB_NOT_MC_KEY, F(rte2d.directions), 2, 2000, "128", NULL,
@@ -167,6 +189,13 @@ static const key_def keys[] = {
      "the machine's memory"},
 };
 #undef F
+
+/* The PPB_MC_KEY keys that join the cache's key only away from their defaults (config.h,
+ * ppb_key_info.keyed_when_set): added after references were traced and shipped, and at their
+ * defaults changing nothing, so those references keep their keys. */
+static const char *const keyed_when_set[] = {"medium.material", "medium.channel", "light.lit",
+                                             "light.x0", "light.width"};
+
 #define NKEYS ((int)(sizeof keys / sizeof keys[0]))
 _Static_assert(sizeof keys / sizeof keys[0] <= PPB_MAX_KEYS, "raise PPB_MAX_KEYS");
 
@@ -499,14 +528,23 @@ static const char *enum_value_name(const enum_name *e, int value)
 
 static int parse_enum(const key_def *k, const char *text, int *out, char *why, size_t n)
 {
-    for (int j = 0; k->enums[j].name; j++)
+    const char *best = NULL;
+    int bestd = 99;
+    for (int j = 0; k->enums[j].name; j++) {
         if (strcasecmp(k->enums[j].name, text) == 0) {
             *out = k->enums[j].value;
             return 0;
         }
+        int d = ppb_name_distance(text, k->enums[j].name);
+        if (d >= 0 && d < bestd) {
+            best = k->enums[j].name;
+            bestd = d;
+        }
+    }
     char names[256], q[96];
     enum_list(k->enums, names, sizeof names);
-    snprintf(why, n, "'%s' is not one of %s", shown(text, q, sizeof q), names);
+    snprintf(why, n, "'%s' is not one of %s%s%s%s", shown(text, q, sizeof q), names,
+             best ? " (did you mean " : "", best ? best : "", best ? "?)" : "");
     return -1;
 }
 
@@ -572,6 +610,31 @@ static int parse_string(const key_def *k, char *dst, size_t cap, const char *tex
     return 0;
 }
 
+/* A material's name (model/materials.h) or "none", stored as the table spells it; an unknown
+ * name is refused with the nearest one when close (ppb_name_distance). */
+static int parse_material(char *dst, size_t cap, const char *text, char *why, size_t n)
+{
+    const ppb_material *m = ppb_material_find(text);
+    if (m || strcasecmp(text, "none") == 0) {
+        snprintf(dst, cap, "%s", m ? m->name : "none");
+        return 0;
+    }
+    const char *best = NULL;
+    int bestd = 99;
+    for (int i = 0; i < ppb_material_count(); i++) {
+        int d = ppb_name_distance(text, ppb_material_at(i)->name);
+        if (d >= 0 && d < bestd) {
+            best = ppb_material_at(i)->name;
+            bestd = d;
+        }
+    }
+    char q[96];
+    snprintf(why, n, "unknown material '%s' (%s%s%s`ppbench materials` lists them)",
+             shown(text, q, sizeof q), best ? "did you mean " : "", best ? best : "",
+             best ? "? " : "");
+    return -1;
+}
+
 /* Sets key i from text; a list on a numeric key becomes an axis of grid (NULL: refused). */
 static int set_key(ppb_config *cfg, ppb_grid *grid, int i, const char *text, char *why, size_t n)
 {
@@ -586,6 +649,8 @@ static int set_key(ppb_config *cfg, ppb_grid *grid, int i, const char *text, cha
         return parse_string(k, p, sizeof cfg->out_dir, text, why, n);
     case K_METHODS:
         return parse_methods(cfg, text, why, n);
+    case K_MATERIAL:
+        return parse_material(p, sizeof cfg->material, text, why, n);
     default:
         break;
     }
@@ -996,6 +1061,76 @@ static int validate_strip(const ppb_config *cfg, ppb_err *err)
     return 0;
 }
 
+/* Whether a key was given (in the file, a grid axis's list included, or by --set). */
+static int key_given(const ppb_config *cfg, const char *section, const char *key)
+{
+    int i = find_key(section, key);
+    return cfg->origin[i].line > 0 || cfg->origin[i].from_set;
+}
+
+/* The keys a material sets (reference: Materials). */
+static const char *const material_keys[] = {"sigma_t", "albedo", "g", "n"};
+static int set_by_material(const ppb_config *cfg, int k);
+
+/* [medium] material and channel: the medium's sigma_t, albedo, g and n from the table
+ * (model/materials.h), each checked against its own key's range; refused with a key that sets
+ * any of them to another value, without unit = mm, and a channel without a material. */
+static int apply_material(ppb_config *cfg, ppb_err *err)
+{
+    char where[256];
+    const ppb_material *m = ppb_material_find(cfg->material);
+    if (!m) {
+        /* Written configs (config.ini, provenance.txt) hold every key, the default channel
+         * too: only another channel is refused. */
+        if (cfg->channel != PPB_CH_G)
+            return ppb_config_key_fail(cfg, "medium", "channel", err,
+                                       "%s selects a colour channel of a [medium] material, and "
+                                       "none is given",
+                                       enum_value_name(channel_names, cfg->channel));
+        return 0;
+    }
+    if (cfg->unit != PPB_UNIT_MM)
+        return ppb_config_key_fail(cfg, "medium", "material", err,
+                                   "a material's coefficients are per mm: set [experiment] unit = "
+                                   "mm, and give the tube's sizes in mm (unit = mfp from %s)",
+                                   origin_of(cfg, "experiment", "unit", where, sizeof where));
+    ppb_scene *sc = &cfg->scene;
+    double v[4], *dst[4] = {&sc->sigma_t, &sc->albedo, &sc->g, &sc->n};
+    ppb_material_medium(m, (ppb_channel)cfg->channel, &v[0], &v[1], &v[2], &v[3]);
+    for (int j = 0; j < 4; j++) {
+        const key_def *k = &keys[find_key("medium", material_keys[j])];
+        /* A key given beside the material is refused unless it states the material's own value
+         * (provenance.txt, which `ppbench score` reads back, holds every resolved key). */
+        if (key_given(cfg, "medium", k->key) && *dst[j] != v[j])
+            return ppb_config_key_fail(
+                cfg, "medium", k->key, err,
+                "given together with material = %s (%s), which sets it to %.17g: remove one of "
+                "the two",
+                m->name, origin_of(cfg, "medium", "material", where, sizeof where), v[j]);
+        if (v[j] < k->min || v[j] > k->max)
+            return ppb_config_key_fail(
+                cfg, "medium", "material", err,
+                "%s's %s channel has %s = %g, outside the range [%g, %g] the methods take", m->name,
+                enum_value_name(channel_names, cfg->channel), k->key, v[j], k->min, k->max);
+    }
+    for (int j = 0; j < 4; j++)
+        *dst[j] = v[j];
+    return 0;
+}
+
+/* apply_material, and a sweep over a key the material sets refused whatever its first value. */
+static int apply_material_grid(ppb_config *cfg, const ppb_grid *grid, ppb_err *err)
+{
+    char where[256];
+    for (int a = 0; grid && ppb_material_find(cfg->material) && a < grid->naxes; a++)
+        if (set_by_material(cfg, grid->axes[a].key))
+            return ppb_config_key_fail(
+                cfg, keys[grid->axes[a].key].section, keys[grid->axes[a].key].key, err,
+                "swept together with material = %s (%s), which sets it: remove one of the two",
+                cfg->material, origin_of(cfg, "medium", "material", where, sizeof where));
+    return apply_material(cfg, err);
+}
+
 /* Checks that involve more than one key; each names the key it fails and where the other
  * one was set. */
 static int validate(const ppb_config *cfg, ppb_err *err)
@@ -1104,7 +1239,7 @@ int ppb_config_load_grid(ppb_config *cfg, ppb_grid *grid, const char *path, ppb_
 {
     if (read_file(cfg, grid, path, err))
         return -1;
-    return validate(cfg, err);
+    return apply_material_grid(cfg, grid, err) ? -1 : validate(cfg, err);
 }
 
 int ppb_config_load(ppb_config *cfg, const char *path, ppb_err *err)
@@ -1138,7 +1273,7 @@ int ppb_config_set_grid(ppb_config *cfg, ppb_grid *grid, const char *section, co
 {
     if (override(cfg, grid, section, key, value, err))
         return -1;
-    return validate(cfg, err);
+    return apply_material_grid(cfg, grid, err) ? -1 : validate(cfg, err);
 }
 
 int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const char *value,
@@ -1201,7 +1336,7 @@ int ppb_config_load_sets(ppb_config *cfg, ppb_grid *grid, const char *path, cons
         if (override(cfg, grid, section, key, eq + 1, err))
             return -1;
     }
-    return validate(cfg, err);
+    return apply_material_grid(cfg, grid, err) ? -1 : validate(cfg, err);
 }
 
 int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, ppb_config *out,
@@ -1213,7 +1348,7 @@ int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, p
     *out = *cfg;
     for (int a = 0; grid && a < grid->naxes; a++)
         store_number(out, &keys[grid->axes[a].key], ppb_grid_value(grid, a, i));
-    return validate(out, err);
+    return apply_material(out, err) ? -1 : validate(out, err);
 }
 
 static void write_value(const ppb_config *cfg, const key_def *k, FILE *out)
@@ -1282,6 +1417,8 @@ void ppb_config_write_keys(FILE *out)
             enum_list(k->enums, range, sizeof range);
         else if (k->type == K_INT || k->type == K_LLONG || k->type == K_REAL)
             snprintf(range, sizeof range, "[%g, %g]", k->min, k->max);
+        else if (k->type == K_MATERIAL)
+            snprintf(range, sizeof range, "none or a name of `ppbench materials`");
         fprintf(out, "| %s | %s | %s | %s | %s | %s |\n", k->section, k->key, type_names[k->type],
                 k->def[0] ? k->def : "(see meaning)", range, k->help);
     }
@@ -1353,6 +1490,17 @@ void ppb_config_write_readable(const ppb_config *cfg, FILE *out)
     write_externals(cfg, 0, out);
 }
 
+/* Key k holds a value the config's material set (apply_material). */
+static int set_by_material(const ppb_config *cfg, int k)
+{
+    if (strcmp(keys[k].section, "medium") != 0 || !ppb_material_find(cfg->material))
+        return 0;
+    for (size_t j = 0; j < sizeof material_keys / sizeof material_keys[0]; j++)
+        if (strcmp(keys[k].key, material_keys[j]) == 0)
+            return 1;
+    return 0;
+}
+
 void ppb_config_write_ini(const ppb_config *cfg, FILE *out)
 {
     fprintf(out, "; the resolved config of the run beside it (ppbench run THIS_FILE repeats it)\n");
@@ -1365,7 +1513,9 @@ void ppb_config_write_ini(const ppb_config *cfg, FILE *out)
         fprintf(out, "\n[%s]\n", keys[i].section);
         for (int j = i; j < NKEYS; j++)
             if (strcmp(keys[j].section, keys[i].section) == 0) {
-                fprintf(out, "%s = ", keys[j].key);
+                /* A key the material sets is not given beside it (apply_material refuses
+                 * that): its value stays as a comment. */
+                fprintf(out, "%s%s = ", set_by_material(cfg, j) ? "; " : "", keys[j].key);
                 write_value_short(cfg, &keys[j], out);
                 fputc('\n', out);
             }
@@ -1411,6 +1561,36 @@ void ppb_config_key_info(int key, ppb_key_info *info)
     info->def = k->def;
     for (int i = 0; k->enums && k->enums[i].name && i < 15; i++)
         info->enums[i] = k->enums[i].name;
+    char name[128];
+    snprintf(name, sizeof name, "%s.%s", k->section, k->key);
+    for (size_t i = 0; i < sizeof keyed_when_set / sizeof keyed_when_set[0]; i++)
+        info->keyed_when_set |= strcmp(name, keyed_when_set[i]) == 0;
+}
+
+int ppb_config_key_at_default(const ppb_config *cfg, int key)
+{
+    /* A copy of cfg with the key set to its default, both written as the cache's key writes
+     * them (on the heap: a config is tens of KB). */
+    ppb_config *def = malloc(sizeof *def);
+    char why[512], a[2048] = "", b[2048] = "";
+    int same = 0;
+    if (def) {
+        *def = *cfg;
+        FILE *fa = fmemopen(a, sizeof a - 1, "w"), *fb = fmemopen(b, sizeof b - 1, "w");
+        if (fa && fb && set_key(def, NULL, key, keys[key].def, why, sizeof why) == 0) {
+            write_value(cfg, &keys[key], fa);
+            write_value(def, &keys[key], fb);
+            fflush(fa);
+            fflush(fb);
+            same = strcmp(a, b) == 0;
+        }
+        if (fa)
+            fclose(fa);
+        if (fb)
+            fclose(fb);
+    }
+    free(def);
+    return same;
 }
 
 void ppb_config_write_key(const ppb_config *cfg, int key, FILE *out)

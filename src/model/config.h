@@ -30,6 +30,12 @@
  * no decision, which the table's test refuses (tests/test_cache_keys.c). */
 typedef enum ppb_mc_key { PPB_MC_KEY = 1, PPB_NOT_MC_KEY = 2 } ppb_mc_key;
 
+/* The length unit of a config (reference: Materials): every length is in it and every
+ * coefficient per it. mfp: the study's, the reference medium's mean free path (sigma_t = 1 is
+ * that medium); mm: a measured material's, whose coefficients are per mm. The numbers the
+ * methods receive are the same either way: the unit says how to read them. */
+typedef enum ppb_unit { PPB_UNIT_MFP = 0, PPB_UNIT_MM = 1 } ppb_unit;
+
 #define PPB_MAX_METHODS 16
 #define PPB_MAX_KEYS    64
 
@@ -50,7 +56,11 @@ typedef struct ppb_pp_settings {
     double step;    /* ray-march step length, mfp */
     int albedos;    /* albedo nodes of the tables (Sec. 3.3) */
     int map_res;    /* cells per mfp of the D(x) and average-albedo maps */
+    int delta_m;    /* PPB_DELTA_M_*: the slab solver's delta-M (ppslab and the march) */
 } ppb_pp_settings;
+
+/* [pp] delta_m; the values of PP_DELTA_M_* (physics/ppsolver.h, which asserts it). */
+typedef enum { PPB_DELTA_M_OFF = 0, PPB_DELTA_M_ON = 1, PPB_DELTA_M_AUTO = 2 } ppb_delta_m;
 
 typedef struct ppb_mp_settings {
     int pairs;   /* dipole pairs beyond the first (multipole) */
@@ -61,6 +71,13 @@ typedef struct ppb_burley_settings {
     int samples;    /* quadrature nodes per profile length d over the lit strip */
     int directions; /* direction cells per hemisphere of the slab solve that gives A */
 } ppb_burley_settings;
+
+typedef struct ppb_bdipole_settings {
+    int samples; /* quadrature nodes per 1 / sigma_tr over the lit strip */
+} ppb_bdipole_settings;
+typedef struct ppb_pbd_settings {
+    int nodes; /* Gauss-Legendre nodes per panel of the strip's x and z integrals */
+} ppb_pbd_settings;
 
 typedef struct ppb_rte2d_settings {
     double spacing;  /* grid node spacing over the cross-section, mfp */
@@ -104,12 +121,17 @@ typedef struct ppb_config {
     int nmethods;
     char methods[PPB_MAX_METHODS][32]; /* ids as written; methods/registry.h checks them */
     ppb_scene scene;
-    int samples_dir; /* directions per bin axis for deterministic methods (n x n per bin) */
-    int samples_seg; /* points per segment for deterministic methods */
+    int unit;          /* ppb_unit */
+    char material[32]; /* a row of model/materials.h by name, or "none" */
+    int channel;       /* ppb_channel: the material's colour channel */
+    int samples_dir;   /* directions per bin axis for deterministic methods (n x n per bin) */
+    int samples_seg;   /* points per segment for deterministic methods */
     ppb_mc_settings mc;
     ppb_pp_settings pp;
     ppb_mp_settings mp;
     ppb_burley_settings burley;
+    ppb_bdipole_settings bdipole;
+    ppb_pbd_settings pbd;
     ppb_rte2d_settings rte2d;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
@@ -185,9 +207,16 @@ typedef struct ppb_key_info {
     double min, max;
     const char *def;       /* the default as written in the table */
     const char *enums[16]; /* an enum key's value names, NULL-terminated; else enums[0] NULL */
+    /* 1: a PPB_MC_KEY key that joins the reference cache's key only when it is not at its
+     * default (ppb_config_key_at_default), because at its default it changes nothing: a key
+     * added after references were traced and shipped, which keep their keys. */
+    int keyed_when_set;
 } ppb_key_info;
 int ppb_config_nkeys(void);
 void ppb_config_key_info(int key, ppb_key_info *info);
+
+/* 1 when key k holds its default value in cfg (its written value is the default's). */
+int ppb_config_key_at_default(const ppb_config *cfg, int key);
 
 /* Key k's line of ppb_config_write_resolved ("section.key = value\n", the canonical form). */
 void ppb_config_write_key(const ppb_config *cfg, int key, FILE *out);

@@ -13,8 +13,13 @@
 #include "base/progress.h"
 #include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
+#include "model/config.h"
 #include "physics/directions.h"
 #include "physics/phase.h"
+
+_Static_assert(PP_DELTA_M_OFF == (int)PPB_DELTA_M_OFF && PP_DELTA_M_ON == (int)PPB_DELTA_M_ON &&
+                   PP_DELTA_M_AUTO == (int)PPB_DELTA_M_AUTO,
+               "[pp] delta_m's values are the solver's");
 
 #define RESONANCE_GAP    1e-7  /* |lambda mu0 - 1| below this moves mu0 */
 #define CONSERVATIVE_EPS 1e-13 /* 1 - alpha below this is alpha = 1 */
@@ -42,6 +47,8 @@ struct pp_solution {
     double D, U;   /* the beam's downward and upward series sums (ppsolver.h) */
     double Fb;     /* F of the unscattered beam at either face, from inside */
     double specular, ballistic_top;
+    int delta_m; /* PP_DELTA_M_* as asked */
+    double fwd;  /* delta-M: the forward fraction F the cell matrix holds (0: off; ppsolver.h) */
 };
 
 /* Work space of one solve (N x N unless stated). */
@@ -636,15 +643,80 @@ static void compute_totals(pp_solution *s)
 
 /* ---- the solve ---- */
 
+/* ---- delta-M: the forward fraction the cells leave unresolved (ppsolver.h) ---- */
+
+/* The discrete slab's diffusion coefficient at albedo 1 for the phase blocks held:
+ * D = 2 sum_i |Omega| k_i h_i / (4 pi), h = (E - (A - B))^-1 k over the up cells (the
+ * conservative diffusion mode's h+, diffusion_mode()); 0 when G- is not positive definite. */
+static double discrete_diffusion(const pp_solution *s)
+{
+    size_t n = (size_t)s->n;
+    double *G = dalloc(n * n), *h = dalloc(n), solid = s->dirs.solid, D = 0.0;
+    if (G && h) {
+        for (size_t j = 0; j < n; j++) {
+            for (size_t i = 0; i < n; i++)
+                G[j * n + i] = (i == j ? solid : 0.0) - (s->Sa[j * n + i] - s->Sb[j * n + i]);
+            h[j] = solid * s->dirs.k[j];
+        }
+        if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'L', (lapack_int)n, 1, G, (lapack_int)n, h,
+                          (lapack_int)n) == 0)
+            for (size_t i = 0; i < n; i++)
+                D += 2.0 * solid * s->dirs.k[i] * h[i] / (4.0 * M_PI);
+    }
+    free(G), free(h);
+    return D;
+}
+
+/* The same for isotropic scattering (A = B, h = k): the cells' own 1/3, D_0. */
+static double isotropic_diffusion(const pp_solution *s)
+{
+    double D = 0.0;
+    for (int i = 0; i < s->n; i++)
+        D += 2.0 * s->dirs.solid * s->dirs.k[i] * s->dirs.k[i] / (4.0 * M_PI);
+    return D;
+}
+
+int pp_delta_m_wanted(int delta_m, double g)
+{
+    return g > 0.0 &&
+           (delta_m == PP_DELTA_M_ON || (delta_m == PP_DELTA_M_AUTO && g >= PP_DELTA_M_AUTO_G));
+}
+
+/* P -> F E + (1 - F) P with F = 1 - (1 - g) D_c / D_0 (ppsolver.h): rows still sum to 1, S
+ * stays symmetric, and the discrete slab's diffusion coefficient becomes D_0 / (1 - g). */
+static void delta_m_blocks(pp_solution *s)
+{
+    s->fwd = 0.0;
+    if (!pp_delta_m_wanted(s->delta_m, s->p.g))
+        return;
+    double Dc = discrete_diffusion(s);
+    double F = Dc > 0.0 ? 1.0 - (1.0 - s->p.g) * Dc / isotropic_diffusion(s) : 0.0;
+    if (!(F > 0.0 && F < 1.0))
+        return; /* nothing unresolved: the plain cell matrix */
+    size_t n = (size_t)s->n;
+    for (size_t k = 0; k < n * n; k++)
+        s->Sa[k] *= 1.0 - F, s->Sb[k] *= 1.0 - F;
+    for (size_t i = 0; i < n; i++)
+        s->Sa[i * n + i] += F * s->dirs.solid;
+    s->fwd = F;
+}
+
+/* The blocks of g (shared, or integrated), then delta-M's forward fraction on them. */
 static int phase_stage(pp_solution *s, const pp_solution *share, ppb_err *err)
 {
     size_t nn = (size_t)s->n * s->n;
-    if (share && share->n == s->n && share->p.g == s->p.g) {
+    /* the held blocks carry their delta-M: shared only between solves alike in it */
+    if (share && share->n == s->n && share->p.g == s->p.g &&
+        pp_delta_m_wanted(share->delta_m, share->p.g) == pp_delta_m_wanted(s->delta_m, s->p.g)) {
+        s->fwd = share->fwd;
         memcpy(s->Sa, share->Sa, nn * sizeof(double));
         memcpy(s->Sb, share->Sb, nn * sizeof(double));
         return 0;
     }
-    return pp_phase_blocks(&s->dirs, s->p.g, s->Sa, s->Sb, err);
+    if (pp_phase_blocks(&s->dirs, s->p.g, s->Sa, s->Sb, err) != 0)
+        return -1;
+    delta_m_blocks(s);
+    return 0;
 }
 
 static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp_timing *t,
@@ -681,8 +753,8 @@ static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp
     return 0;
 }
 
-int pp_solve_fresnel(const pp_params *p, double nrel, const pp_solution *share, pp_solution **out,
-                     pp_timing *t, ppb_err *err)
+int pp_solve_delta_m(const pp_params *p, double nrel, int delta_m, const pp_solution *share,
+                     pp_solution **out, pp_timing *t, ppb_err *err)
 {
     *out = NULL;
     if (check_params(p, err) != 0)
@@ -693,6 +765,7 @@ int pp_solve_fresnel(const pp_params *p, double nrel, const pp_solution *share, 
     if (!s)
         return ppb_fail(err, "pp solver: out of memory");
     s->p = *p;
+    s->delta_m = delta_m;
     s->n = p->directions, s->m = 2 * p->directions;
     s->conservative = 1.0 - p->albedo < CONSERVATIVE_EPS;
     if (nrel > 1.0) { /* the beam refracts; mu0 inside from here on */
@@ -725,6 +798,12 @@ int pp_solve_fresnel(const pp_params *p, double nrel, const pp_solution *share, 
     }
     *out = s;
     return 0;
+}
+
+int pp_solve_fresnel(const pp_params *p, double nrel, const pp_solution *share, pp_solution **out,
+                     pp_timing *t, ppb_err *err)
+{
+    return pp_solve_delta_m(p, nrel, PP_DELTA_M_OFF, share, out, t, err);
 }
 
 int pp_solve_ex(const pp_params *p, const pp_solution *share, pp_solution **out, pp_timing *t,
@@ -792,4 +871,9 @@ void pp_blas_threads(char **argv)
     int want = ppb_memory_blas_threads(have);
     if (want != have)
         ppb_memory_blas_reexec(want, argv);
+}
+
+double pp_delta_m(const pp_solution *s)
+{
+    return s->fwd;
 }

@@ -16,12 +16,7 @@
 #ifndef PPB_BURLEY_PROFILE_H
 #define PPB_BURLEY_PROFILE_H
 
-/* Modified Bessel function of the second kind K0(x), x > 0 (0 at x = +inf, +inf at 0): the
- * ascending series A&S 9.6.13 for x <= 2, the trapezoidal rule on A&S 9.6.24,
- * K0(x) = int_0^inf exp(-x cosh t) dt, for 2 < x < 20 (step 1/8: exponentially convergent,
- * error ~ exp(x - pi^2 / h)), the asymptotic series A&S 9.7.2 cut at its smallest term for
- * x >= 20 (error below exp(-2x)). ~1e-15 relative (tests: A&S Table 9.8). */
-double ppb_bessel_k0(double x);
+#include "base/bessel.h" /* K0 */
 
 /* The searchlight scaling factor of Eq. 5, s_fit(A) = 1.85 - A + 7 |A - 0.8|^3 (mfp
  * parameterisation), and the diffuse-surface-transmission one of Eq. 6,

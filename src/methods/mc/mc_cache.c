@@ -28,7 +28,10 @@ static int device_hash(ppb_run_ctx *ctx, uint64_t *h, ppb_err *err)
 }
 
 /* The key's text (mc_cache.h): the canonical line of every key the table marks PPB_MC_KEY,
- * in table order, so a key added to the table joins the key by its flag alone; the photons per
+ * in table order, so a key added to the table joins the key by its flag alone (one added after
+ * references were shipped, keyed_when_set, only away from its default, where it changes
+ * nothing: [medium] material and channel, so the references of every config without a
+ * material keep their keys); the photons per
  * launch when a target noise stops the trace between launches; the kernel's source and the
  * device. */
 static int key_text(ppb_run_ctx *ctx, long long chunk, int with_device, FILE *f, ppb_err *err)
@@ -42,9 +45,10 @@ static int key_text(ppb_run_ctx *ctx, long long chunk, int with_device, FILE *f,
     for (int k = 0; k < ppb_config_nkeys(); k++) {
         ppb_key_info info;
         ppb_config_key_info(k, &info);
-        if (info.mc == PPB_MC_KEY)
-            ppb_config_write_key(cfg, k, f);
-        else if (info.mc != PPB_NOT_MC_KEY)
+        if (info.mc == PPB_MC_KEY) {
+            if (!(info.keyed_when_set && ppb_config_key_at_default(cfg, k)))
+                ppb_config_write_key(cfg, k, f);
+        } else if (info.mc != PPB_NOT_MC_KEY)
             return ppb_fail(err,
                             "mc: key %s.%s: the key table does not say whether it changes "
                             "the Monte Carlo",

@@ -146,22 +146,6 @@ double ppb_multipole_total_T(const ppb_multipole *mp)
     return mp->albedo_reduced * sum;
 }
 
-double ppb_bessel_k1(double x)
-{
-    /* exp(x) K1(x) = int_0^inf exp(-x (cosh t - 1)) cosh t dt; the integrand is analytic in the
-     * strip |Im t| < pi/2, so the trapezoidal rule converges like exp(-pi^2 / h). */
-    const double h = 0.125;
-    double sum = 0.5; /* t = 0 with the trapezoidal half weight */
-    for (int k = 1; k < 100000; k++) {
-        double c = cosh(k * h);
-        double term = exp(-x * (c - 1.0)) * c;
-        sum += term;
-        if (term < 1e-18 * sum)
-            break;
-    }
-    return exp(-x) * h * sum;
-}
-
 /* x K1(x) - 1 (0 when sigma_tr = 0: pure scattering, where the line kernel is exactly 2/rho^2). */
 static double k1_excess(double sigma_tr, double rho)
 {

@@ -16,6 +16,7 @@
 #ifndef PPB_MULTIPOLE_H
 #define PPB_MULTIPOLE_H
 
+#include "base/bessel.h" /* K1: the line kernel */
 #include "base/err.h"
 #include "physics/diffuse_exit.h" /* the diffuse Fresnel reflectance, the exit lobe */
 
@@ -77,10 +78,6 @@ double ppb_multipole_T(const ppb_multipole *mp, double r);
  * depth z contributes charge * alpha' * sign(z) exp(-sigma_tr |z|) / 2 (T: with d - z). */
 double ppb_multipole_total_R(const ppb_multipole *mp);
 double ppb_multipole_total_T(const ppb_multipole *mp);
-
-/* Modified Bessel function K1(x), x > 0, by the trapezoidal rule on
- * K1(x) = int_0^inf exp(-x cosh t) cosh t dt (exponentially convergent; ~1e-15 relative). */
-double ppb_bessel_k1(double x);
 
 /* Flux, per unit irradiance on S1, through a surface of outward normal (nx, ny) at the tube
  * point (xp, yp) (y = -depth) from the sources below every point of the strip xa <= x <= xb of
