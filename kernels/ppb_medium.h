@@ -4,13 +4,12 @@
  * Owns: the one struct that carries the cross-section's size and the piecewise-constant medium
  * (the step's kind and position, both sides' sigma_t and albedo, n, g) into the launch
  * parameters of march.cl, rte2d.cl and mc.cl (embedded as their `med` member), and the medium's
- * values at a point, and S1's lit part (reference: Light: the whole face, the face left of a shadow
- * step, or a searchlight's strip; ppb_tube.h reads it). The host fills it in one place,
- * ppb_medium_of (src/physics/medium.h). `step` here is always the density/albedo/shadow step's kind
- * (PPB_STEP_*); a march's step length is its params' `ds`.
+ * values at a point. The host fills it in one place, ppb_medium_of (src/physics/medium.h).
+ * `step` here is always the density/albedo/shadow step's kind (PPB_STEP_*); a march's step
+ * length is its params' `ds`.
  *
  * Plain C that is also OpenCL C, like ppb_conventions.h. Doubles first, then an even number of
- * ints, so host and device agree on the layout (96 bytes) without packing attributes. */
+ * ints, so host and device agree on the layout (80 bytes) without packing attributes. */
 #ifndef PPB_MEDIUM_H
 #define PPB_MEDIUM_H
 
@@ -21,7 +20,6 @@ typedef struct ppb_medium {
     double sigma_t, sigma_t_right; /* left of the step (everywhere but a density step's right) */
     double albedo, albedo_right;   /* left of the step (everywhere but an albedo step's right) */
     double step_x;                 /* the step plane x = step_x (reference: Medium) */
-    double lit_lo, lit_hi;         /* S1's lit part [lit_lo, lit_hi] (ppb_scene_lit_range) */
     double n;                      /* refractive index inside (<= 1: no boundary) */
     double g;                      /* Henyey-Greenstein asymmetry */
     int step;                      /* PPB_STEP_*: the step's kind; PPB_STEP_NONE in slab mode */

@@ -7,8 +7,8 @@
  * lengths along a ray where the medium or the light change: the step plane x = step_x, the light
  * line through S1 at the step (a shadow step's edge, or where the beam's path crosses a density
  * or albedo step) and the light line through S1's lit edge x' = -W/2 (oblique light;
- * x' = x + |y| tan(theta_L) is where the path toward the light meets S1's plane), and a
- * searchlight strip's edges. The lit part of S1 is [ppb_tube_lit_lo, ppb_tube_lit_hi).
+ * x' = x + |y| tan(theta_L) is where the path toward the light meets S1's plane). The lit part
+ * of S1 is [-W/2, ppb_tube_lit_hi).
  *
  * Plain C that is also OpenCL C, like ppb_conventions.h. Every function keeps the operations
  * (and their order) the marchers and walks had written out, so their results are the same bits. */
@@ -144,24 +144,18 @@ PPB_FN void ppb_tube_reflect(int face, double width, double height, double l, do
     }
 }
 
-/* The ends of S1's lit part [lo, hi] (reference: Light): -W/2 and W/2, or a shadow step's x,
- * or a searchlight's strip (the host's ppb_scene_lit_range, carried in the medium block). */
-PPB_FN double ppb_tube_lit_lo(const ppb_medium *M)
-{
-    return M->lit_lo;
-}
+/* The upper end of S1's lit part: W/2, or a shadow step's x (reference: Light). */
 PPB_FN double ppb_tube_lit_hi(const ppb_medium *M)
 {
-    return M->lit_hi;
+    double hi = 0.5 * M->width;
+    return M->step == PPB_STEP_SHADOW ? fmin(hi, M->step_x) : hi;
 }
 
-/* Whether the light path that meets S1's plane at x' is lit: x' >= lo (less the caller's
- * tolerance tol) and x' < hi where hi is an edge inside S1 (a shadow step's or a strip's; at
- * hi = W/2 the caller bounds x' by S4) (reference: Light). A line (lo == hi) lights no path:
- * its methods take it apart (ss refuses it). */
+/* Whether the light path that meets S1's plane at x' is lit: x' on S1 (x' >= -W/2, less the
+ * caller's tolerance tol) and, with a shadow step, left of its edge (reference: Light). */
 PPB_FN int ppb_tube_lit_at(const ppb_medium *M, double xp, double tol)
 {
-    return xp >= M->lit_lo - tol && (!(M->lit_hi < 0.5 * M->width) || xp < M->lit_hi);
+    return xp >= -0.5 * M->width - tol && (M->step != PPB_STEP_SHADOW || xp < M->step_x);
 }
 
 /* The medium of the piece [la, lb] of the ray from (px, py) along (mx, my), read at the piece's
@@ -178,26 +172,21 @@ PPB_FN void ppb_piece_medium(const ppb_medium *M, double px, double mx, double l
 /* Where a ray from (px, py) along (mx, my) crosses the lines where the medium or the direct
  * light change (tube only): the step plane x = step_x (density or albedo step), the light line
  * through S1 at x' = step_x (any step) and the light line through S1's lit edge x' = -W/2
- * (oblique light, tan_l = tan(theta_L) inside), then a searchlight strip's edges inside S1: the
- * light lines through x' = lo (lo > -W/2) and x' = hi (hi < W/2, no shadow step: that edge is
- * already the step's). Appends the lengths that lie in (0, lfar), 1e-12 clear of both ends, to
- * brk[nb..] in that order and returns the new count (at most nb + 5). */
+ * (oblique light, tan_l = tan(theta_L) inside). Appends the lengths that lie in (0, lfar),
+ * 1e-12 clear of both ends, to brk[nb..] in that order and returns the new count (at most
+ * nb + 3). */
 PPB_FN int ppb_tube_breaks(const ppb_medium *M, double tan_l, double px, double py, double mx,
                            double my, double lfar, double *brk, int nb)
 {
     double dxp = mx + my * tan_l, xp = px + py * tan_l;
-    double cand[5] = {-1.0, -1.0, -1.0, -1.0, -1.0};
+    double cand[3] = {-1.0, -1.0, -1.0};
     if ((M->step == PPB_STEP_DENSITY || M->step == PPB_STEP_ALBEDO) && mx != 0.0)
         cand[0] = (M->step_x - px) / mx;
     if (M->step != PPB_STEP_NONE && dxp != 0.0)
         cand[1] = (M->step_x - xp) / dxp;
     if (tan_l > 0.0 && dxp != 0.0)
         cand[2] = (-0.5 * M->width - xp) / dxp;
-    if (M->lit_lo > -0.5 * M->width && dxp != 0.0)
-        cand[3] = (M->lit_lo - xp) / dxp;
-    if (M->lit_hi < 0.5 * M->width && M->step != PPB_STEP_SHADOW && dxp != 0.0)
-        cand[4] = (M->lit_hi - xp) / dxp;
-    for (int k = 0; k < 5; k++)
+    for (int k = 0; k < 3; k++)
         if (cand[k] > 1e-12 && cand[k] < lfar - 1e-12)
             brk[nb++] = cand[k];
     return nb;

@@ -21,7 +21,7 @@
  *   photons, moved by at most 5e-4) agree in every total within 4 standard errors. */
 #include "testutil.h"
 
-#include "kernels/ppb_tube.h"
+#include "kernels/ppb_light.h"
 #include "methods/mc/mc_tally.h"
 #include "methods/mc/method_mc.h"
 #include "methods/pp/method_ss.h"
@@ -166,16 +166,18 @@ static void test_lit_part(void **state)
      * normal light crosses no light line, one from (-2, -1) toward (3, -1) crosses both. */
     ppb_scene nsc = strip_scene(1, 2, 0);
     ppb_medium M = ppb_medium_of(&nsc);
-    assert_true(ppb_tube_lit_at(&M, 0.0, 0.0) && ppb_tube_lit_at(&M, 1.99, 0.0));
-    assert_false(ppb_tube_lit_at(&M, 2.0, 0.0) || ppb_tube_lit_at(&M, -0.01, 0.0));
+    ppb_lit L = ppb_lit_of(&nsc);
+    assert_true(ppb_lit_at(&M, &L, 0.0, 0.0) && ppb_lit_at(&M, &L, 1.99, 0.0));
+    assert_false(ppb_lit_at(&M, &L, 2.0, 0.0) || ppb_lit_at(&M, &L, -0.01, 0.0));
     double brk[8];
-    assert_int_equal(ppb_tube_breaks(&M, 0.0, 1.5, 0.0, 0.0, -1.0, 3.0, brk, 0), 0);
-    assert_int_equal(ppb_tube_breaks(&M, 0.0, -2.0, -1.0, 1.0, 0.0, 5.0, brk, 0), 2);
+    assert_int_equal(ppb_lit_breaks(&M, &L, 0.0, 1.5, 0.0, 0.0, -1.0, 3.0, brk, 0), 0);
+    assert_int_equal(ppb_lit_breaks(&M, &L, 0.0, -2.0, -1.0, 1.0, 0.0, 5.0, brk, 0), 2);
     assert_close(brk[0], 2.0, 1e-15);
     assert_close(brk[1], 4.0, 1e-15);
     ppb_scene whole = tu_tube();
     ppb_medium F = ppb_medium_of(&whole);
-    assert_int_equal(ppb_tube_breaks(&F, 0.0, -2.0, -1.0, 1.0, 0.0, 5.0, brk, 0), 0);
+    ppb_lit FL = ppb_lit_of(&whole);
+    assert_int_equal(ppb_lit_breaks(&F, &FL, 0.0, -2.0, -1.0, 1.0, 0.0, 5.0, brk, 0), 0);
 }
 
 /* ---- against the Monte Carlo ---- */

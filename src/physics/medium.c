@@ -19,8 +19,14 @@ ppb_medium ppb_medium_of(const ppb_scene *sc)
         .step = tube ? sc->step : PPB_STEP_NONE,
         .tube = tube,
     };
-    ppb_scene_lit_range(sc, &m.lit_lo, &m.lit_hi);
     return m;
+}
+
+ppb_lit ppb_lit_of(const ppb_scene *sc)
+{
+    ppb_lit L = {0.0, 0.0, ppb_scene_searchlight(sc), 0};
+    ppb_scene_lit_range(sc, &L.lo, &L.hi);
+    return L;
 }
 
 int ppb_lit_pieces(const ppb_scene *sc, ppb_lit_piece piece[2])

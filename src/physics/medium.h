@@ -8,10 +8,14 @@
 #ifndef PPB_PHYSICS_MEDIUM_H
 #define PPB_PHYSICS_MEDIUM_H
 
-#include "kernels/ppb_tube.h"
+#include "kernels/ppb_light.h"
 #include "model/scene.h"
 
 ppb_medium ppb_medium_of(const ppb_scene *sc);
+
+/* S1's lit part as the marchers' parameters carry it (kernels/ppb_light.h): the searchlight's
+ * strip from ppb_scene_lit_range, strip 0 for the whole face. */
+ppb_lit ppb_lit_of(const ppb_scene *sc);
 
 /* A piece of S1's lit strip over which the medium is one (reference: Light, Medium): [xa, xb],
  * and sigma_t and albedo at its entry points. */

@@ -210,7 +210,7 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
     int nb = 0;
     brk[nb++] = 0.0;
     if (P->med.tube)
-        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
+        nb = ppb_lit_breaks(&P->med, &P->lit, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
     ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first; at most five breaks */
     brk[nb++] = lfar;
 
@@ -364,7 +364,7 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
     int nb = 0;
     brk[nb++] = 0.0;
     if (P->med.tube)
-        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
+        nb = ppb_lit_breaks(&P->med, &P->lit, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
     ppb_sort_doubles(brk + 1, nb - 1);
     brk[nb++] = lfar;
     double ct = P->cos_theta_l, st = P->light_x;

@@ -19,7 +19,7 @@
 #include "methods/rte2d/rte2d_grid.h"
 
 _Static_assert(sizeof(ppb_rte_params) ==
-                   sizeof(ppb_medium) + 13 * sizeof(double) + 22 * sizeof(int),
+                   sizeof(ppb_medium) + sizeof(ppb_lit) + 13 * sizeof(double) + 22 * sizeof(int),
                "ppb_rte_params: the medium, doubles, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
