@@ -5,6 +5,7 @@
 
 #include "methods/bdipole/method_bdipole.h"
 #include "methods/burley/method_burley.h"
+#include "methods/dirpole/method_dirpole.h"
 #include "methods/external/method_external.h"
 #include "methods/mc/method_mc.h"
 #include "methods/mc/perf_mc.h"
@@ -84,6 +85,15 @@ static const ppb_method methods[] = {
      .run = ppb_method_pbd,
      .check = ppb_pbd_check,
      .section = "pbd"},
+    {.id = "dirpole",
+     .summary = "directional dipole (Frisvad, Hachisuka & Kjeldsen 2014)",
+     .run = ppb_method_dirpole,
+     .check = ppb_dirpole_check,
+     .section = "dirpole"},
+    {.id = "dirpole+ss",
+     .summary = "directional dipole plus single scattering",
+     .run = run_sum,
+     .sum_of = (const char *const[]){"dirpole", "ss", NULL}},
     {.id = "ppslab",
      .slab_only = 1,
      .reference = 2,

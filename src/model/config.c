@@ -172,6 +172,9 @@ static const key_def keys[] = {
      "bdipole: quadrature nodes per 1 / sigma_tr over the lit strip"},
     {"pbd", "nodes", K_INT, PPB_NOT_MC_KEY, F(pbd.nodes), 2, 16, "6", NULL,
      "pbd: Gauss-Legendre nodes per panel of the strip's x and z integrals"},
+    {"dirpole", "samples", K_INT, PPB_NOT_MC_KEY, F(dirpole.samples), 1, 256, "16", NULL,
+     "dirpole: quadrature nodes per diffusion length 1/sigma_tr along the strip and per unit of "
+     "t along z = q sinh t"},
     {"rte2d", "spacing", K_REAL, PPB_NOT_MC_KEY, F(rte2d.spacing), 0.005, 10, "0.1", NULL,
      "rte2d: grid node spacing over the cross-section, mfp"},
     {"rte2d", "directions", K_INT, PPB_NOT_MC_KEY, F(rte2d.directions), 2, 2000, "128", NULL,

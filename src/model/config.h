@@ -78,6 +78,9 @@ typedef struct ppb_bdipole_settings {
 typedef struct ppb_pbd_settings {
     int nodes; /* Gauss-Legendre nodes per panel of the strip's x and z integrals */
 } ppb_pbd_settings;
+typedef struct ppb_dirpole_settings {
+    int samples; /* nodes per diffusion length along the strip and per unit of t along z */
+} ppb_dirpole_settings;
 
 typedef struct ppb_rte2d_settings {
     double spacing;  /* grid node spacing over the cross-section, mfp */
@@ -132,6 +135,7 @@ typedef struct ppb_config {
     ppb_burley_settings burley;
     ppb_bdipole_settings bdipole;
     ppb_pbd_settings pbd;
+    ppb_dirpole_settings dirpole;
     ppb_rte2d_settings rte2d;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
