@@ -10,7 +10,7 @@
 #ifndef PPB_MARCH_PARAMS_H
 #define PPB_MARCH_PARAMS_H
 
-#include "ppb_tube.h"
+#include "ppb_light.h"
 
 #ifdef __OPENCL_VERSION__
 #define PPB_GMEM __global
@@ -57,6 +57,7 @@ enum {
  * asserts the size. */
 typedef struct ppb_march_params {
     ppb_medium med; /* the cross-section and the medium (reference: Medium to Light) */
+    ppb_lit lit;    /* S1's lit part: a searchlight's strip (ppb_light.h) */
     double tan_theta_l, cos_theta_l; /* light incidence */
     double light_x, light_y;         /* w_L = (light_x, light_y, 0) */
     /* map: light-aligned grid over x' = x + y tan(theta_L) and depth -y */

@@ -15,7 +15,7 @@
 #ifndef PPB_BEAM_IMAGES_H
 #define PPB_BEAM_IMAGES_H
 
-#include "ppb_tube.h"
+#include "ppb_light.h"
 
 /* The image series' stopping tolerance, relative to what has been summed: 2^-60, 64 times below
  * the half ulp (2^-54 of the sum at least) under which a term leaves a double sum unchanged. */
@@ -56,6 +56,7 @@ inline void ppb_beam_phases(double g, double st, double ct, double vx, double vy
 /* The refracted beam inside the tube (n > 1), as both kernels' parameters hold it. */
 typedef struct ppb_beam_tube {
     ppb_medium med;             /* the cross-section and the medium (ppb_medium.h) */
+    ppb_lit lit;                /* S1's lit part (ppb_light.h) */
     double sin_t, cos_t, tan_t; /* the beam's direction (sin, -cos) inside */
     double beam_in;             /* its perpendicular irradiance inside */
     double beam_fb, beam_fs;    /* F at S1, S2 and at S3, S4 from inside */
@@ -66,6 +67,7 @@ typedef struct ppb_beam_tube {
  * names but the sine of the beam's angle, SIN: light_x in march's, sin_theta_l in rte2d's). */
 #define PPB_BEAM_TUBE(P, SIN)                                                                      \
     ((ppb_beam_tube){.med = (P)->med,                                                              \
+                     .lit = (P)->lit,                                                              \
                      .sin_t = (P)->SIN,                                                            \
                      .cos_t = (P)->cos_theta_l,                                                    \
                      .tan_t = (P)->tan_theta_l,                                                    \
@@ -115,7 +117,7 @@ inline double ppb_beam_images(const ppb_beam_tube *B, const double *cb, double p
                               double mx, double my, double la, double lb, double sigma_t, double d0)
 {
     double W = B->med.width, H = B->med.height, ct = B->cos_t, tn = B->tan_t;
-    double lo = -0.5 * W, hi = ppb_tube_lit_hi(&B->med); /* S1's lit part */
+    double lo = ppb_lit_lo(&B->med, &B->lit), hi = ppb_lit_hi(&B->med, &B->lit); /* S1's lit */
     if (!(hi > lo))
         return 0.0;
     /* Image j's beam has come at least j H / cos theta_t, through the lesser sigma_t at worst;

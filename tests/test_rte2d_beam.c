@@ -10,7 +10,9 @@
  *   ppb_rte_absorbed_beam (rte2d_grid.h: the beam walked forward along its path, 2e4 midpoints
  *   over the entry points where it reflects off the side walls), and a brute-force integral
  *   written here of (1 - alpha) sigma_t E over the cross-section, E from the backward point
- *   evaluator above, by nested adaptive Simpson (to 1e-10 absolute). */
+ *   evaluator above, by nested adaptive Simpson (to 1e-10 absolute).
+ * A searchlight's strip (reference: Light) joins both: its two light lines cut the rectangles,
+ * and the point evaluator lights its own strip. */
 #include "testutil.h"
 
 #include "kernels/ppb_fresnel.h"
@@ -149,6 +151,9 @@ static int s1_lit(const ppb_scene *sc, double x)
 {
     if (!is_tube(sc))
         return 1;
+    if (sc->searchlight) /* reference: Light: the strip [x0 - width/2, x0 + width/2) */
+        return x >= sc->light_x0 - 0.5 * sc->light_width &&
+               x < sc->light_x0 + 0.5 * sc->light_width;
     double hi = sc->step == PPB_STEP_SHADOW ? fmin(0.5 * sc->width, sc->step_x) : 0.5 * sc->width;
     return x >= -0.5 * sc->width && x < hi;
 }
@@ -298,6 +303,32 @@ static void test_against_quadrature(void **state)
     quad_case("n = 1.4, 45 deg, tube, density step (right)", &sc, r4);
     double r5[4] = {-0.5, 0.1, -1.2, 0.0};
     quad_case("n = 1.4, 45 deg, tube, density step (left)", &sc, r5);
+
+    /* A searchlight's strip [-0.6, 0.2]: both its light lines cross the rectangles. */
+    sc = base_scene(PPB_GEOM_TUBE);
+    sc.width = 2.0;
+    sc.height = 1.5;
+    sc.sigma_t = 1.3;
+    sc.theta_deg = 45.0;
+    sc.searchlight = 1;
+    sc.light_x0 = -0.2;
+    sc.light_width = 0.8;
+    double r6[4] = {-0.9, 0.9, -1.4, -0.1};
+    quad_case("n = 1, 45 deg, strip", &sc, r6);
+    sc.step = PPB_STEP_DENSITY;
+    sc.step_x = 0.0;
+    sc.sigma_t_right = 2.5;
+    double r7[4] = {0.0, 0.9, -1.3, -0.1};
+    quad_case("n = 1, 45 deg, strip, density step (right)", &sc, r7);
+    sc.n = 1.4;
+    sc.width = 1.0;
+    sc.height = 2.0;
+    sc.step = PPB_STEP_NONE;
+    sc.sigma_t = 0.4;
+    sc.light_x0 = 0.05;
+    sc.light_width = 0.5;
+    double r8[4] = {-0.3, 0.35, -1.7, -0.4};
+    quad_case("n = 1.4, 45 deg, tube, strip", &sc, r8);
 }
 
 /* ---- conservation ---- */
@@ -387,31 +418,37 @@ typedef struct cons_case {
     double n, theta;
     int step;
     double sigma_t; /* 0: 0.8 */
+    int strip;      /* 1: a searchlight's strip [-0.75, 0.15] (reference: Light) */
 } cons_case;
 
 static void test_conservation(void **state)
 {
     (void)state;
     const cons_case cs[] = {
-        {"slab n = 1 normal", PPB_GEOM_SLAB, 1.0, 0.0, PPB_STEP_NONE, 0.0},
-        {"slab n = 1 45", PPB_GEOM_SLAB, 1.0, 45.0, PPB_STEP_NONE, 0.0},
-        {"slab n = 1.4 normal", PPB_GEOM_SLAB, 1.4, 0.0, PPB_STEP_NONE, 0.0},
-        {"slab n = 1.4 45", PPB_GEOM_SLAB, 1.4, 45.0, PPB_STEP_NONE, 0.0},
-        {"tube n = 1 normal", PPB_GEOM_TUBE, 1.0, 0.0, PPB_STEP_NONE, 0.0},
-        {"tube n = 1 normal density", PPB_GEOM_TUBE, 1.0, 0.0, PPB_STEP_DENSITY, 0.0},
-        {"tube n = 1 45", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_NONE, 0.0},
-        {"tube n = 1 45 shadow", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_SHADOW, 0.0},
-        {"tube n = 1 45 density", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_DENSITY, 0.0},
-        {"tube n = 1 45 albedo", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_ALBEDO, 0.0},
-        {"tube n = 1.4 normal", PPB_GEOM_TUBE, 1.4, 0.0, PPB_STEP_NONE, 0.0},
-        {"tube n = 1.4 normal density", PPB_GEOM_TUBE, 1.4, 0.0, PPB_STEP_DENSITY, 0.0},
-        {"tube n = 1.4 45", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_NONE, 0.0},
-        {"tube n = 1.4 45 shadow", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_SHADOW, 0.0},
-        {"tube n = 1.4 45 density", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_DENSITY, 0.0},
-        {"tube n = 1.4 45 albedo", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_ALBEDO, 0.0},
-        {"tube n = 1 80 density, thick", PPB_GEOM_TUBE, 1.0, 80.0, PPB_STEP_DENSITY, 12.0},
-        {"tube n = 1.4 80 shadow, thin", PPB_GEOM_TUBE, 1.4, 80.0, PPB_STEP_SHADOW, 0.05},
-        {"tube n = 1.4 80 density, thick", PPB_GEOM_TUBE, 1.4, 80.0, PPB_STEP_DENSITY, 12.0},
+        {"slab n = 1 normal", PPB_GEOM_SLAB, 1.0, 0.0, PPB_STEP_NONE, 0.0, 0},
+        {"slab n = 1 45", PPB_GEOM_SLAB, 1.0, 45.0, PPB_STEP_NONE, 0.0, 0},
+        {"slab n = 1.4 normal", PPB_GEOM_SLAB, 1.4, 0.0, PPB_STEP_NONE, 0.0, 0},
+        {"slab n = 1.4 45", PPB_GEOM_SLAB, 1.4, 45.0, PPB_STEP_NONE, 0.0, 0},
+        {"tube n = 1 normal", PPB_GEOM_TUBE, 1.0, 0.0, PPB_STEP_NONE, 0.0, 0},
+        {"tube n = 1 normal density", PPB_GEOM_TUBE, 1.0, 0.0, PPB_STEP_DENSITY, 0.0, 0},
+        {"tube n = 1 45", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_NONE, 0.0, 0},
+        {"tube n = 1 45 shadow", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_SHADOW, 0.0, 0},
+        {"tube n = 1 45 density", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_DENSITY, 0.0, 0},
+        {"tube n = 1 45 albedo", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_ALBEDO, 0.0, 0},
+        {"tube n = 1.4 normal", PPB_GEOM_TUBE, 1.4, 0.0, PPB_STEP_NONE, 0.0, 0},
+        {"tube n = 1.4 normal density", PPB_GEOM_TUBE, 1.4, 0.0, PPB_STEP_DENSITY, 0.0, 0},
+        {"tube n = 1.4 45", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_NONE, 0.0, 0},
+        {"tube n = 1.4 45 shadow", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_SHADOW, 0.0, 0},
+        {"tube n = 1.4 45 density", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_DENSITY, 0.0, 0},
+        {"tube n = 1.4 45 albedo", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_ALBEDO, 0.0, 0},
+        {"tube n = 1 80 density, thick", PPB_GEOM_TUBE, 1.0, 80.0, PPB_STEP_DENSITY, 12.0, 0},
+        {"tube n = 1.4 80 shadow, thin", PPB_GEOM_TUBE, 1.4, 80.0, PPB_STEP_SHADOW, 0.05, 0},
+        {"tube n = 1.4 80 density, thick", PPB_GEOM_TUBE, 1.4, 80.0, PPB_STEP_DENSITY, 12.0, 0},
+        {"tube n = 1 normal strip", PPB_GEOM_TUBE, 1.0, 0.0, PPB_STEP_NONE, 0.0, 1},
+        {"tube n = 1 45 strip albedo", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_ALBEDO, 0.0, 1},
+        {"tube n = 1 45 strip density", PPB_GEOM_TUBE, 1.0, 45.0, PPB_STEP_DENSITY, 0.0, 1},
+        {"tube n = 1.4 45 strip", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_NONE, 0.0, 1},
+        {"tube n = 1.4 45 strip density", PPB_GEOM_TUBE, 1.4, 45.0, PPB_STEP_DENSITY, 0.0, 1},
     };
     for (size_t c = 0; c < sizeof cs / sizeof cs[0]; c++) {
         ppb_scene sc = base_scene(cs[c].geom);
@@ -425,6 +462,9 @@ static void test_conservation(void **state)
         sc.step_x = 0.25;
         sc.sigma_t_right = 2.2;
         sc.albedo_right = 0.75;
+        sc.searchlight = cs[c].strip;
+        sc.light_x0 = -0.3;
+        sc.light_width = 0.9;
         ppb_rte_params P = scene_params(&sc);
         double got = tiled_absorbed(&sc, &P), ref = ppb_rte_absorbed_beam(&sc);
         double wit = witness_absorbed(&sc, 1e-10);

@@ -690,9 +690,7 @@ static void write_ranking(FILE *f, const char *const *cases, const case_data *cd
     for (int j = 0; j < ncols; j++)
         for (int k = 0; k < NRANK_CELLS; k++)
             med[j][k] = method_median(cases, cd, ncases, cols[j], rank_cells[k]);
-    fprintf(f, "## Ranking
-
-");
+    fprintf(f, "## Ranking\n\n");
     fprintf(f, "Every method per surface: the median over the %d cases of the excess RMS "
                "(rms_excess, percent) at the Table 2 cells and over each whole surface, its "
                "rank among the methods at that cell (1 = closest to the Monte Carlo), and in "

@@ -154,8 +154,9 @@ static json_t *scene_doc(const ppb_config *cfg)
 {
     const ppb_scene *sc = &cfg->scene;
     ppb_layout lo = ppb_scene_layout(sc);
-    double wl[3];
+    double wl[3], lit_lo, lit_hi; /* S1's lit part (reference: Light) */
     ppb_scene_light_dir(sc, wl);
+    ppb_scene_lit_range(sc, &lit_lo, &lit_hi);
     int tube = sc->geometry == PPB_GEOM_TUBE;
     json_t *doc = json_pack(
         "{sssisssss{sssfsfsisi}}", "format", "ppbench-scene", "version", PPB_SCENE_JSON_VERSION,
@@ -175,9 +176,11 @@ static json_t *scene_doc(const ppb_config *cfg)
                       sc->step_x, "sigma_t_right", sc->sigma_t_right, "albedo_right",
                       sc->albedo_right, "n", sc->n)) ||
         add(doc, "light",
-            json_pack("{sfsfsfs[fff]sfsf}", "theta_deg", sc->theta_deg, "irradiance_perp", 1.0,
-                      "irradiance_s1", ppb_scene_cos_theta_l(sc), "direction", wl[0], wl[1], wl[2],
-                      "lit_width", ppb_scene_lit_width(sc), "power_in", ppb_scene_power_in(sc))) ||
+            json_pack("{sfsfsfs[fff]sfsfs[ff]sb}", "theta_deg", sc->theta_deg, "irradiance_perp",
+                      1.0, "irradiance_s1", ppb_scene_cos_theta_l(sc), "direction", wl[0], wl[1],
+                      wl[2], "lit_width", ppb_scene_lit_width(sc), "power_in",
+                      ppb_scene_power_in(sc), "lit", lit_lo, lit_hi, "line",
+                      ppb_scene_lit_line(sc))) ||
         add(doc, "averaging",
             json_pack("{sisi}", "directions_per_bin", cfg->samples_dir * cfg->samples_dir,
                       "points_per_segment", cfg->samples_seg)) ||

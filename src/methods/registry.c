@@ -103,6 +103,7 @@ static const ppb_method methods[] = {
      .reference = 2, /* noise-free in the tube: summary_rte2d.csv */
      .summary = "the tube's transfer solved: the paper's refinement iterated",
      .run = ppb_method_rte2d,
+     .check = ppb_rte2d_check,
      .section = "rte2d",
      .draw = ppb_rte2d_draw,
      .perf_title = "rte2d: the refinement iterated (OpenCL marches)",

@@ -47,6 +47,7 @@ static const enum_name step_names[] = {{PPB_STEP_NONE, "none"},
                                        {PPB_STEP_ALBEDO, "albedo"},
                                        {PPB_STEP_SHADOW, "shadow"},
                                        {0, NULL}};
+static const enum_name lit_names[] = {{0, "face"}, {1, "strip"}, {0, NULL}};
 static const enum_name table_names[] = {{PPB_TABLE_R, "R"}, {PPB_TABLE_S, "S"}, {0, NULL}};
 static const enum_name unit_names[] = {{PPB_UNIT_MFP, "mfp"}, {PPB_UNIT_MM, "mm"}, {0, NULL}};
 /* The first name of a value is the one written; the others are accepted too. */
@@ -117,6 +118,13 @@ static const key_def keys[] = {
      "albedo for x >= step_x (step = albedo)"},
     {"light", "theta_deg", K_REAL, PPB_MC_KEY, F(scene.theta_deg), 0, 89, "0", NULL,
      "incidence angle from the S1 normal, degrees"},
+    {"light", "lit", K_ENUM, PPB_MC_KEY, F(scene.searchlight), 0, 0, "face", lit_names,
+     "the lit part of S1: the whole face (x < step_x with step = shadow), or a searchlight's "
+     "strip (x0, width; tube only; docs/reference.md: Light)"},
+    {"light", "x0", K_REAL, PPB_MC_KEY, F(scene.light_x0), -500, 500, "0", NULL,
+     "centre of the strip (lit = strip), mfp"},
+    {"light", "width", K_REAL, PPB_MC_KEY, F(scene.light_width), 0, 1000, "1", NULL,
+     "width of the strip (lit = strip), mfp; 0 = a line along z at x0"},
     {"bins", "theta", K_INT, PPB_MC_KEY, F(scene.ntheta), 1, 64, "8", NULL,
      "theta bins (equal projected solid angle)"},
     {"bins", "phi", K_INT, PPB_MC_KEY, F(scene.nphi), 1, 64, "8", NULL,
@@ -192,7 +200,8 @@ static const key_def keys[] = {
 /* The PPB_MC_KEY keys that join the cache's key only away from their defaults (config.h,
  * ppb_key_info.keyed_when_set): added after references were traced and shipped, and at their
  * defaults changing nothing, so those references keep their keys. */
-static const char *const keyed_when_set[] = {"medium.material", "medium.channel"};
+static const char *const keyed_when_set[] = {"medium.material", "medium.channel", "light.lit",
+                                             "light.x0", "light.width"};
 
 #define NKEYS ((int)(sizeof keys / sizeof keys[0]))
 _Static_assert(sizeof keys / sizeof keys[0] <= PPB_MAX_KEYS, "raise PPB_MAX_KEYS");
@@ -1026,6 +1035,39 @@ static const char *origin_of(const ppb_config *cfg, const char *section, const c
     return buf;
 }
 
+/* The searchlight's strip (reference: Light): in the tube, on S1, not with a shadow step (the
+ * strip would be cut by it: refused rather than intersected, so the lit part is always one
+ * strip). x0 and width are read with lit = strip only. */
+static int validate_strip(const ppb_config *cfg, ppb_err *err)
+{
+    const ppb_scene *sc = &cfg->scene;
+    char where[600], where2[600];
+    double w = sc->light_width, x0 = sc->light_x0, half = 0.5 * sc->width;
+    if (!sc->searchlight)
+        return 0; /* x0 and width unused, as step_x without a step */
+    if (sc->geometry == PPB_GEOM_SLAB)
+        return ppb_config_key_fail(
+            cfg, "light", "lit", err,
+            "a searchlight needs the tube (docs/reference.md, Light; geometry = slab from %s)",
+            origin_of(cfg, "experiment", "geometry", where, sizeof where));
+    if (sc->step == PPB_STEP_SHADOW)
+        return ppb_config_key_fail(
+            cfg, "light", "lit", err,
+            "a searchlight and a shadow step do not combine (docs/reference.md, Light; step from "
+            "%s): light the strip you want with x0 and width",
+            origin_of(cfg, "medium", "step", where, sizeof where));
+    int on_s1 = w > 0.0 ? x0 - 0.5 * w >= -half && x0 + 0.5 * w <= half : fabs(x0) < half;
+    if (!on_s1)
+        return ppb_config_key_fail(
+            cfg, "light", w > 0.0 ? "width" : "x0", err,
+            "the lit %s [x0 - width/2, x0 + width/2] = [%g, %g] must lie on S1 [%g, %g]%s "
+            "(x0 from %s, tube width from %s)",
+            w > 0.0 ? "strip" : "line", x0 - 0.5 * w, x0 + 0.5 * w, -half, half,
+            w > 0.0 ? "" : ", inside it", origin_of(cfg, "light", "x0", where, sizeof where),
+            origin_of(cfg, "tube", "width", where2, sizeof where2));
+    return 0;
+}
+
 /* Whether a key was given (in the file, a grid axis's list included, or by --set). */
 static int key_given(const ppb_config *cfg, const char *section, const char *key)
 {
@@ -1122,7 +1164,7 @@ static int validate(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "step_x", err,
             "the step must lie inside the tube (|step_x| < width / 2 = %g, width from %s)",
             0.5 * sc->width, origin_of(cfg, "tube", "width", where, sizeof where));
-    return 0;
+    return validate_strip(cfg, err);
 }
 
 static void base_name(const char *path, char *out, size_t cap)

@@ -87,7 +87,9 @@ const char *ppb_region_name(int region)
  * the step region partition the surface. */
 static int in_region(const ppb_scene *sc, int kind, double s)
 {
-    double x0 = sc->step != PPB_STEP_NONE ? sc->step_x : 0.0;
+    double x0 = sc->step != PPB_STEP_NONE   ? sc->step_x
+                : ppb_scene_searchlight(sc) ? sc->light_x0
+                                            : 0.0; /* reference: Metrics, Regions */
     double half = 0.5 * sc->width;
     switch (kind) {
     case PPB_REGION_LEFT:

@@ -65,20 +65,52 @@ void ppb_scene_light_dir(const ppb_scene *sc, double w[3])
     w[2] = 0.0;
 }
 
+int ppb_scene_searchlight(const ppb_scene *sc)
+{
+    return sc->geometry == PPB_GEOM_TUBE && sc->searchlight;
+}
+
+int ppb_scene_lit_line(const ppb_scene *sc)
+{
+    return ppb_scene_searchlight(sc) && sc->light_width == 0.0;
+}
+
+void ppb_scene_lit_range(const ppb_scene *sc, double *lo, double *hi)
+{
+    *lo = -0.5 * sc->width;
+    *hi = 0.5 * sc->width;
+    if (ppb_scene_searchlight(sc)) {
+        /* The config keeps the strip on S1 (config.c); the clamp only guards round-off. */
+        *lo = fmax(*lo, sc->light_x0 - 0.5 * sc->light_width);
+        *hi = fmin(*hi, sc->light_x0 + 0.5 * sc->light_width);
+    } else if (sc->step == PPB_STEP_SHADOW && sc->geometry == PPB_GEOM_TUBE)
+        *hi = fmin(*hi, sc->step_x);
+}
+
 double ppb_scene_lit_width(const ppb_scene *sc)
 {
     if (sc->geometry == PPB_GEOM_SLAB)
         return 1.0;
-    if (sc->step == PPB_STEP_SHADOW) {
+    if (sc->step == PPB_STEP_SHADOW && !ppb_scene_searchlight(sc)) {
         double lit = sc->step_x + 0.5 * sc->width;
         return lit < 0 ? 0 : (lit > sc->width ? sc->width : lit);
+    }
+    if (ppb_scene_searchlight(sc)) {
+        double lo, hi;
+        ppb_scene_lit_range(sc, &lo, &hi);
+        return hi > lo ? hi - lo : 0.0;
     }
     return sc->width;
 }
 
+double ppb_scene_lit_measure(const ppb_scene *sc)
+{
+    return ppb_scene_lit_line(sc) ? 1.0 : ppb_scene_lit_width(sc);
+}
+
 double ppb_scene_power_in(const ppb_scene *sc)
 {
-    return ppb_scene_lit_width(sc) * ppb_scene_cos_theta_l(sc);
+    return ppb_scene_lit_measure(sc) * ppb_scene_cos_theta_l(sc);
 }
 
 double ppb_scene_segment_length(const ppb_scene *sc, int surf)

@@ -25,6 +25,11 @@ typedef struct ppb_scene {
     int step; /* PPB_STEP_* */
     double step_x, sigma_t_right, albedo_right;
     double theta_deg; /* light incidence from the S1 normal */
+    /* S1's lit part (reference: Light): searchlight 0 (zero-initialised: the default) lights the
+     * whole face (x < step_x with a shadow step); 1 the strip of centre light_x0 and width
+     * light_width, a line along z at light_x0 when light_width = 0. */
+    int searchlight;
+    double light_x0, light_width;
     int ntheta, nphi;
 } ppb_scene;
 
@@ -55,12 +60,28 @@ double ppb_scene_cos_theta_l(const ppb_scene *sc);
 double ppb_scene_sin_theta_l(const ppb_scene *sc);
 double ppb_scene_tan_theta_l(const ppb_scene *sc);
 
-/* Width of the lit part of S1 (tube) -- the shadow step lights x < step_x only; 1 in slab mode
- * (per unit area). Used to normalise totals (reference: Bins). */
+/* The one definition of S1's lit part (reference: Light), tube mode: [*lo, *hi], the whole face
+ * [-W/2, W/2], or [-W/2, step_x] with a shadow step, or the searchlight's strip
+ * [x0 - width/2, x0 + width/2] (lo == hi == x0 for a line). Slab mode: [-W/2, W/2] (unused:
+ * the slab is lit everywhere). */
+void ppb_scene_lit_range(const ppb_scene *sc, double *lo, double *hi);
+
+/* Whether the light is a searchlight (a strip narrower than the face, or a line), and whether it
+ * is a line ([light] width = 0: a delta in x at x0). */
+int ppb_scene_searchlight(const ppb_scene *sc);
+int ppb_scene_lit_line(const ppb_scene *sc);
+
+/* Width of the lit part of S1 (tube) -- the shadow step lights x < step_x only, a strip its
+ * width, a line 0; 1 in slab mode (per unit area). */
 double ppb_scene_lit_width(const ppb_scene *sc);
 
-/* Power entering the lit part of S1 per unit E_perp: lit width x cos(theta_L) per unit length
- * in z (tube), cos(theta_L) per unit area (slab). Totals are fractions of it (reference: Light). */
+/* The lit part's measure that normalises the power entering: the lit width, except 1 for a line
+ * (a line of unit strength: the limit of a strip of width w under E_perp = 1 / w). */
+double ppb_scene_lit_measure(const ppb_scene *sc);
+
+/* Power entering the lit part of S1 per unit E_perp: lit measure x cos(theta_L) per unit length
+ * in z (tube; a line: cos(theta_L) per unit line strength), cos(theta_L) per unit area (slab).
+ * Totals are fractions of it (reference: Light). */
 double ppb_scene_power_in(const ppb_scene *sc);
 
 /* Length of one segment of surface surf (ppb_segment_length); 1 in slab mode (per unit area). */

@@ -111,5 +111,12 @@ int ppb_bssrdf_check(const ppb_config *cfg, const char *id, ppb_err *err)
     if (cfg->scene.ntheta > PPB_BSSRDF_MAX_THETA)
         return ppb_config_key_fail(cfg, "bins", "theta", err, "%s: bins.theta = %d above %d", id,
                                    cfg->scene.ntheta, PPB_BSSRDF_MAX_THETA);
+    /* The strip callback integrates a profile over [xa, xb]: a line searchlight (xa == xb)
+     * needs the line kernel at the point instead (reference: Light), not given yet. */
+    if (ppb_scene_lit_line(&cfg->scene))
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "%s: a line searchlight (width = 0) is refused: the profile is "
+                                   "integrated over a strip; use width > 0",
+                                   id);
     return 0;
 }

@@ -69,7 +69,8 @@ void ppb_light_path_exact(const ppb_scene *sc, double x, double y, double *D, do
     /* Reference: Light: lit only if the path meets S1 inside its lit part; for theta_L >= 0 a
      * path that would meet S1's plane left of -W/2 leaves through S3 first. */
     ppb_medium M = ppb_medium_of(sc);
-    *lit = ppb_tube_lit_at(&M, xp, 0.0) && xp <= ppb_face_line(PPB_S4, sc->width, sc->height);
+    ppb_lit L = ppb_lit_of(sc);
+    *lit = ppb_lit_at(&M, &L, xp, 0.0) && xp <= ppb_face_line(PPB_S4, sc->width, sc->height);
 }
 
 /* The grid of the maps without its cells (ppb_maps_build, ppb_maps_bytes). */
@@ -170,7 +171,12 @@ double ppb_beam_depth(const ppb_scene *sc, double xe)
 double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *width)
 {
     ppb_medium M = ppb_medium_of(sc);
-    double a = ppb_face_line(PPB_S3, sc->width, sc->height), b = ppb_tube_lit_hi(&M);
+    ppb_lit L = ppb_lit_of(sc);
+    double a = ppb_lit_lo(&M, &L), b = ppb_lit_hi(&M, &L);
+    if (ppb_scene_lit_line(sc)) { /* a line of unit strength: f at it (ppb_scene_lit_measure) */
+        *width = 1.0;
+        return f(sc, a, arg);
+    }
     *width = b > a ? b - a : 0.0;
     if (b <= a)
         return 0.0;
@@ -203,9 +209,11 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
 double ppb_lit_midpoint_sum(const ppb_scene *sc, ppb_entry_fn f, void *arg, int np, double *width)
 {
     ppb_medium M = ppb_medium_of(sc);
-    double a = ppb_face_line(PPB_S3, sc->width, sc->height), hi = ppb_tube_lit_hi(&M);
-    *width = hi > a ? hi - a : 0.0;
-    if (!(hi > a))
+    ppb_lit L = ppb_lit_of(sc);
+    double a = ppb_lit_lo(&M, &L), hi = ppb_lit_hi(&M, &L);
+    int line = ppb_scene_lit_line(sc); /* np points all on the line, of measure 1 */
+    *width = line ? 1.0 : (hi > a ? hi - a : 0.0);
+    if (!(hi > a) && !line)
         return 0.0;
     double sum = 0.0;
     for (int i = 0; i < np; i++)

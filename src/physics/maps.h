@@ -71,7 +71,8 @@ double ppb_ballistic_fraction(const ppb_scene *sc);
 
 /* The integral over the lit part of S1 (tube mode) of f(x_e) dx_e, x_e the beam's entry point,
  * by Gauss-Legendre panels between the entry points where f may jump or kink (the beam's path
- * switching its exit from S2 to S4, the step); *width is the lit width. The ballistic fraction
+ * switching its exit from S2 to S4, the step); *width is the lit width. A line searchlight is a
+ * delta of unit strength (ppb_scene_lit_measure): f at the line, *width = 1. The ballistic fraction
  * and rte2d's absorbed beam are its two integrands. */
 typedef double (*ppb_entry_fn)(const ppb_scene *sc, double x_entry, void *arg);
 double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *width);
@@ -81,7 +82,7 @@ double ppb_lit_integral(const ppb_scene *sc, ppb_entry_fn f, void *arg, double *
  * integrands whose breaks are not known in closed form: at n > 1 the refracted beam walked
  * through its reflections off all four faces (march.c's ballistic fraction, rte2d_grid.c's
  * absorbed beam) kinks or jumps wherever the walk's sequence of faces changes. Returns 0 (and
- * *width = 0) when no part is lit. */
+ * *width = 0) when no part is lit; a line: np f(x0), *width = 1. */
 double ppb_lit_midpoint_sum(const ppb_scene *sc, ppb_entry_fn f, void *arg, int np, double *width);
 
 /* The midpoints both Fresnel walks take: 2e4 put their integrals within ~1e-5. */

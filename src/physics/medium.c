@@ -22,11 +22,17 @@ ppb_medium ppb_medium_of(const ppb_scene *sc)
     return m;
 }
 
+ppb_lit ppb_lit_of(const ppb_scene *sc)
+{
+    ppb_lit L = {0.0, 0.0, ppb_scene_searchlight(sc), 0};
+    ppb_scene_lit_range(sc, &L.lo, &L.hi);
+    return L;
+}
+
 int ppb_lit_pieces(const ppb_scene *sc, ppb_lit_piece piece[2])
 {
-    double xa = -0.5 * sc->width, xb = 0.5 * sc->width;
-    if (sc->step == PPB_STEP_SHADOW)
-        xb = fmin(xb, sc->step_x);
+    double xa, xb; /* the lit part (reference: Light), cut below where the medium steps */
+    ppb_scene_lit_range(sc, &xa, &xb);
     double cut[3] = {xa, xb, xb};
     int n = 1, npiece = 0;
     if ((sc->step == PPB_STEP_DENSITY || sc->step == PPB_STEP_ALBEDO) && sc->step_x > xa &&
@@ -35,7 +41,8 @@ int ppb_lit_pieces(const ppb_scene *sc, ppb_lit_piece piece[2])
         n = 2;
     }
     for (int i = 0; i < n; i++) {
-        if (!(cut[i + 1] > cut[i]))
+        /* A line (xa == xb) is one degenerate piece; an empty strip part is left out. */
+        if (!(cut[i + 1] > cut[i]) && !(n == 1 && ppb_scene_lit_line(sc)))
             continue;
         double x = 0.5 * (cut[i] + cut[i + 1]); /* the piece's coefficients: at its entry points */
         ppb_lit_piece *p = &piece[npiece++];

@@ -34,6 +34,12 @@ uint64_t ppb_mc_scene_fingerprint(const ppb_scene *sc)
     /* n joins the text only where it acts, so n = 1 fingerprints are those of before. */
     if (sc->n > 1.0 && n > 0 && n < (int)sizeof buf)
         n += snprintf(buf + n, sizeof buf - (size_t)n, " n=%.17g", sc->n);
+    /* The searchlight's keys join it once any differs from its default (lit = face, x0 = 0,
+     * width = 1; reference: Light), so the whole face's fingerprints too are those of before. */
+    if ((sc->searchlight || sc->light_x0 != 0.0 || sc->light_width != 1.0) && n > 0 &&
+        n < (int)sizeof buf)
+        n += snprintf(buf + n, sizeof buf - (size_t)n, " light=%d,%.17g,%.17g", sc->searchlight,
+                      sc->light_x0, sc->light_width);
     return ppb_hash64(buf, n < (int)sizeof buf ? (size_t)n : sizeof buf - 1);
 }
 

@@ -67,6 +67,8 @@ static ppb_mc_params make_params(const ppb_config *cfg)
         wl[1] = -ppb_refract_cos(cos_l, sc->n);
         entry_weight = (float)(1.0 - ppb_fresnel(cos_l, sc->n));
     }
+    double lit_lo, lit_hi; /* S1's lit part (reference: Light); a line: lit_lo == lit_hi */
+    ppb_scene_lit_range(sc, &lit_lo, &lit_hi);
     ppb_mc_params p = {
         .seed = (ppb_u64)cfg->mc.seed,
         .ncells = (ppb_u64)lo.ncells,
@@ -76,7 +78,7 @@ static ppb_mc_params make_params(const ppb_config *cfg)
         .nphi = sc->nphi,
         .light_x = (float)wl[0],
         .light_y = (float)wl[1],
-        .enter_x0 = (float)(-0.5 * sc->width),
+        .enter_x0 = (float)lit_lo,
         .enter_width = (float)ppb_scene_lit_width(sc),
         .entry_weight = entry_weight,
     };

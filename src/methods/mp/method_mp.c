@@ -256,5 +256,9 @@ int ppb_mp_check(const ppb_config *cfg, ppb_err *err)
             cfg, "medium", "albedo_right", err,
             "mp, mp+ss: albedo = 1 gives sigma_tr = 0, where the multipole's image series of a "
             "finite slab converges only conditionally; use albedo < 1 or leave mp out");
+    if (ppb_scene_lit_line(sc)) /* its strip quadrature has no line kernel yet */
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "mp, mp+ss: a line searchlight (width = 0) is refused: the "
+                                   "model integrates its sources over a strip; use width > 0");
     return 0; /* n > 1: mp has the Fresnel boundary (file comment) */
 }

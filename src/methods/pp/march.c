@@ -10,7 +10,7 @@
 #include "physics/medium.h"
 
 _Static_assert(sizeof(ppb_march_params) ==
-                   sizeof(ppb_medium) + 17 * sizeof(double) + 24 * sizeof(int),
+                   sizeof(ppb_medium) + sizeof(ppb_lit) + 17 * sizeof(double) + 24 * sizeof(int),
                "ppb_march_params: the medium, doubles, an even number of ints, no padding");
 
 static cl_mem upload(ppb_ocl *ocl, const double *data, size_t n, const char *what, ppb_err *err)
@@ -37,6 +37,7 @@ static ppb_march_params march_params(const ppb_scene *sc, const ppb_maps *maps,
     ppb_scene_light_dir(sc, wl);
     ppb_march_params P = {
         .med = ppb_medium_of(sc),
+        .lit = ppb_lit_of(sc),
         .tan_theta_l = ppb_scene_tan_theta_l(sc),
         .cos_theta_l = ppb_scene_cos_theta_l(sc),
         .light_x = wl[0],

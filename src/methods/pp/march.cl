@@ -205,13 +205,13 @@ inline double ppb_march_ray(const ppb_march_params *P, __global const double *ma
      * sum); capping l keeps grazing rays finite. */
     lfar = fmax(0.0, fmin(lfar, P->d_cap / ppb_medium_sigma_min(&P->med)));
 
-    /* Piece ends: the step plane and the light lines through S1's shadow edges (ppb_tube.h). */
-    double brk[5];
+    /* Piece ends: the step plane and the light lines through S1's lit edges (ppb_tube.h). */
+    double brk[7];
     int nb = 0;
     brk[nb++] = 0.0;
     if (P->med.tube)
-        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
-    ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first; at most three breaks */
+        nb = ppb_lit_breaks(&P->med, &P->lit, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
+    ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first; at most five breaks */
     brk[nb++] = lfar;
 
     double r0 = wy; /* d tau / (sigma_t dl) in a slab: tau = sigma_t depth, depth grows as wy l */
@@ -358,13 +358,13 @@ inline double ppb_leg_fresnel(const ppb_march_params *P, __global const double *
                               double py, double vx, double vy, double vz, double lfar, double *d)
 {
     double mx = -vx, my = -vy;
-    /* 0, at most three breaks, lfar: brk[4] was one short, and a leg crossing the step plane
-     * and both light lines (oblique light, density or albedo step) wrote past it. */
-    double brk[5];
+    /* 0, at most five breaks (ppb_tube_breaks: the step plane, three light lines of the step and
+     * S1's edge, a searchlight's two edges), lfar. */
+    double brk[7];
     int nb = 0;
     brk[nb++] = 0.0;
     if (P->med.tube)
-        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
+        nb = ppb_lit_breaks(&P->med, &P->lit, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
     ppb_sort_doubles(brk + 1, nb - 1);
     brk[nb++] = lfar;
     double ct = P->cos_theta_l, st = P->light_x;

@@ -94,8 +94,15 @@ int ppb_method_pp(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
  * each with its direction variants. Every n in range has a meaning: nothing is refused. */
 int ppb_pp_check(const ppb_config *cfg, ppb_err *err)
 {
-    (void)cfg;
-    (void)err;
+    const ppb_scene *sc = &cfg->scene;
+    double lo, hi;
+    ppb_scene_lit_range(sc, &lo, &hi);
+    /* The paper's method reads a plane-parallel field along the light path: a searchlight strip
+     * narrower than S1 has none (reference: Methods, `pp`). */
+    if (ppb_scene_searchlight(sc) && (lo > -0.5 * sc->width || hi < 0.5 * sc->width))
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "pp: a searchlight (a strip or line narrower than S1) has no "
+                                   "plane-parallel field; leave pp out or light the whole face");
     return 0;
 }
 

@@ -50,6 +50,13 @@ int ppb_work_images(const ppb_config *cfg, ppb_work_img *w)
  * where F_b is near 1 and a row of images adds little depth). */
 int ppb_ss_check(const ppb_config *cfg, ppb_err *err)
 {
+    /* A line's once-scattered light is a line integral along the viewing ray's crossing of one
+     * light plane, not the volume source the march integrates (reference: Methods, `ss`). */
+    if (ppb_scene_lit_line(&cfg->scene))
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "ss: a line searchlight (width = 0) is refused: its single "
+                                   "scattering is a line integral the march does not take; use "
+                                   "a strip (width > 0)");
     ppb_work_img w;
     if (!ppb_work_images(cfg, &w) || w.terms <= PPB_WORK_IMAGE_TERMS_MAX)
         return 0;

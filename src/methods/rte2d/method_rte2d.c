@@ -19,7 +19,7 @@
 #include "methods/rte2d/rte2d_grid.h"
 
 _Static_assert(sizeof(ppb_rte_params) ==
-                   sizeof(ppb_medium) + 15 * sizeof(double) + 22 * sizeof(int),
+                   sizeof(ppb_medium) + sizeof(ppb_lit) + 15 * sizeof(double) + 22 * sizeof(int),
                "ppb_rte_params: the medium, doubles, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
@@ -741,6 +741,16 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, dou
     if (stats)
         *stats = st;
     return rc;
+}
+
+int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
+{
+    if (ppb_scene_lit_line(&cfg->scene))
+        return ppb_config_key_fail(cfg, "light", "width", err,
+                                   "rte2d: a line searchlight (width = 0) is refused: the beam's "
+                                   "first scattering is integrated over cells, where a line is a "
+                                   "delta; use a strip (width > 0)");
+    return 0;
 }
 
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)

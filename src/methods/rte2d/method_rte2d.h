@@ -54,6 +54,10 @@ typedef struct ppb_rte2d_study {
 
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
+/* Refuses what the solver cannot take before any work: a line searchlight (its first-scatter
+ * source is a delta on a light plane, which the cells' beam integrals do not hold). */
+int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err);
+
 /* The method, reporting what it took (tests, `make perf`; stats may be NULL): the refinement
  * study runs after a converged solve where ctx->extras is set. */
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);

@@ -96,7 +96,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
     if (lfar <= 0.0)
         return wall ? rte_wall(P, rad, bnd, px, py, mx, my, wx, wy, 0.0, 0.0) : 0.0;
 
-    double brk[7];
+    double brk[9]; /* 0, two layer lines, at most five breaks (ppb_lit_breaks), lfar */
     int nb = 0;
     brk[nb++] = 0.0;
     /* The boundary layers' lines: inside them the march steps shrink with the rows. */
@@ -106,9 +106,9 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
             if (ly[k] > 1e-12 && ly[k] < lfar - 1e-12)
                 brk[nb++] = ly[k];
     }
-    /* The step plane and the light lines through S1's shadow edges (ppb_tube.h). */
+    /* The step plane and the light lines through S1's lit edges (ppb_light.h). */
     if (P->med.tube)
-        nb = ppb_tube_breaks(&P->med, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
+        nb = ppb_lit_breaks(&P->med, &P->lit, P->tan_theta_l, px, py, mx, my, lfar, brk, nb);
     ppb_sort_doubles(brk + 1, nb - 1); /* brk[0] = 0 stays first */
     brk[nb++] = lfar;
 

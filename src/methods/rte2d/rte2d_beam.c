@@ -264,8 +264,8 @@ static beam_term light_term(const ppb_rte_params *P, term_kind kind, int cls, do
     beam_term t = {.kind = kind, .cls = cls, .w = w, .xe = {0.0, 1.0, P->tan_theta_l}};
     t.has_lit = P->med.tube;
     t.cut = P->med.tube && P->med.step == PPB_STEP_DENSITY;
-    t.lo = ppb_face_line(PPB_S3, P->med.width, P->med.height); /* S1's lit part (ppb_tube.h) */
-    t.hi = ppb_tube_lit_hi(&P->med);
+    t.lo = ppb_lit_lo(&P->med, &P->lit); /* S1's lit part (ppb_light.h) */
+    t.hi = ppb_lit_hi(&P->med, &P->lit);
     return t;
 }
 
@@ -279,8 +279,8 @@ static beam_term image_term(const ppb_rte_params *P, int k, int j, double w)
     t.xe.c = (j & 1) ? -tn : tn;
     t.has_lit = 1;
     t.cut = P->med.step == PPB_STEP_DENSITY;
-    t.lo = ppb_face_line(PPB_S3, P->med.width, P->med.height); /* S1's lit part (ppb_tube.h) */
-    t.hi = ppb_tube_lit_hi(&P->med);
+    t.lo = ppb_lit_lo(&P->med, &P->lit); /* S1's lit part (ppb_light.h) */
+    t.hi = ppb_lit_hi(&P->med, &P->lit);
     return t;
 }
 
@@ -304,7 +304,7 @@ static void sum_images(const ppb_rte_params *P, double sigma_t, const beam_poly 
                        double out[PPB_BEAM_CLASSES])
 {
     double W = P->med.width, H = P->med.height, tn = P->tan_theta_l;
-    if (!(ppb_tube_lit_hi(&P->med) > -0.5 * W))
+    if (!(ppb_lit_hi(&P->med, &P->lit) > ppb_lit_lo(&P->med, &P->lit)))
         return;
     int jmax = image_jmax(P);
     double fj = 1.0;

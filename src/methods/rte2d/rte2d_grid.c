@@ -425,6 +425,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     int tube = sc->geometry == PPB_GEOM_TUBE;
     ppb_rte_params *P = &G->P;
     P->med = ppb_medium_of(sc);
+    P->lit = ppb_lit_of(sc);
     P->sin_theta_l = ppb_scene_sin_theta_l(sc);
     P->cos_theta_l = ppb_scene_cos_theta_l(sc);
     P->tan_theta_l = ppb_scene_tan_theta_l(sc);

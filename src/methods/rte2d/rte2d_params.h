@@ -26,7 +26,7 @@
 #ifndef PPB_RTE2D_PARAMS_H
 #define PPB_RTE2D_PARAMS_H
 
-#include "ppb_tube.h"
+#include "ppb_light.h"
 
 #ifdef __OPENCL_VERSION__
 #define PPB_RTE_GMEM __global
@@ -98,6 +98,7 @@ PPB_FN int ppb_moc_nedge(int nfx, int ny, int face)
  * (host asserts). */
 typedef struct ppb_rte_params {
     ppb_medium med;                               /* the cross-section and the medium */
+    ppb_lit lit;                                  /* S1's lit part (ppb_light.h) */
     double sin_theta_l, cos_theta_l, tan_theta_l; /* light incidence (at n > 1 inside) */
     double hxl, hxr, hy;                          /* node spacings left/right of the step, in y */
     double hyf, dlay;                             /* y: boundary-layer spacing and depth */
@@ -228,9 +229,10 @@ PPB_RTE_HOT double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM do
 }
 
 /* The exact direct beam at (x, y), y <= 0 (reference: Light): the ray toward the light meets
- * S1's plane at x' = x + y tan(theta_L); the point is lit when x' lies on S1 (>= -W/2) and, with
- * a shadow step, left of step_x. D = optical depth of that path through the piecewise-constant
- * medium, continued where unlit (the caller multiplies by lit). Slab: sigma_t |y| / cos. */
+ * S1's plane at x' = x + y tan(theta_L); the point is lit when x' lies on S1's lit part
+ * (ppb_lit_at: >= -W/2, left of a shadow step, or in a searchlight's strip). D = optical depth
+ * of that path through the piecewise-constant medium, continued where unlit (the caller multiplies
+ * by lit). Slab: sigma_t |y| / cos. */
 PPB_FN void ppb_rte_light(const ppb_rte_params *P, double x, double y, double *D, int *lit)
 {
     double t = -y < 0.0 ? 0.0 : -y, len = t / P->cos_theta_l;
@@ -240,7 +242,7 @@ PPB_FN void ppb_rte_light(const ppb_rte_params *P, double x, double y, double *D
         return;
     }
     double xp = x - t * P->tan_theta_l;
-    *lit = ppb_tube_lit_at(&P->med, xp, 1e-12 * P->med.width);
+    *lit = ppb_lit_at(&P->med, &P->lit, xp, 1e-12 * P->med.width);
     if (P->med.step != PPB_STEP_DENSITY) {
         *D = P->med.sigma_t * len;
         return;
