@@ -7,6 +7,7 @@
  * method on every study config (finite, non-negative, totals within the profile's bounds), at
  * the robustness grid's corners and in slab mode; bdipole+ss = bdipole + ss cell by cell. */
 #include "testutil.h"
+#include "study_cases.h"
 
 #include <math.h>
 
@@ -254,29 +255,6 @@ static void test_strip_quadrature(void **state)
     }
 }
 
-/* The study's config, loaded from configs/ (as the runner does). */
-static void load_config(const char *name, ppb_config *cfg)
-{
-    char path[512];
-    ppb_err err;
-    snprintf(path, sizeof path, "%s/configs/%s.ini", PPB_SOURCE_DIR, name);
-    if (ppb_config_load(cfg, path, &err))
-        fail_msg("%s", err.msg);
-}
-
-static int run_id(ppb_run_ctx *ctx, const char *id, ppb_result *out)
-{
-    ppb_err err;
-    ppb_layout lo = ppb_scene_layout(&ctx->cfg->scene);
-    assert_int_equal(ppb_result_init(out, id, &lo, &err), 0);
-    const ppb_method *m = ppb_method_find(ctx->cfg, id);
-    assert_non_null(m);
-    ctx->self = m;
-    if (m->run(ctx, out, &err))
-        fail_msg("%s: %s", id, err.msg);
-    return 0;
-}
-
 static void test_study_configs(void **state)
 {
     (void)state;
@@ -286,34 +264,15 @@ static void test_study_configs(void **state)
      * most R_d), S2 in the plane at distance H (at most P(H)), each side in a half plane at some
      * distance (at most R_d / 2); times the entering 1 - F(theta_L), with the larger of the
      * tube's two media. */
-    static const char *names[] = {"uniform_g0_normal",
-                                  "uniform_g0_oblique",
-                                  "uniform_gm05_normal",
-                                  "uniform_gp05_normal",
-                                  "density_step",
-                                  "albedo_step",
-                                  "shadow_step",
-                                  "uniform_g0_normal_n14",
-                                  "uniform_g0_oblique_n14",
-                                  "uniform_gm05_normal_n14",
-                                  "uniform_gp05_normal_n14",
-                                  "realistic_g09_normal_n14",
-                                  "realistic_g08_step_oblique_n14"};
-    FILE *list = fopen(PPB_SOURCE_DIR "/configs/study.list", "r");
-    assert_non_null(list);
-    char line[128];
-    int nlisted = 0;
-    while (fgets(line, sizeof line, list))
-        nlisted += line[0] != '\n' && line[0] != '#';
-    fclose(list);
-    assert_int_equal(nlisted, (int)(sizeof names / sizeof names[0])); /* the list is covered */
-    for (size_t c = 0; c < sizeof names / sizeof names[0]; c++) {
+    char names[STUDY_MAX_CASES][64];
+    int ncase = study_cases(names);
+    for (int c = 0; c < ncase; c++) {
         ppb_config cfg;
-        load_config(names[c], &cfg);
+        study_load_config(names[c], &cfg);
         const ppb_scene *sc = &cfg.scene;
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result out;
-        run_id(&ctx, "bdipole", &out);
+        study_run_id(&ctx, "bdipole", &out);
         for (size_t i = 0; i < out.layout.ncells; i++) {
             assert_true(isfinite(out.radiance[i]));
             assert_true(out.radiance[i] >= 0);
@@ -372,7 +331,7 @@ static void test_extremes(void **state)
                             cfg.samples_seg = 1;
                             ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
                             ppb_result out;
-                            run_id(&ctx, "bdipole", &out);
+                            study_run_id(&ctx, "bdipole", &out);
                             for (size_t i = 0; i < out.layout.ncells; i++)
                                 if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
                                     fail_msg("albedo %g g %g H %g theta %g n %g: cell %zu = %g",
@@ -397,7 +356,7 @@ static void test_quadrature_converges_on_tube(void **state)
     const char *names[] = {"uniform_g0_normal", "density_step", "uniform_g0_normal_n14"};
     for (int c = 0; c < 3; c++) {
         ppb_config cfg;
-        load_config(names[c], &cfg);
+        study_load_config(names[c], &cfg);
         cfg.scene.segments_top = 32;
         cfg.scene.segments_side = 12;
         if (c == 2)
@@ -405,11 +364,11 @@ static void test_quadrature_converges_on_tube(void **state)
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result ref, r;
         cfg.bdipole.samples = 64;
-        run_id(&ctx, "bdipole", &ref);
+        study_run_id(&ctx, "bdipole", &ref);
         const int nodes[] = {8, 16};
         for (int k = 0; k < 2; k++) {
             cfg.bdipole.samples = nodes[k];
-            run_id(&ctx, "bdipole", &r);
+            study_run_id(&ctx, "bdipole", &r);
             double worst = 0;
             for (size_t i = 0; i < r.layout.ncells; i++)
                 worst = fmax(worst, fabs(r.radiance[i] - ref.radiance[i]) / ref.radiance[i]);
@@ -438,7 +397,7 @@ static void test_slab_mode(void **state)
         cfg.scene.n = n[i];
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result out;
-        run_id(&ctx, "bdipole", &out);
+        study_run_id(&ctx, "bdipole", &out);
         double mu = cos(30 * PPB_PI / 180);
         double entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
         ppb_bdipole b = ppb_bdipole_make(cfg.scene.sigma_t, 0.95, 0.0, n[i]);
@@ -459,16 +418,16 @@ static void test_sum_with_ss(void **state)
      * n = 1.4 (ss through the OpenCL marcher), and its totals are bdipole's with ss's R, T and
      * sides added. */
     ppb_config cfg;
-    load_config("uniform_g0_oblique_n14", &cfg);
+    study_load_config("uniform_g0_oblique_n14", &cfg);
     cfg.scene.segments_top = 16;
     cfg.scene.segments_side = 6;
     cfg.samples_dir = 2;
     cfg.samples_seg = 2;
     ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
     ppb_result sum, b, s;
-    run_id(&ctx, "bdipole+ss", &sum);
-    run_id(&ctx, "bdipole", &b);
-    run_id(&ctx, "ss", &s);
+    study_run_id(&ctx, "bdipole+ss", &sum);
+    study_run_id(&ctx, "bdipole", &b);
+    study_run_id(&ctx, "ss", &s);
     double ss_total = 0;
     for (size_t i = 0; i < sum.layout.ncells; i++) {
         assert_close(sum.radiance[i], b.radiance[i] + s.radiance[i], 0.0);

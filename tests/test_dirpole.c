@@ -8,6 +8,7 @@
  * config and at the robustness grid's extremes (finite, non-negative, within the plane's
  * bounds) and dirpole+ss = dirpole + ss cell by cell. */
 #include "testutil.h"
+#include "study_cases.h"
 
 #include <math.h>
 
@@ -249,28 +250,6 @@ static void test_strip_converges(void **state)
     assert_lt(corner[1], 1e-5);
 }
 
-/* The study's config, loaded from configs/ (as the runner does). */
-static void load_config(const char *name, ppb_config *cfg)
-{
-    char path[512];
-    ppb_err err;
-    snprintf(path, sizeof path, "%s/configs/%s.ini", PPB_SOURCE_DIR, name);
-    if (ppb_config_load(cfg, path, &err))
-        fail_msg("%s", err.msg);
-}
-
-static void run_id(ppb_run_ctx *ctx, const char *id, ppb_result *out)
-{
-    ppb_err err;
-    ppb_layout lo = ppb_scene_layout(&ctx->cfg->scene);
-    assert_int_equal(ppb_result_init(out, id, &lo, &err), 0);
-    const ppb_method *m = ppb_method_find(ctx->cfg, id);
-    assert_non_null(m);
-    ctx->self = m;
-    if (m->run(ctx, out, &err))
-        fail_msg("%s: %s", id, err.msg);
-}
-
 /* The plane integrals of the media of scene sc (both sides of a step): the largest R at the
  * face and T at depth H, per unit power entering. */
 static void plane_bounds(const ppb_scene *sc, double *R, double *T)
@@ -297,34 +276,15 @@ static void test_study_configs(void **state)
      * gives each exit point at most what the whole plane of entry points gives, R_plane at the
      * face and T_plane at depth H; over the face that is at most (1 - F) R_plane W / W_lit of
      * the entering power (W_lit the lit width), likewise T. */
-    static const char *names[] = {"uniform_g0_normal",
-                                  "uniform_g0_oblique",
-                                  "uniform_gm05_normal",
-                                  "uniform_gp05_normal",
-                                  "density_step",
-                                  "albedo_step",
-                                  "shadow_step",
-                                  "uniform_g0_normal_n14",
-                                  "uniform_g0_oblique_n14",
-                                  "uniform_gm05_normal_n14",
-                                  "uniform_gp05_normal_n14",
-                                  "realistic_g09_normal_n14",
-                                  "realistic_g08_step_oblique_n14"};
-    FILE *list = fopen(PPB_SOURCE_DIR "/configs/study.list", "r");
-    assert_non_null(list);
-    char line[128];
-    int nlisted = 0;
-    while (fgets(line, sizeof line, list))
-        nlisted += line[0] != '\n' && line[0] != '#';
-    fclose(list);
-    assert_int_equal(nlisted, (int)(sizeof names / sizeof names[0])); /* the list is covered */
-    for (size_t c = 0; c < sizeof names / sizeof names[0]; c++) {
+    char names[STUDY_MAX_CASES][64];
+    int ncase = study_cases(names);
+    for (int c = 0; c < ncase; c++) {
         ppb_config cfg;
-        load_config(names[c], &cfg);
+        study_load_config(names[c], &cfg);
         const ppb_scene *sc = &cfg.scene;
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result out;
-        run_id(&ctx, "dirpole", &out);
+        study_run_id(&ctx, "dirpole", &out);
         for (size_t i = 0; i < out.layout.ncells; i++) {
             assert_true(isfinite(out.radiance[i]));
             assert_true(out.radiance[i] >= 0);
@@ -374,7 +334,7 @@ static void test_extremes(void **state)
                             cfg.dirpole.samples = 4;
                             ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
                             ppb_result out;
-                            run_id(&ctx, "dirpole", &out);
+                            study_run_id(&ctx, "dirpole", &out);
                             double sum = 0;
                             for (size_t i = 0; i < out.layout.ncells; i++) {
                                 if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
@@ -406,7 +366,7 @@ static void test_slab_mode(void **state)
         cfg.scene.n = n[i];
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result out;
-        run_id(&ctx, "dirpole", &out);
+        study_run_id(&ctx, "dirpole", &out);
         double mu = cos(30 * PPB_PI / 180), w[3];
         double entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
         ppb_dirpole p;
@@ -429,16 +389,16 @@ static void test_sum_with_ss(void **state)
      * n = 1.4 (ss through the OpenCL marcher), and its totals are dirpole's with ss's R, T and
      * sides added. */
     ppb_config cfg;
-    load_config("uniform_g0_oblique_n14", &cfg);
+    study_load_config("uniform_g0_oblique_n14", &cfg);
     cfg.scene.segments_top = 16;
     cfg.scene.segments_side = 6;
     cfg.samples_dir = 2;
     cfg.samples_seg = 2;
     ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
     ppb_result sum, d, s;
-    run_id(&ctx, "dirpole+ss", &sum);
-    run_id(&ctx, "dirpole", &d);
-    run_id(&ctx, "ss", &s);
+    study_run_id(&ctx, "dirpole+ss", &sum);
+    study_run_id(&ctx, "dirpole", &d);
+    study_run_id(&ctx, "ss", &s);
     double ss_total = 0;
     for (size_t i = 0; i < sum.layout.ncells; i++) {
         assert_close(sum.radiance[i], d.radiance[i] + s.radiance[i], 0.0);

@@ -7,6 +7,7 @@
  * strip quadrature against an independent polar-coordinate integral, and the method on every
  * study config, in slab mode and at the extremes. */
 #include "testutil.h"
+#include "study_cases.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -432,28 +433,6 @@ static void test_strip_quadrature(void **state)
     assert_lt(worst12, 1);
 }
 
-/* The study's config, loaded from configs/ (as the runner does). */
-static void load_config(const char *name, ppb_config *cfg)
-{
-    char path[512];
-    ppb_err err;
-    snprintf(path, sizeof path, "%s/configs/%s.ini", PPB_SOURCE_DIR, name);
-    if (ppb_config_load(cfg, path, &err))
-        fail_msg("%s", err.msg);
-}
-
-static void run_id(ppb_run_ctx *ctx, const char *id, ppb_result *out)
-{
-    ppb_err err;
-    ppb_layout lo = ppb_scene_layout(&ctx->cfg->scene);
-    assert_int_equal(ppb_result_init(out, id, &lo, &err), 0);
-    const ppb_method *m = ppb_method_find(ctx->cfg, id);
-    assert_non_null(m);
-    ctx->self = m;
-    if (m->run(ctx, out, &err))
-        fail_msg("%s: %s", id, err.msg);
-}
-
 static void test_study_configs(void **state)
 {
     (void)state;
@@ -463,23 +442,18 @@ static void test_study_configs(void **state)
      * S2 in the plane at distance H (at most the plane integral beyond H), the two sides in
      * half planes (at most rhoEff together); times the entering 1 - F(theta_L), with the
      * largest over the tube's media. The table is built once per (g, n) and kept. */
-    FILE *list = fopen(PPB_SOURCE_DIR "/configs/study.list", "r");
-    assert_non_null(list);
-    char name[128];
-    int configs = 0;
-    while (fgets(name, sizeof name, list)) {
-        name[strcspn(name, "\r\n")] = 0;
-        if (!name[0] || name[0] == '#')
-            continue;
-        configs++;
+    char names[STUDY_MAX_CASES][64];
+    int ncase = study_cases(names);
+    for (int c = 0; c < ncase; c++) {
+        const char *name = names[c];
         ppb_config cfg;
-        load_config(name, &cfg);
+        study_load_config(name, &cfg);
         cfg.scene.segments_top = 32;
         cfg.scene.segments_side = 12;
         const ppb_scene *sc = &cfg.scene;
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result out;
-        run_id(&ctx, "pbd", &out);
+        study_run_id(&ctx, "pbd", &out);
         assert_non_null(ppb_ctx_state(&ctx, "pbd"));
         for (size_t i = 0; i < out.layout.ncells; i++) {
             assert_true(isfinite(out.radiance[i]));
@@ -506,7 +480,6 @@ static void test_study_configs(void **state)
         ppb_result_free(&out);
         ppb_ctx_close(&ctx);
     }
-    assert_int_equal(configs, 13); /* every case of configs/study.list */
 }
 
 static void test_slab_mode(void **state)
@@ -524,8 +497,8 @@ static void test_slab_mode(void **state)
         cfg.scene.n = n[i];
         ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
         ppb_result out, again;
-        run_id(&ctx, "pbd", &out);
-        run_id(&ctx, "pbd", &again);
+        study_run_id(&ctx, "pbd", &out);
+        study_run_id(&ctx, "pbd", &again);
         double mu = cos(30 * PPB_PI / 180), entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
         ppb_pbd_profile p;
         ppb_pbd_profile_init(&p, table(0.0, n[i]), cfg.scene.sigma_t, 0.95);
@@ -565,7 +538,7 @@ static void test_extremes(void **state)
                     cfg.samples_seg = 1;
                     ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
                     ppb_result out;
-                    run_id(&ctx, "pbd", &out);
+                    study_run_id(&ctx, "pbd", &out);
                     for (size_t i = 0; i < out.layout.ncells; i++)
                         if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
                             fail_msg("albedo %g g %g H %g n %g: cell %zu = %g", albedo[ia], g[ig],

@@ -662,7 +662,16 @@ static double method_median(const char *const *cases, const case_data *cd, int n
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/* How many cases name `method` the lowest rms_excess at `cell` among the columns. */
+/* A method checked as an exact answer (rte2d: ppb_method.reference): it is ranked, but the
+ * cases a model wins are counted among the models alone. */
+static int is_reference(const char *method)
+{
+    const ppb_method *m = ppb_method_find(NULL, method);
+    return m && m->reference;
+}
+
+/* How many cases name `method` the lowest rms_excess at `cell` among the non-reference
+ * columns. */
 static int method_wins(const case_data *cd, int ncases, char cols[][32], int ncols,
                        const char *method, const char *cell)
 {
@@ -671,6 +680,8 @@ static int method_wins(const case_data *cd, int ncases, char cols[][32], int nco
         const char *best = NULL;
         double lo = INFINITY;
         for (int j = 0; j < ncols; j++) {
+            if (is_reference(cols[j]))
+                continue;
             const summary_row *r = find_row(&cd[c], cols[j], cell);
             if (r && r->excess < lo) {
                 lo = r->excess;
@@ -694,7 +705,8 @@ static void write_ranking(FILE *f, const char *const *cases, const case_data *cd
     fprintf(f, "Every method per surface: the median over the %d cases of the excess RMS "
                "(rms_excess, percent) at the Table 2 cells and over each whole surface, its "
                "rank among the methods at that cell (1 = closest to the Monte Carlo), and in "
-               "brackets at how many cases it is the best there.\n\n| method |",
+               "brackets at how many cases it is the best there among the models (the exact "
+               "solvers set aside).\n\n| method |",
             ncases);
     for (int k = 0; k < NRANK_CELLS; k++)
         fprintf(f, " %s |", rank_cells[k]);
@@ -712,8 +724,11 @@ static void write_ranking(FILE *f, const char *const *cases, const case_data *cd
             int rank = 1;
             for (int i = 0; i < ncols; i++)
                 rank += !isnan(med[i][k]) && med[i][k] < med[j][k];
-            fprintf(f, " %.1f (#%d) [%d] |", 100 * med[j][k], rank,
-                    method_wins(cd, ncases, cols, ncols, cols[j], rank_cells[k]));
+            if (is_reference(cols[j]))
+                fprintf(f, " %.1f (#%d) |", 100 * med[j][k], rank);
+            else
+                fprintf(f, " %.1f (#%d) [%d] |", 100 * med[j][k], rank,
+                        method_wins(cd, ncases, cols, ncols, cols[j], rank_cells[k]));
         }
         fputc('\n', f);
     }
