@@ -702,11 +702,12 @@ static void write_ranking(FILE *f, const char *const *cases, const case_data *cd
         for (int k = 0; k < NRANK_CELLS; k++)
             med[j][k] = method_median(cases, cd, ncases, cols[j], rank_cells[k]);
     fprintf(f, "## Ranking\n\n");
-    fprintf(f, "Every method per surface: the median over the %d cases of the excess RMS "
-               "(rms_excess, percent) at the Table 2 cells and over each whole surface, its "
-               "rank among the methods at that cell (1 = closest to the Monte Carlo), and in "
-               "brackets at how many cases it is the best there among the models (the exact "
-               "solvers set aside).\n\n| method |",
+    fprintf(f,
+            "Every method per surface: the median over the %d cases of the excess RMS "
+            "(rms_excess, percent) at the Table 2 cells and over each whole surface, its "
+            "rank among the methods at that cell (1 = closest to the Monte Carlo), and in "
+            "brackets at how many cases it is the best there among the models (the exact "
+            "solvers set aside).\n\n| method |",
             ncases);
     for (int k = 0; k < NRANK_CELLS; k++)
         fprintf(f, " %s |", rank_cells[k]);
