@@ -228,9 +228,8 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                 wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py, v[0], v[1]);
             continue;
         }
-        double cb[4] = {
-            P.ss_w * ppb_hg_phase(P.ss_g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l), 0.0, 0.0,
-            0.0};
+        double cb[4] = {P.ss_w * ppb_hg_phase(P.ss_g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l),
+                        0.0, 0.0, 0.0};
         sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, v[0], v[1]);
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
