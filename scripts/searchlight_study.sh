@@ -12,8 +12,8 @@
 # provenance.txt), one direction bin (bins.theta = bins.phi = 1: a segment's radiance is its
 # exitance / pi exactly). Methods: mc, burley, bdipole, dirpole, pbd on the line; mp refuses a
 # line, so it runs on a strip of width MP_W = 0.01 mfp and its radiance is divided by MP_W (the
-# line is that limit, reference: Light; the centred strip differs from the line by
-# O((MP_W / d)^2) at distance d, below 1e-3 from the nearest segment centre out).
+# line is that limit, reference: Light; mp's profile is smooth on the scale of its sources'
+# depth, 1 mfp, so the centred strip differs from the line by about MP_W^2 / 24 relative).
 # S1 is folded about the line (the two sides averaged; the Monte Carlo's standard errors
 # combined as independent). Writes OUT_DIR (default results/searchlight):
 #   profile_a<ALBEDO>.csv  distance (segment centre, mfp), seg_lo, seg_hi, then the exitance per
