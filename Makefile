@@ -73,6 +73,10 @@ $(LIB): $(OBJ)
 $(BIN): $(BUILD)/obj/drivers/main.o $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $^ $(PKG_LIBS)
 
+# Burley's s refit to the searchlight study's Monte Carlo profiles (scripts/searchlight_study.sh).
+$(BUILD)/burley_fit: scripts/burley_fit.c $(LIB) | $(BUILD)/deps.mk
+	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
 $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS) \

@@ -1,7 +1,8 @@
 /* test_searchlight.c: the searchlight light (reference: Light; `[light] lit = strip`, x0, width),
  * each check with its source:
  * - the keys and their refusals (a strip off S1, with a shadow step, in a slab; pp's strip, a
- *   line in ss, mp, burley, bdipole, pbd, dirpole and rte2d): the reference's rules;
+ *   line in ss, mp, the `+ss` sums and rte2d; a line taken by the profile models): the
+ *   reference's rules;
  * - S1's lit part, the power entering, the diffusion models' pieces, the kernels' lit test and
  *   light-line breaks: the definitions of reference: Light, by hand;
  * - the ballistic fraction of a strip and of a line near S4 at oblique light: Beer-Lambert along
@@ -100,18 +101,21 @@ static void test_keys(void **state)
     expect_refused("strip_shadow", SETS("medium.step=shadow"), "do not combine");
     expect_refused("strip_slab", SETS("experiment.geometry=slab"), "needs the tube");
     expect_refused("strip_pp", SETS("experiment.methods=mc, pp"), "pp: a searchlight");
-    const char *line_refusers[] = {"ss",    "mp",      "burley", "rte2d",
-                                   "mp+ss", "bdipole", "pbd",    "dirpole"};
-    for (int i = 0; i < 8; i++) {
+    const char *line_refusers[] = {"ss", "mp", "rte2d", "mp+ss", "burley+ss"};
+    for (int i = 0; i < 5; i++) {
         char methods[64], name[32];
         snprintf(methods, sizeof methods, "experiment.methods=mc, %s", line_refusers[i]);
         snprintf(name, sizeof name, "line_%d", i);
         expect_refused(name, SETS(methods, "light.width=0"),
                        "a line searchlight (width = 0) is refused");
     }
-    /* A line takes mc; a strip takes mc, ss, mp, burley, rte2d; a strip that is the whole
-     * face takes pp too. */
+    /* A line takes mc and the profile models with a line hook (physics/bssrdf_tube.h); a strip
+     * takes mc, ss, mp, burley, rte2d; a strip that is the whole face takes pp too. */
     assert_string_equal(load_check("line_mc", SETS("light.width=0")), "");
+    assert_string_equal(
+        load_check("line_models",
+                   SETS("experiment.methods=mc, burley, bdipole, pbd, dirpole", "light.width=0")),
+        "");
     assert_string_equal(
         load_check("strip_all",
                    SETS("experiment.methods=mc, ss, mp, mp+ss, burley, burley+ss, rte2d")),

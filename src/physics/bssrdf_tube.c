@@ -14,8 +14,35 @@ typedef struct bssrdf_exit {
     double lobe[PPB_BSSRDF_MAX_THETA]; /* per theta bin, mean 1 (n > 1) */
 } bssrdf_exit;
 
+/* The flux at the exit point (x, y) per unit entering irradiance (per unit line strength for
+ * a line), summed over the lit pieces. */
+static double point_flux(const ppb_bssrdf *m, const ppb_lit_piece *lit, int nlit, double x,
+                         double y, int surf)
+{
+    double sum = 0.0;
+    for (int i = 0; i < nlit; i++)
+        sum += lit[i].xa == lit[i].xb ? m->line(m->model, i, lit[i].xa, x, y, surf)
+                                      : m->strip(m->model, i, lit[i].xa, lit[i].xb, x, y, surf);
+    return sum;
+}
+
+/* The midpoint rule on `points` points over the stretch of length len centred at mid, along x
+ * (S1, S2: at y = other) or along y (the sides: at x = other): the sum of the fluxes. */
+static double midpoint_sum(const ppb_bssrdf *m, const ppb_lit_piece *lit, int nlit, int surf,
+                           int along_x, double mid, double len, double other, int points)
+{
+    double sum = 0.0;
+    for (int j = 0; j < points; j++) {
+        double t = mid + ((j + 0.5) / points - 0.5) * len;
+        sum += along_x ? point_flux(m, lit, nlit, t, other, surf)
+                       : point_flux(m, lit, nlit, other, t, surf);
+    }
+    return sum;
+}
+
 /* Flux per unit entering irradiance averaged over a segment: the strips' flux at samples_seg
- * points spread evenly over it (the midpoint rule). */
+ * points spread evenly over it (the midpoint rule); a segment of S1 with a line inside it is
+ * split at the line, each part by its own midpoint rule, weighted by its length. */
 static double segment_flux(const ppb_config *cfg, const ppb_bssrdf *m, const ppb_lit_piece *lit,
                            int nlit, int surf, int seg, double seg_len)
 {
@@ -23,14 +50,17 @@ static double segment_flux(const ppb_config *cfg, const ppb_bssrdf *m, const ppb
     ppb_scene_sample_point(&cfg->scene, surf, seg, &x, &y);
     int along_x = surf == PPB_S1 || surf == PPB_S2, points = cfg->samples_seg;
     points = points < 1 ? 1 : points;
-    double sum = 0.0;
-    for (int j = 0; j < points; j++) {
-        double f = (j + 0.5) / points - 0.5;
-        double xp = along_x ? x + f * seg_len : x, yp = along_x ? y : y + f * seg_len;
-        for (int i = 0; i < nlit; i++)
-            sum += m->strip(m->model, i, lit[i].xa, lit[i].xb, xp, yp, surf);
+    double a = x - 0.5 * seg_len, b = x + 0.5 * seg_len;
+    for (int i = 0; i < nlit && surf == PPB_S1; i++) {
+        double xl = lit[i].xa, la = xl - a, lb = b - xl;
+        if (lit[i].xb == xl && la > 0.0 && lb > 0.0)
+            return (midpoint_sum(m, lit, nlit, surf, 1, a + 0.5 * la, la, y, points) * la +
+                    midpoint_sum(m, lit, nlit, surf, 1, xl + 0.5 * lb, lb, y, points) * lb) /
+                   (points * seg_len);
     }
-    return sum / points;
+    return midpoint_sum(m, lit, nlit, surf, along_x, along_x ? x : y, seg_len, along_x ? y : x,
+                        points) /
+           points;
 }
 
 static void fill_bins(ppb_result *out, const ppb_scene *sc, const bssrdf_exit *ex, int surf,
@@ -82,7 +112,7 @@ int ppb_bssrdf_fill(const ppb_config *cfg, const ppb_bssrdf *m, int quiet, ppb_r
                     ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
-    if (ppb_bssrdf_check(cfg, out->method, err))
+    if (ppb_bssrdf_check(cfg, out->method, m->line != NULL, err))
         return -1;
     out->totals.absorbed_tracked = 0; /* absorbed = 1 - the rest, by the writer */
     bssrdf_exit ex = {.fresnel = sc->n > 1.0, .specular = 0.0, .entry = 1.0};
@@ -106,17 +136,17 @@ int ppb_bssrdf_fill(const ppb_config *cfg, const ppb_bssrdf *m, int quiet, ppb_r
     return 0;
 }
 
-int ppb_bssrdf_check(const ppb_config *cfg, const char *id, ppb_err *err)
+int ppb_bssrdf_check(const ppb_config *cfg, const char *id, int has_line, ppb_err *err)
 {
     if (cfg->scene.ntheta > PPB_BSSRDF_MAX_THETA)
         return ppb_config_key_fail(cfg, "bins", "theta", err, "%s: bins.theta = %d above %d", id,
                                    cfg->scene.ntheta, PPB_BSSRDF_MAX_THETA);
     /* The strip callback integrates a profile over [xa, xb]: a line searchlight (xa == xb)
-     * needs the line kernel at the point instead (reference: Light), not given yet. */
-    if (ppb_scene_lit_line(&cfg->scene))
+     * needs the model's line kernel at the point instead (reference: Light). */
+    if (ppb_scene_lit_line(&cfg->scene) && !has_line)
         return ppb_config_key_fail(cfg, "light", "width", err,
-                                   "%s: a line searchlight (width = 0) is refused: the profile is "
-                                   "integrated over a strip; use width > 0",
+                                   "%s: a line searchlight (width = 0) is refused: the model has "
+                                   "no line kernel; use width > 0",
                                    id);
     return 0;
 }

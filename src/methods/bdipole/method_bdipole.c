@@ -14,6 +14,8 @@
  *   crosses the boundary: C_phi and C_E hold its Fresnel transmission). */
 #include "methods/bdipole/method_bdipole.h"
 
+#include <math.h>
+
 #include "methods/bdipole/bdipole_profile.h"
 #include "methods/result_check.h"
 #include "physics/bssrdf_tube.h"
@@ -32,6 +34,15 @@ static double bdipole_strip(const void *model, int piece, double xa, double xb, 
     (void)surf; /* the profile is radial: only the distance counts */
     const bdipole_model *m = model;
     return ppb_bdipole_strip(&m->profile[piece], xa - x, xb - x, y, m->samples);
+}
+
+/* A line of entry points along z at x = xa: the line kernel (K0, K1 in closed form) at the
+ * in-plane distance from the line (reference: Light; bdipole_profile.h). */
+static double bdipole_line(const void *model, int piece, double xa, double x, double y, int surf)
+{
+    (void)surf;
+    const bdipole_model *m = model;
+    return ppb_bdipole_line(&m->profile[piece], hypot(x - xa, y));
 }
 
 static void bdipole_slab(const void *model, double height, double *R, double *T)
@@ -56,7 +67,8 @@ int ppb_method_bdipole(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         for (int i = 0; i < nlit; i++)
             model.profile[i] = ppb_bdipole_make(lit[i].sigma_t, lit[i].albedo, sc->g, sc->n);
     }
-    ppb_bssrdf m = {.model = &model, .strip = bdipole_strip, .slab = bdipole_slab};
+    ppb_bssrdf m = {
+        .model = &model, .strip = bdipole_strip, .line = bdipole_line, .slab = bdipole_slab};
     if (ppb_bssrdf_fill(cfg, &m, ctx->quiet, out, err) ||
         ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
@@ -65,5 +77,5 @@ int ppb_method_bdipole(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 
 int ppb_bdipole_check(const ppb_config *cfg, ppb_err *err)
 {
-    return ppb_bssrdf_check(cfg, "bdipole", err);
+    return ppb_bssrdf_check(cfg, "bdipole", 1, err); /* the line hook above */
 }

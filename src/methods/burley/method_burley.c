@@ -95,6 +95,15 @@ static double burley_strip(const void *model, int piece, double xa, double xb, d
     return ppb_burley_strip(&m->profile[piece], xa - x, xb - x, y, m->samples);
 }
 
+/* A line of entry points along z at x = xa: the line kernel (2 K0, closed form) at the in-plane
+ * distance from the line (reference: Light; burley_profile.h). */
+static double burley_line(const void *model, int piece, double xa, double x, double y, int surf)
+{
+    (void)surf;
+    const burley_model *m = model;
+    return ppb_burley_line(&m->profile[piece], hypot(x - xa, y));
+}
+
 /* The profile over the planes at 0 and H in closed form: R = A, T = A (1 - cdf(H)) (the tube's
  * S2 rule far from its sides). */
 static void burley_slab(const void *model, double height, double *R, double *T)
@@ -121,7 +130,8 @@ int ppb_method_burley(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
             if (piece_profile(cfg, lit[i].sigma_t, lit[i].albedo, &model.profile[i], err))
                 return -1;
     }
-    ppb_bssrdf m = {.model = &model, .strip = burley_strip, .slab = burley_slab};
+    ppb_bssrdf m = {
+        .model = &model, .strip = burley_strip, .line = burley_line, .slab = burley_slab};
     if (ppb_bssrdf_fill(cfg, &m, ctx->quiet, out, err) ||
         ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
@@ -130,5 +140,5 @@ int ppb_method_burley(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 
 int ppb_burley_check(const ppb_config *cfg, ppb_err *err)
 {
-    return ppb_bssrdf_check(cfg, "burley", err);
+    return ppb_bssrdf_check(cfg, "burley", 1, err); /* the line hook above */
 }

@@ -48,6 +48,15 @@ static double dirpole_strip(const void *model, int piece, double xa, double xb, 
     return ppb_dirpole_strip(&m->profile[piece], x - xb, x - xa, y, no, m->samples);
 }
 
+/* A line of entry points along z at x = xa: the exitance's z integral at u = x - xa (z = q sinh t
+ * Gauss-Legendre, dirpole_profile.h), the exit normal the surface's. */
+static double dirpole_line(const void *model, int piece, double xa, double x, double y, int surf)
+{
+    const dirpole_model *m = model;
+    const double no[3] = {ppb_normal_x(surf), ppb_normal_y(surf), 0.0};
+    return ppb_dirpole_line(&m->profile[piece], x - xa, y, no, m->samples);
+}
+
 /* The whole plane of entry points (the strip out to where e^(-sigma_tr r) < 5e-18) at an exit
  * point on the entry face (R) and on the face at depth `height` (T). */
 static void dirpole_slab(const void *model, double height, double *R, double *T)
@@ -77,7 +86,8 @@ int ppb_method_dirpole(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         for (int i = 0; i < nlit; i++)
             ppb_dirpole_init(&model.profile[i], lit[i].sigma_t, lit[i].albedo, sc->g, sc->n, w);
     }
-    ppb_bssrdf m = {.model = &model, .strip = dirpole_strip, .slab = dirpole_slab};
+    ppb_bssrdf m = {
+        .model = &model, .strip = dirpole_strip, .line = dirpole_line, .slab = dirpole_slab};
     if (ppb_bssrdf_fill(cfg, &m, ctx->quiet, out, err) ||
         ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
@@ -86,5 +96,5 @@ int ppb_method_dirpole(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 
 int ppb_dirpole_check(const ppb_config *cfg, ppb_err *err)
 {
-    return ppb_bssrdf_check(cfg, "dirpole", err);
+    return ppb_bssrdf_check(cfg, "dirpole", 1, err); /* the line hook above */
 }

@@ -15,6 +15,7 @@
  *   the exact normalisation instead of pbrt's moment fit c = 1 - 2 FresnelMoment1(1 / eta). */
 #include "methods/pbd/method_pbd.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 #include "methods/pbd/pbd_profile.h"
@@ -85,6 +86,15 @@ static double pbd_strip(const void *model, int piece, double xa, double xb, doub
     return ppb_pbd_strip(&m->profile[piece], xa - x, xb - x, y, m->nodes);
 }
 
+/* A line of entry points along z at x = xa: the table profile's z integral (Gauss-Legendre
+ * panels between the table's radii, pbd_profile.h) at the in-plane distance from the line. */
+static double pbd_line(const void *model, int piece, double xa, double x, double y, int surf)
+{
+    (void)surf;
+    const pbd_model *m = model;
+    return ppb_pbd_line(&m->profile[piece], hypot(x - xa, y), m->nodes);
+}
+
 static void pbd_slab(const void *model, double height, double *R, double *T)
 {
     const pbd_model *m = model;
@@ -110,7 +120,7 @@ int ppb_method_pbd(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         for (int i = 0; i < nlit; i++)
             ppb_pbd_profile_init(&model.profile[i], t, lit[i].sigma_t, lit[i].albedo);
     }
-    ppb_bssrdf m = {.model = &model, .strip = pbd_strip, .slab = pbd_slab};
+    ppb_bssrdf m = {.model = &model, .strip = pbd_strip, .line = pbd_line, .slab = pbd_slab};
     if (ppb_bssrdf_fill(cfg, &m, ctx->quiet, out, err) ||
         ppb_radiance_check(cfg->name, out, NULL, err))
         return -1;
@@ -119,5 +129,5 @@ int ppb_method_pbd(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 
 int ppb_pbd_check(const ppb_config *cfg, ppb_err *err)
 {
-    return ppb_bssrdf_check(cfg, "pbd", err);
+    return ppb_bssrdf_check(cfg, "pbd", 1, err); /* the line hook above */
 }
