@@ -13,7 +13,7 @@
 enum { STUDY_MAX_CASES = 64 };
 
 /* The case names of configs/study.list (blank and '#' lines skipped); at least one. */
-static int study_cases(char names[STUDY_MAX_CASES][64])
+static inline int study_cases(char names[STUDY_MAX_CASES][64])
 {
     FILE *list = fopen(PPB_SOURCE_DIR "/configs/study.list", "r");
     assert_non_null(list);
@@ -32,7 +32,7 @@ static int study_cases(char names[STUDY_MAX_CASES][64])
 }
 
 /* The study's config NAME, loaded from configs/ (as the runner does). */
-static void study_load_config(const char *name, ppb_config *cfg)
+static inline void study_load_config(const char *name, ppb_config *cfg)
 {
     char path[4096 + 128];
     ppb_err err;
@@ -42,7 +42,7 @@ static void study_load_config(const char *name, ppb_config *cfg)
 }
 
 /* Runs method id on ctx's config into out (initialised here with the scene's layout). */
-static void study_run_id(ppb_run_ctx *ctx, const char *id, ppb_result *out)
+static inline void study_run_id(ppb_run_ctx *ctx, const char *id, ppb_result *out)
 {
     ppb_err err;
     ppb_layout lo = ppb_scene_layout(&ctx->cfg->scene);

@@ -351,19 +351,119 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
     return rc;
 }
 
-/* study: the refinement study follows, keeping GMRES's first cycle (one vector more than its
- * restart) and its own three vectors beside the solve's. */
-static int rte_memory_check(const ppb_config *cfg, const ppb_layout *lo, int study, ppb_err *err)
+/* What a solve allocates, from the config alone (before the grid is built). The exit march's
+ * source, a value per exit direction sample and grid node, is the largest array: one buffer on
+ * the device (solver_init's "rte2d exit source") and its copy on the host (exit_march's Jx). Its
+ * planes are surfaces x bins.theta x bins.phi x bins.samples_dir^2 (at least the cells), its
+ * nodes those of rte2d.spacing over the cross-section (ppb_rte_nodes, exact); tube.segments_*
+ * size only the exit output (segments x bins). study: the refinement study follows, keeping
+ * GMRES's first cycle (one vector more than its restart) and its own three vectors. */
+typedef struct rte_sizes {
+    double nodes, planes; /* grid nodes; exit direction samples */
+    double source;        /* bytes of the exit source */
+    double largest;       /* bytes of the largest device buffer */
+    double total;         /* bytes in all, host and device */
+} rte_sizes;
+
+static rte_sizes rte_sizes_of(const ppb_config *cfg, int study)
 {
     const ppb_rte2d_settings *r = &cfg->rte2d;
-    int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir, vecs = RTE_RESTART + 4 * study;
-    double solve = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, vecs);
-    double nodes = solve / (8.0 * (r->directions + 10.0) * (vecs + 8)); /* about */
-    double exitb = 8.0 * ppb_bin_sample_count(lo->nsurf, lo->nbins, nsamp) * nodes * 2.0;
-    char detail[160];
-    snprintf(detail, sizeof detail, "solve %.3g GB, exit source %.3g GB x 2", solve / 1e9,
-             exitb / 2e9);
-    return ppb_memory_check(solve + exitb, cfg->memory_limit, "rte2d", detail, err);
+    ppb_layout lo = ppb_scene_layout(&cfg->scene);
+    int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
+    double cells = r->directions + sqrt(r->directions) + 2.0; /* ppb_rte_bytes' bound */
+    rte_sizes z;
+    z.nodes = ppb_rte_nodes(&cfg->scene, r->spacing);
+    z.planes = fmax((double)lo.nsurf * lo.nbins * nsamp * nsamp, cells);
+    z.source = 8.0 * z.planes * z.nodes;
+    /* The field buffers: cells x regions and edges, the regions at most twice the nodes (a
+     * column split at the step). */
+    z.largest = fmax(z.source, 8.0 * cells * 2.0 * z.nodes);
+    z.total = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, RTE_RESTART + 4 * study) +
+              2.0 * z.source + 8.0 * z.planes * cells + 16.0 * (double)lo.ncells;
+    return z;
+}
+
+/* Whether cfg's largest buffer (device) or its total (host) is within limit bytes. */
+static int rte_fits(const ppb_config *cfg, int study, int device, double limit)
+{
+    rte_sizes z = rte_sizes_of(cfg, study);
+    return (device ? z.largest : z.total) <= limit;
+}
+
+/* "bins.samples_dir = K fits, rte2d.spacing = S fits": the nearest settings under limit, each
+ * key changed alone (samples_dir down by one, spacing up by 25 % steps to its range's 10). */
+static void rte_what_fits(const ppb_config *cfg, int study, int device, double limit, char *buf,
+                          size_t cap)
+{
+    ppb_config *c = malloc(sizeof *c);
+    snprintf(buf, cap, "nothing found");
+    if (!c)
+        return;
+    *c = *cfg;
+    size_t n = 0;
+    buf[0] = 0;
+    for (c->samples_dir = cfg->samples_dir - 1; c->samples_dir >= 1; c->samples_dir--)
+        if (rte_fits(c, study, device, limit)) {
+            n += snprintf(buf + n, cap - n, "bins.samples_dir = %d fits", c->samples_dir);
+            break;
+        }
+    c->samples_dir = cfg->samples_dir;
+    for (double s = cfg->rte2d.spacing * 1.25; n < cap && s <= 10.0; s *= 1.25) {
+        c->rte2d.spacing = s;
+        if (rte_fits(c, study, device, limit)) {
+            snprintf(buf + n, cap - n, "%srte2d.spacing = %.3g fits", n ? ", " : "", s);
+            break;
+        }
+    }
+    if (!buf[0])
+        snprintf(buf, cap, "no single key's change fits");
+    free(c);
+}
+
+/* The host's bound (reference: Methods, `rte2d`, Refused): the total against [run]
+ * memory_limit, refused naming the keys that size it. */
+static int rte_memory_check(const ppb_config *cfg, int study, ppb_err *err)
+{
+    rte_sizes z = rte_sizes_of(cfg, study);
+    double limit = ppb_memory_limit(cfg->memory_limit);
+    if (z.total <= limit)
+        return 0;
+    char fits[160];
+    rte_what_fits(cfg, study, 0, limit, fits, sizeof fits);
+    return ppb_config_key_fail(
+        cfg, "rte2d", "spacing", err,
+        "rte2d needs about %.3g GB, above the memory limit of %.3g GB ([run] memory_limit%s): its "
+        "exit source is %.3g GB on the host and again on the device (%.0f direction samples: "
+        "surfaces x bins.theta x bins.phi x bins.samples_dir^2, x %.0f grid nodes: the tube at "
+        "rte2d.spacing); lower bins.samples_dir or rte2d.directions, or raise rte2d.spacing (%s)",
+        z.total / 1e9, limit / 1e9, cfg->memory_limit > 0.0 ? "" : " = 0: half the machine's",
+        z.source / 1e9, z.planes, z.nodes, fits);
+}
+
+/* The device's bound, known once it is open: the largest buffer against its
+ * CL_DEVICE_MAX_MEM_ALLOC_SIZE (max_alloc), before the grid is built or a kernel launched. */
+static int rte_device_check(const ppb_config *cfg, int study, double max_alloc, const char *device,
+                            ppb_err *err)
+{
+    rte_sizes z = rte_sizes_of(cfg, study);
+    double limit = max_alloc;
+    if (z.largest <= limit)
+        return 0;
+    char fits[160];
+    rte_what_fits(cfg, study, 1, limit, fits, sizeof fits);
+    return ppb_fail(err,
+                    "rte2d: its exit source needs one buffer of %.3g GB (%.0f direction samples: "
+                    "surfaces x bins.theta x bins.phi x bins.samples_dir^2, x %.0f grid nodes: the "
+                    "tube at rte2d.spacing), above the %.3g GB the device %s allocates at once "
+                    "(CL_DEVICE_MAX_MEM_ALLOC_SIZE): lower bins.samples_dir, or raise "
+                    "rte2d.spacing (%s)",
+                    z.largest / 1e9, z.planes, z.nodes, limit / 1e9, device, fits);
+}
+
+int ppb_rte2d_device_check(const ppb_config *cfg, double max_alloc, const char *device,
+                           ppb_err *err)
+{
+    return rte_device_check(cfg, 0, max_alloc, device, err);
 }
 
 /* The refinement study (reference: rte2d_refinements.csv): after a converged solve, the exit
@@ -687,7 +787,8 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, dou
         out->extra = (ppb_result_extra){study, write_study, free};
     }
     ppb_ocl *ocl;
-    if (rte_memory_check(cfg, lo, study != NULL, err) || ppb_ctx_ocl(ctx, &ocl, err))
+    if (rte_memory_check(cfg, study != NULL, err) || ppb_ctx_ocl(ctx, &ocl, err) ||
+        rte_device_check(cfg, study != NULL, (double)ocl->max_alloc, ocl->name, err))
         return -1;
     int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
     size_t planes = (size_t)ppb_bin_sample_count(lo->nsurf, lo->nbins, nsamp);
@@ -750,7 +851,9 @@ int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err)
                                    "rte2d: a line searchlight (width = 0) is refused: the beam's "
                                    "first scattering is integrated over cells, where a line is a "
                                    "delta; use a strip (width > 0)");
-    return 0;
+    /* Every run needs the solve and the exit march (the refinement study's vectors, which a
+     * converged `run` adds, are checked again when it runs). */
+    return rte_memory_check(cfg, 0, err);
 }
 
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)

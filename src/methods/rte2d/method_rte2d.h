@@ -55,8 +55,17 @@ typedef struct ppb_rte2d_study {
 int ppb_method_rte2d(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
 
 /* Refuses what the solver cannot take before any work: a line searchlight (its first-scatter
- * source is a delta on a light plane, which the cells' beam integrals do not hold). */
+ * source is a delta on a light plane, which the cells' beam integrals do not hold), and a grid
+ * whose arrays, host and device together, exceed [run] memory_limit (the exit source of
+ * surfaces x bins x bins.samples_dir^2 planes by the nodes of rte2d.spacing the largest), the
+ * message naming the keys and the nearest settings that fit. */
 int ppb_rte2d_check(const ppb_config *cfg, ppb_err *err);
+
+/* The device's bound, known once it is open (the run checks it there, before the grid is
+ * built): fails, naming device, the keys and what fits, when cfg's largest buffer (the exit
+ * source) exceeds max_alloc bytes (its CL_DEVICE_MAX_MEM_ALLOC_SIZE). */
+int ppb_rte2d_device_check(const ppb_config *cfg, double max_alloc, const char *device,
+                           ppb_err *err);
 
 /* The method, reporting what it took (tests, `make perf`; stats may be NULL): the refinement
  * study runs after a converged solve where ctx->extras is set. */

@@ -384,7 +384,7 @@ int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, pp
     return 0;
 }
 
-double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart)
+double ppb_rte_nodes(const ppb_scene *sc, double spacing)
 {
     int nl = 0, nr = 0, nx = 1;
     double hl, hr;
@@ -394,7 +394,12 @@ double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int re
     }
     ppb_rte_params Py;
     grid_y(sc, spacing, &Py);
-    double nodes = (double)nx * Py.ny, nc = directions + sqrt(directions) + 2;
+    return (double)nx * Py.ny;
+}
+
+double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart)
+{
+    double nodes = ppb_rte_nodes(sc, spacing), nc = directions + sqrt(directions) + 2;
     /* Krylov vectors, the solve's work arrays (x, b, J, out x 2 for host and device) and the
      * phase matrix. */
     return 8.0 * (nodes * nc * (restart + 8) + 4.0 * directions * directions);

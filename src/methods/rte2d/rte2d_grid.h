@@ -94,6 +94,9 @@ void ppb_rte_grid_free(ppb_rte_grid *G);
  * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. */
 double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out);
 
+/* Nodes of the grid ppb_rte_grid_make builds at `spacing` (G->nnodes), before building. */
+double ppb_rte_nodes(const ppb_scene *sc, double spacing);
+
 /* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building. */
 double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart);
 
