@@ -367,6 +367,47 @@ static void test_uniform_field(void **state)
     fake_free(f);
 }
 
+/* The light arrow points at a searchlight's strip (images.c): with the strip at x0 = W/4 (the
+ * whole face's arrow ends at -W/4, W/2 away) and only S1's segments inside it bright, the
+ * arrow's tip (its lowest pixel: the tail is above S1, the head's strokes go back up from the
+ * tip) lies within 3 pixels of a bright pixel of the strip (the arrow at -W/4, as drawn before
+ * it followed the strip, ended 70 pixels from the nearest). */
+static void test_arrow_at_strip(void **state)
+{
+    (void)state;
+    fake *f = fake_new("arrow_strip", PPB_GEOM_TUBE);
+    ppb_scene *sc = &f->cfg.scene;
+    sc->searchlight = 1;
+    sc->light_x0 = 0.25 * sc->width;
+    sc->light_width = 0.1 * sc->width;
+    ppb_layout lo = ppb_scene_layout(sc);
+    for (int i = 0; i < 2; i++)
+        for (int seg = 0; seg < lo.nseg[PPB_S1]; seg++) {
+            double x, y;
+            ppb_scene_sample_point(sc, PPB_S1, seg, &x, &y);
+            for (int b = 0; b < lo.nbins; b++)
+                f->ex.res[i].radiance[ppb_cell(&lo, PPB_S1, seg, b)] =
+                    fabs(x - sc->light_x0) < 0.5 * sc->light_width ? 1.0 : 0.0;
+        }
+    write_images(f);
+    int w, h, pw, ph;
+    float *exr = read_exr(f, "pp.exr", &w, &h);
+    unsigned char *png = read_png(f, "pp.png", &pw, &ph);
+    long tip = -1;
+    for (long k = 0; k < (long)w * h / 2; k++)
+        if (is_arrow(png + 3 * k))
+            tip = k; /* the last in row order: the lowest row */
+    assert_true(tip >= 0);
+    double best = INFINITY;
+    for (long k = 0; k < (long)w * h / 2; k++)
+        if (exr[3 * k] > 0.0f)
+            best = fmin(best, hypot((double)(k % w - tip % w), (double)(k / w - tip / w)));
+    assert_true(best <= 3.0);
+    free(exr);
+    free(png);
+    fake_free(f);
+}
+
 /* The pixel showing segment k of S1 (S2) holds exactly that segment's radiance: the camera
  * mapping end to end, through the EXR. */
 static void test_segment_field_through_exr(void **state)
@@ -601,6 +642,7 @@ int main(void)
         cmocka_unit_test(test_camera_projection_analytic),
         cmocka_unit_test(test_camera_cell),
         cmocka_unit_test(test_uniform_field),
+        cmocka_unit_test(test_arrow_at_strip),
         cmocka_unit_test(test_segment_field_through_exr),
         cmocka_unit_test(test_shared_exposure_and_files),
         cmocka_unit_test(test_exposure_per_view),

@@ -25,7 +25,8 @@
  *                       uniform_g0_normal). Below the knee, grey levels compare linearly
  *                       between methods; the top view carries the
  *                       light arrow: the beam's direction w_L drawn in light yellow ending on
- *                       S1 at x = -W/4, z = 0. Background slate blue, cut caps brown.
+ *                       S1 at z = 0 and x = -W/4, or a searchlight's centre (its strip or
+ *                       line). Background slate blue, cut caps brown.
  *   errmap_<method>.png for every method but the reference, when there is one: false colour of
  *                       the relative error e = (L_m - L_ref) / L_ref, clamped to +-50%,
  *                       diverging map blue (-50%) .. light grey (0) .. red (+50%), linear in
@@ -88,6 +89,16 @@ static void free_ctx(img_ctx *c)
     free(c->value);
 }
 
+/* Where the light arrow meets S1 (ppb_scene_lit_range): a searchlight's centre, else -W/4. */
+static double arrow_x(const ppb_scene *sc)
+{
+    if (!ppb_scene_searchlight(sc))
+        return -0.25 * sc->width;
+    double lo, hi;
+    ppb_scene_lit_range(sc, &lo, &hi);
+    return 0.5 * (lo + hi);
+}
+
 static int render_panels(img_ctx *c, ppb_err *err)
 {
     ppb_tube_view views[2];
@@ -97,9 +108,10 @@ static int render_panels(img_ctx *c, ppb_err *err)
     c->value = calloc((size_t)c->n, sizeof *c->value);
     if (!c->kind || !c->value)
         return ppb_fail(err, "images: out of memory");
-    /* The light arrow: w_L ending on S1 (y = 0) at x = -W/4, z = 0, 0.6 W long (the top view
-     * looks down steeply, so the shaft is foreshortened). */
-    double w[3], tip[3] = {-0.25 * c->scene->width, 0, 0}, tail[3];
+    /* The light arrow: w_L ending on S1 (y = 0) at z = 0, 0.6 W long (the top view looks down
+     * steeply, so the shaft is foreshortened); at x = -W/4 when the whole face (or the part
+     * before a shadow step) is lit, at the searchlight's centre (strip or line) otherwise. */
+    double w[3], tip[3] = {arrow_x(c->scene), 0, 0}, tail[3];
     ppb_scene_light_dir(c->scene, w);
     for (int k = 0; k < 3; k++)
         tail[k] = tip[k] - 0.6 * c->scene->width * w[k];
