@@ -54,4 +54,37 @@ static inline void study_run_id(ppb_run_ctx *ctx, const char *id, ppb_result *ou
         fail_msg("%s: %s", id, err.msg);
 }
 
+/* A registry sum `model`+ss is `model` + ss cell by cell, on a coarse oblique tube at n = 1.4
+ * (ss through the OpenCL marcher), and its totals are the model's with ss's R, T and sides
+ * added (method.h: ppb_method_sum). */
+static inline void study_check_sum_with_ss(const char *model)
+{
+    char sum_id[64];
+    snprintf(sum_id, sizeof sum_id, "%s+ss", model);
+    ppb_config cfg;
+    study_load_config("uniform_g0_oblique_n14", &cfg);
+    cfg.scene.segments_top = 16;
+    cfg.scene.segments_side = 6;
+    cfg.samples_dir = 2;
+    cfg.samples_seg = 2;
+    ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
+    ppb_result sum, b, s;
+    study_run_id(&ctx, sum_id, &sum);
+    study_run_id(&ctx, model, &b);
+    study_run_id(&ctx, "ss", &s);
+    double ss_total = 0;
+    for (size_t i = 0; i < sum.layout.ncells; i++) {
+        assert_close(sum.radiance[i], b.radiance[i] + s.radiance[i], 0.0);
+        ss_total += s.radiance[i];
+    }
+    assert_lt(0, ss_total); /* ss did add light */
+    assert_rel(sum.totals.R, b.totals.R + s.totals.R, 1e-15);
+    assert_rel(sum.totals.T, b.totals.T + s.totals.T, 1e-15);
+    assert_rel(sum.totals.sides, b.totals.sides + s.totals.sides, 1e-15);
+    ppb_result_free(&sum);
+    ppb_result_free(&b);
+    ppb_result_free(&s);
+    ppb_ctx_close(&ctx);
+}
+
 #endif

@@ -442,33 +442,7 @@ static void test_slab_mode(void **state)
 static void test_sum_with_ss(void **state)
 {
     (void)state;
-    /* burley+ss is burley + ss cell by cell (the registry's sum), on a coarse oblique tube at
-     * n = 1.4 (ss through the OpenCL marcher), and its totals are burley's with ss's R, T and
-     * sides added. */
-    ppb_config cfg;
-    study_load_config("uniform_g0_oblique_n14", &cfg);
-    cfg.scene.segments_top = 16;
-    cfg.scene.segments_side = 6;
-    cfg.samples_dir = 2;
-    cfg.samples_seg = 2;
-    ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-    ppb_result sum, b, s;
-    study_run_id(&ctx, "burley+ss", &sum);
-    study_run_id(&ctx, "burley", &b);
-    study_run_id(&ctx, "ss", &s);
-    double ss_total = 0;
-    for (size_t i = 0; i < sum.layout.ncells; i++) {
-        assert_close(sum.radiance[i], b.radiance[i] + s.radiance[i], 0.0);
-        ss_total += s.radiance[i];
-    }
-    assert_lt(0, ss_total); /* ss did add light */
-    assert_rel(sum.totals.R, b.totals.R + s.totals.R, 1e-15);
-    assert_rel(sum.totals.T, b.totals.T + s.totals.T, 1e-15);
-    assert_rel(sum.totals.sides, b.totals.sides + s.totals.sides, 1e-15);
-    ppb_result_free(&sum);
-    ppb_result_free(&b);
-    ppb_result_free(&s);
-    ppb_ctx_close(&ctx);
+    study_check_sum_with_ss("burley");
 }
 
 int main(void)
