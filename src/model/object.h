@@ -26,10 +26,10 @@ typedef struct ppb_object_material {
 typedef struct ppb_object {
     char name[64];
     int nx, ny, nz;
-    double voxel;        /* voxel edge length h */
-    unsigned char *mat;  /* [nx * ny * nz] material index, 0 = outside */
-    float *albedo_tex;   /* [nx * ny * nz] albedo per voxel overriding the material's, or NULL */
-    int nmat;            /* materials 1..nmat are used */
+    double voxel;       /* voxel edge length h */
+    unsigned char *mat; /* [nx * ny * nz] material index, 0 = outside */
+    float *albedo_tex;  /* [nx * ny * nz] albedo per voxel overriding the material's, or NULL */
+    int nmat;           /* materials 1..nmat are used */
     ppb_object_material material[PPB_OBJ_MAX_MAT];
     double g;            /* Henyey-Greenstein g of the whole object */
     double n;            /* refractive index inside (1: no boundary) */
@@ -39,6 +39,33 @@ typedef struct ppb_object {
     int ntheta, nphi;    /* direction bins per patch (phi over [0, 2 pi) in the patch frame) */
     int patch;           /* patch edge in voxel faces: a patch is patch x patch boundary faces */
 } ppb_object;
+
+/* A patch: patch x patch boundary faces of one plane and orientation (a boundary face is a face
+ * of a medium voxel whose neighbour is outside or beyond the grid). Its frame: n the outward
+ * normal (an axis), t the phi = 0 direction, b = n x t; direction bins are ppb_theta_bin's
+ * theta bins about n and phi over [0, 2 pi) from t toward b (docs/reference.md, Objects). */
+typedef struct ppb_object_patch {
+    double c[3];       /* centroid of its faces */
+    double n[3], t[3]; /* outward normal and phi = 0 tangent */
+    double area;       /* faces x voxel^2 */
+    int axis, side;    /* n = side * e_axis, side = +1 or -1 */
+    int plane;         /* the face plane's grid index along axis (coordinate plane * voxel) */
+    int region;        /* a ppb_object_region, set by whoever labels regions (0 until then) */
+} ppb_object_patch;
+
+/* The boundary faces' patches and, for the kernels, where each face's radiance goes. */
+typedef struct ppb_object_patches {
+    int npatch;
+    ppb_object_patch *patch;
+    /* face_patch[6 * voxel + f], f = 2 * axis + (side > 0): the patch of that face of that
+     * voxel, -1 when it is no boundary face. */
+    int *face_patch;
+} ppb_object_patches;
+
+/* Enumerates o's boundary faces into patches of o->patch x o->patch faces (patch >= 1), in a
+ * fixed order (orientation, plane, then the patch's two in-plane indices), so runs agree. */
+int ppb_object_patches_build(const ppb_object *o, ppb_object_patches *p, ppb_err *err);
+void ppb_object_patches_free(ppb_object_patches *p);
 
 static inline size_t ppb_object_voxel(const ppb_object *o, int i, int j, int k)
 {
