@@ -18,7 +18,7 @@
 #                                theta-bin centre (phi bin 0: +, along t; the last phi bin: -),
 #                                each half its own line, Monte Carlo +- 1 standard error
 #   plots/angular_x0_polar.{png,pdf}  the same as a polar plot (paper Fig. 5)
-#   images/all.{png,pdf}         every method's picture side by side, titled with its id, over a
+#   images/all.{png,pdf}         every method's picture side by side (rows of 7), titled, over a
 #                                colour bar of the grey levels (radiance / L_white; paper
 #                                Fig. 6-7); the light arrow is in the pictures (src/io/images.c)
 #   images/error_<m>.{png,pdf}   errmap_<m>.png titled "<m> vs mc", with a colour bar numbered
@@ -231,13 +231,17 @@ if [ -d "$img" ] && has_rows "$dir/angular.csv"; then
   for m in "${all_methods[@]}"; do [ -s "$img/$m.png" ] && present+=("$m"); done
   n=${#present[@]}
   if [ "$n" -gt 0 ]; then
+    cols=$((n < 7 ? n : 7)) rows=$(((n + 6) / 7))
+    page_h=$((73 + rows * 392 + 95))
     {
       echo "set multiplot title NAME.\": every method's picture\\ntop: S1, S3 from above; bottom: S2, S3 from below\\nyellow arrow: the light (theta_L = $theta_l deg); brown: the cut; grey: the bar below\""
       echo "unset border; unset tics; unset key; set size ratio -1; set margins 0.5, 0.5, 0.5, 2"
-      # the pictures in a row above the colour bar (the bottom 0.17 of the page)
+      # the pictures in rows of at most 7 above the colour bar: a page of a title band (73 px),
+      # rows of 392 px and the bar's band (95 px), so that a picture keeps its size however
+      # many methods ran (14 in one row were too small to read)
       i=0
       for m in "${present[@]}"; do
-        echo "set origin $(awk -v i=$i -v n="$n" 'BEGIN {print i / n}'), 0.17; set size $(awk -v n="$n" 'BEGIN {print 1 / n}'), 0.70"
+        echo "set origin $(awk -v i=$i -v c="$cols" -v r="$rows" -v h="$page_h" 'BEGIN {print (i % c) / c, (95 + (r - 1 - int(i / c)) * 392) / h}' | tr ' ' ,); set size $(awk -v c="$cols" -v h="$page_h" 'BEGIN {print 1 / c ", " 392 / h}')"
         echo "set title '$m' font ',14'"
         echo "plot DIR.'/images/$m.png' binary filetype=png with rgbimage"
         i=$((i + 1))
@@ -245,18 +249,18 @@ if [ -d "$img" ] && has_rows "$dir/angular.csv"; then
       # The colour bar of the pictures' grey levels: the tone curve of src/io/images.c (x =
       # L / L_white, the identity to 0.75, the shoulder above, sRGB-encoded), so a grey in a
       # picture reads off as a radiance relative to its view's L_white.
-      echo "set origin 0, 0; set size 1, 0.17; set size noratio; unset title"
+      echo "set origin 0, 0; set size 1, $(awk -v h="$page_h" 'BEGIN {print 95 / h}'); set size noratio; unset title"
       echo "sh(x) = x <= 0.75 ? x : 0.75 + 0.25 * (1 - exp(-(x - 0.75) / 0.25))"
       echo "enc(v) = v <= 0.0031308 ? 12.92 * v : 1.055 * v ** (1 / 2.4) - 0.055"
       echo "set palette functions enc(sh(2 * gray)), enc(sh(2 * gray)), enc(sh(2 * gray))"
       echo "set cbrange [0:2]; set cbtics ('0' 0, '0.25' 0.25, '0.5' 0.5, '0.75' 0.75, '1' 1, '1.5' 1.5, '2' 2) out nomirror"
-      echo "set colorbox horizontal user origin screen 0.1, screen 0.1 size screen 0.8, screen 0.03"
+      echo "set colorbox horizontal user origin screen 0.1, screen $(awk -v h="$page_h" 'BEGIN {print 56 / h}') size screen 0.8, screen $(awk -v h="$page_h" 'BEGIN {print 17 / h}')"
       echo "set cblabel 'radiance / L_white (the Monte Carlo 99th percentile of the view); linear to 0.75, a shoulder above' offset 0, 0.4"
       echo "set xrange [0:1]; set yrange [0:1]"
       echo "plot '+' using (NaN):(NaN):(0) with points lc palette notitle"
       echo "unset multiplot"
     } > "$tmp/body.gp"
-    render "$img/all" $((n * 250 + 20)) 560
+    render "$img/all" $((cols * 250 + 20)) "$page_h"
   fi
   for m in "${present[@]}"; do
     [ -s "$img/errmap_$m.png" ] || continue
