@@ -24,8 +24,11 @@ static ppb_run_ctx ctx;
 static ppb_config config_of(ppb_scene sc, long long photons)
 {
     ppb_config cfg;
-    memset(&cfg, 0, sizeof cfg);
+    ppb_err err;
+    if (ppb_config_defaults(&cfg, &err))
+        fail_msg("%s", err.msg);
     cfg.scene = sc;
+    cfg.mc.first = 0, cfg.mc.chunk = 0, cfg.mc.workgroup = 0, cfg.mc.target_noise = 0;
     cfg.mc.photons = photons;
     cfg.mc.batches = 32;
     cfg.mc.seed = 7;
@@ -261,6 +264,58 @@ static void test_reproducible(void **state)
         ppb_mc_tallies_free(&ref[c]);
 }
 
+/* The registry's entry (ppb_mc_run_channels): without a cache, the hero run's results (the
+ * same bytes as ppb_mc_trace_channels' tallies converted); with every channel's single-channel
+ * reference in the cache (stored by ppb_method_mc), those references, no photon traced. */
+static void test_run_channels_entry(void **state)
+{
+    (void)state;
+    ppb_config cfgs[3];
+    material_configs("skimmilk", coarse_tube(4, 2), 20000, cfgs);
+    ppb_layout lo = ppb_scene_layout(&cfgs[0].scene);
+    ppb_result out[6], single[2];
+    ppb_err err;
+    for (int i = 0; i < 6; i++)
+        if (ppb_result_init(&out[i], i % 2 ? "mc1" : "mc", &lo, &err))
+            fail_msg("%s", err.msg);
+    ppb_mc_tallies t[3];
+    trace_rgb(cfgs, 3, t);
+    if (ppb_mc_run_channels(&ctx, cfgs, 3, out, &err))
+        fail_msg("%s", err.msg);
+    for (int c = 0; c < 3; c++) {
+        ppb_result r;
+        if (ppb_result_init(&r, "mc", &lo, &err))
+            fail_msg("%s", err.msg);
+        ppb_mc_tallies_to_results(&t[c], &cfgs[c].scene, &r, NULL);
+        assert_memory_equal(r.radiance, out[2 * c].radiance, lo.ncells * sizeof(double));
+        assert_true(out[2 * c].photons == 20000 && !out[2 * c].partial);
+        ppb_result_free(&r);
+        ppb_mc_tallies_free(&t[c]);
+    }
+    char dir[1100];
+    snprintf(dir, sizeof dir, "%s/cache", tu_scratch("mc_rgb_cache"));
+    ctx.ref_cache = dir;
+    for (int c = 0; c < 3; c++) {
+        ctx.cfg = &cfgs[c];
+        for (int i = 0; i < 2; i++)
+            if (ppb_result_init(&single[i], i ? "mc1" : "mc", &lo, &err))
+                fail_msg("%s", err.msg);
+        if (ppb_method_mc(&ctx, single, &err))
+            fail_msg("%s", err.msg);
+        ppb_result_free(&single[1]);
+        if (c < 2)
+            ppb_result_free(&single[0]);
+    }
+    if (ppb_mc_run_channels(&ctx, cfgs, 3, out, &err))
+        fail_msg("%s", err.msg);
+    ctx.ref_cache = NULL;
+    assert_memory_equal(single[0].radiance, out[4].radiance, lo.ncells * sizeof(double));
+    assert_true(ctx.mc_reference[0] != '\0');
+    ppb_result_free(&single[0]);
+    for (int i = 0; i < 6; i++)
+        ppb_result_free(&out[i]);
+}
+
 /* Channels that differ beyond the medium, or in their [mc] settings, are refused by name. */
 static void test_refuses_other_scenes(void **state)
 {
@@ -290,6 +345,7 @@ int main(void)
         cmocka_unit_test(test_refuses_other_scenes),
         cmocka_unit_test(test_equal_channels_are_single_bytes),
         cmocka_unit_test(test_reproducible),
+        cmocka_unit_test(test_run_channels_entry),
         cmocka_unit_test(test_skimmilk_agrees),
         cmocka_unit_test(test_density_step_g_agrees),
         cmocka_unit_test(test_spread_channels_agree),

@@ -631,33 +631,70 @@ int ppb_mc_rgb_params_of(const ppb_config *cfgs, int nch, ppb_mc_rgb_params *ch,
     return 0;
 }
 
+/* Every channel's single-channel reference from the cache or the shipped layer (mc_cache.h),
+ * into t: 1 when all nch are there (ctx->mc_reference then names the last), else 0 with t
+ * freed. */
+static int cached_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_mc_tallies *t,
+                           ppb_err *err)
+{
+    if (!ctx->ref_cache)
+        return 0;
+    const ppb_config *own = ctx->cfg;
+    int found = 0;
+    for (; found < nch; found++) {
+        long long chunk = 0;
+        ctx->cfg = &cfgs[found];
+        if (cfgs[found].mc.target_noise > 0 && ppb_mc_chunk(ctx, &chunk, err))
+            break;
+        if (!ppb_mc_cache_get(ctx, chunk, &t[found]))
+            break;
+    }
+    ctx->cfg = own;
+    if (found == nch)
+        return 1;
+    for (int c = 0; c < found; c++)
+        ppb_mc_tallies_free(&t[c]);
+    ctx->mc_reference[0] = '\0';
+    ctx->mc_reference_shipped = 0;
+    return 0;
+}
+
 int ppb_mc_run_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_result *out,
                         ppb_err *err)
 {
     ppb_mc_rgb_params ch;
     if (ppb_mc_rgb_params_of(cfgs, nch, &ch, err) || check_memory(&cfgs[0], nch, err))
         return -1;
-    /* Not cached: no run of the single-channel kernel has these tallies (docs/methods.md). */
     ctx->mc_reference[0] = '\0';
     ctx->mc_shipped_key[0] = '\0';
     ctx->mc_reference_shipped = 0;
-    if (no_trace())
-        return ppb_fail(err, "mc: a multi-channel reference is never cached nor shipped, and "
-                             "PPBENCH_MC_NO_TRACE=1: nothing traced (set PPBENCH_MC_NO_TRACE=0 "
-                             "to trace it)");
     ppb_mc_tallies t[PPB_MC_MAX_CH];
     memset(t, 0, sizeof t);
-    int status = 0;
-    for (int c = 0; c < nch && status == 0; c++)
-        status = ppb_mc_tallies_init(&t[c], &cfgs[c].scene, (uint64_t)cfgs[c].mc.seed,
-                                     cfgs[c].mc.batches, err);
     ppb_mc_trace_info info = {0};
-    const ppb_config *own = ctx->cfg;
-    ctx->cfg = &cfgs[0]; /* the trace's scene and settings; the media come from ch */
-    if (status == 0)
-        status =
-            ppb_mc_trace_channels(ctx, &ch, cfgs[0].mc.first, cfgs[0].mc.photons, t, &info, err);
-    ctx->cfg = own;
+    int status = 0;
+    if (cached_channels(ctx, cfgs, nch, t, err)) {
+        /* Each channel's own reference was traced before: those, not a new trace. */
+        if (ctx->quiet < 2)
+            fprintf(stderr, "%s: mc: %d channels' references from the %s, 0 traced\n", cfgs[0].name,
+                    nch, ctx->mc_reference_shipped ? "shipped references" : "reference cache");
+    } else if (no_trace()) {
+        return ppb_fail(err,
+                        "mc: no reference for every channel in the cache (%s) nor the "
+                        "shipped layer (%s), and PPBENCH_MC_NO_TRACE=1: nothing traced "
+                        "(set PPBENCH_MC_NO_TRACE=0 to trace it)",
+                        ctx->ref_cache ? ctx->ref_cache : "none", ppb_mc_shipped_dir());
+    } else {
+        /* Traced by hero sampling, and not stored (docs/methods.md says why). */
+        for (int c = 0; c < nch && status == 0; c++)
+            status = ppb_mc_tallies_init(&t[c], &cfgs[c].scene, (uint64_t)cfgs[c].mc.seed,
+                                         cfgs[c].mc.batches, err);
+        const ppb_config *own = ctx->cfg;
+        ctx->cfg = &cfgs[0]; /* the trace's scene and settings; the media come from ch */
+        if (status == 0)
+            status = ppb_mc_trace_channels(ctx, &ch, cfgs[0].mc.first, cfgs[0].mc.photons, t, &info,
+                                           err);
+        ctx->cfg = own;
+    }
     for (int c = 0; c < nch && status == 0; c++) {
         note_capped(&cfgs[c], &t[c]);
         ppb_mc_tallies_to_results(&t[c], &cfgs[c].scene, &out[2 * c], &out[2 * c + 1]);
