@@ -173,6 +173,8 @@ static int perf_channels(ppb_run_ctx *ctx, long long photons, FILE *out, ppb_err
     }
     if (rc == 0)
         rc = ppb_mc_trace_channels(&sub, &ch, 0, photons, t, &info, err);
+    if (rc == 0 && info.traced < photons)
+        rc = ppb_fail(err, "perf: interrupted after %lld photons", info.traced);
     double hero_s = info.seconds, hero_noise[3] = {0, 0, 0}, hero_ev = 0;
     for (int c = 0; c < 3 && rc == 0; c++) {
         ppb_mc_totals_stats st;
