@@ -74,15 +74,6 @@ static void trace_rgb(const ppb_config *cfgs, int nch, ppb_mc_tallies *t)
     assert_int_equal(info.traced, cfgs[0].mc.photons);
 }
 
-static int same_tallies(const ppb_mc_tallies *a, const ppb_mc_tallies *b)
-{
-    size_t nb = (size_t)a->batches;
-    return a->batches == b->batches && a->ncells == b->ncells &&
-           !memcmp(a->photons, b->photons, nb * sizeof *a->photons) &&
-           !memcmp(a->totals, b->totals, nb * PPB_MC_NTOT * sizeof *a->totals) &&
-           !memcmp(a->cells, b->cells, nb * PPB_MC_NTALLY * a->ncells * sizeof *a->cells);
-}
-
 /* Channel c of the hero run (a) against its single run (b): the mean of z^2 = (a - b)^2 /
  * (se_a^2 + se_b^2) over the cells of mc where both runs have relative error below 0.2 (so
  * that z is near normal), and each total within 3 joint standard errors. With standard errors
@@ -226,7 +217,7 @@ static void test_equal_channels_are_single_bytes(void **state)
         trace_rgb(cfgs, 3, rgb);
         trace_single(&cfgs[0], &one);
         for (int c = 0; c < 3; c++) {
-            if (!same_tallies(&rgb[c], &one))
+            if (!ppb_mc_tallies_equal(&rgb[c], &one))
                 fail_msg("variant %d: channel %d's tallies differ from the single run's", variant,
                          c);
             ppb_mc_tallies_free(&rgb[c]);
@@ -252,7 +243,7 @@ static void test_reproducible(void **state)
         }
         trace_rgb(cfgs, 3, t);
         for (int c = 0; c < 3; c++) {
-            if (!same_tallies(&ref[c], &t[c]))
+            if (!ppb_mc_tallies_equal(&ref[c], &t[c]))
                 fail_msg("channel %d differs with %s", c,
                          v == 0   ? "work-group size 16"
                          : v == 1 ? "4 chunks"

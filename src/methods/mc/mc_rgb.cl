@@ -29,7 +29,10 @@
  * tallies of each channel are mc.cl's bytes for the same seed (tests/test_mc_rgb.c checks it).
  *
  * Layout, chunking and reproducibility are mc.cl's (included below, whose functions this file
- * uses unchanged): a photon's path depends only on the seed and its index. */
+ * uses unchanged): a photon's path depends only on the seed and its index. ppb_rgb_step is
+ * ppb_mc_step with the channels added, not a call of it: mc.cl's text (with its headers) is in
+ * the key of every cached and shipped reference (mc_cache.h), so splitting its step into parts
+ * both kernels share would re-key references/; that belongs with their next regeneration. */
 #include "mc.cl"
 #include "mc_rgb_params.h"
 
