@@ -8,8 +8,9 @@
  * per channel in expectation (R + T + sides + ballistic + absorbed + specular = 1: each term is an
  * unbiased estimate of the channel's own). With three equal channels every weight is exactly the
  * single-channel weight, so the tallies are its bytes. The tallies do not depend on work-group size
- * or chunking. Experiments that differ beyond the medium are refused. Every statistical bound is in
- * units of the runs' own standard errors. */
+ * or chunking, a target noise stops the run at a prefix, and the registry's entry uses cached
+ * single-channel references when every channel has one. Experiments that differ beyond the medium
+ * are refused. Every statistical bound is in units of the runs' own standard errors. */
 #include "testutil.h"
 
 #include <math.h>
@@ -255,6 +256,41 @@ static void test_reproducible(void **state)
         ppb_mc_tallies_free(&ref[c]);
 }
 
+/* A target noise stops the joint run between chunks once every channel meets it (checked as
+ * mc checks it, noise_rel at the Table 2 cells); what was traced is a prefix, so the tallies are
+ * those of a run of that many photons. */
+static void test_target_noise(void **state)
+{
+    (void)state;
+    ppb_config cfgs[3];
+    material_configs("skimmilk", coarse_tube(4, 2), 2000000, cfgs);
+    for (int c = 0; c < 3; c++)
+        cfgs[c].mc.chunk = 20000, cfgs[c].mc.target_noise = 0.3;
+    ppb_mc_rgb_params ch;
+    ppb_err err;
+    ppb_mc_tallies t[3], u[3];
+    if (ppb_mc_rgb_params_of(cfgs, 3, &ch, &err))
+        fail_msg("%s", err.msg);
+    for (int c = 0; c < 3; c++)
+        if (ppb_mc_tallies_init(&t[c], &cfgs[c].scene, (uint64_t)cfgs[c].mc.seed,
+                                cfgs[c].mc.batches, &err))
+            fail_msg("%s", err.msg);
+    ctx.cfg = &cfgs[0];
+    ppb_mc_trace_info info;
+    if (ppb_mc_trace_channels(&ctx, &ch, 0, cfgs[0].mc.photons, t, &info, &err))
+        fail_msg("%s", err.msg);
+    assert_true(info.reached_noise);
+    assert_true(info.traced < cfgs[0].mc.photons && info.traced % 20000 == 0);
+    for (int c = 0; c < 3; c++)
+        cfgs[c].mc.photons = info.traced, cfgs[c].mc.target_noise = 0;
+    trace_rgb(cfgs, 3, u);
+    for (int c = 0; c < 3; c++) {
+        assert_true(ppb_mc_tallies_equal(&t[c], &u[c]));
+        ppb_mc_tallies_free(&t[c]);
+        ppb_mc_tallies_free(&u[c]);
+    }
+}
+
 /* The registry's entry (ppb_mc_run_channels): without a cache, the hero run's results (the
  * same bytes as ppb_mc_trace_channels' tallies converted); with every channel's single-channel
  * reference in the cache (stored by ppb_method_mc), those references, no photon traced. */
@@ -337,6 +373,7 @@ int main(void)
         cmocka_unit_test(test_equal_channels_are_single_bytes),
         cmocka_unit_test(test_reproducible),
         cmocka_unit_test(test_run_channels_entry),
+        cmocka_unit_test(test_target_noise),
         cmocka_unit_test(test_skimmilk_agrees),
         cmocka_unit_test(test_density_step_g_agrees),
         cmocka_unit_test(test_spread_channels_agree),
