@@ -227,7 +227,8 @@ static void test_equal_channels_are_single_bytes(void **state)
     }
 }
 
-/* The same bytes whatever the work-group size and chunking (as tests/test_mc.c checks mc). */
+/* The same bytes whatever the work-group size, chunking and lanes (as tests/test_mc.c checks
+ * mc). */
 static void test_reproducible(void **state)
 {
     (void)state;
@@ -249,6 +250,21 @@ static void test_reproducible(void **state)
                          v == 0   ? "work-group size 16"
                          : v == 1 ? "4 chunks"
                                   : "7777-photon chunks");
+            ppb_mc_tallies_free(&t[c]);
+        }
+    }
+    /* Lanes per work-item (method_mc.c's device_shape; PPBENCH_MC_LANES): the exp and log of
+     * mc_rgb.cl are plain arithmetic, so no lane width changes a bit. */
+    for (int c = 0; c < 3; c++)
+        cfgs[c].mc.workgroup = 0, cfgs[c].mc.chunk = 0;
+    const char *lanes[4] = {"2", "4", "8", "16"};
+    for (int i = 0; i < 4; i++) {
+        setenv("PPBENCH_MC_LANES", lanes[i], 1);
+        trace_rgb(cfgs, 3, t);
+        unsetenv("PPBENCH_MC_LANES");
+        for (int c = 0; c < 3; c++) {
+            if (!ppb_mc_tallies_equal(&ref[c], &t[c]))
+                fail_msg("channel %d differs with %s lanes", c, lanes[i]);
             ppb_mc_tallies_free(&t[c]);
         }
     }
