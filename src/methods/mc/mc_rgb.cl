@@ -110,8 +110,8 @@ PPB_MC_HOT vfloat ppb_rgb_hg_cos(vfloat g, vfloat u)
  * in the same order on the hero's path, so equal channels give its bytes), with each channel's
  * density ratio and weight carried along. med[k * 6 + j]: channel k's sigma_t left/right,
  * 1/sigma_t left/right, alpha left/right, as mc.cl's medium[]. */
-PPB_MC_HOT void ppb_rgb_step(const ppb_mc_params *p, const ppb_mc_rgb_params *q,
-                             ppb_rgb_state *r, const float *med)
+PPB_MC_HOT void ppb_rgb_step(const ppb_mc_params *p, const ppb_mc_rgb_params *q, ppb_rgb_state *r,
+                             const float *med)
 {
     ppb_mc_state *s = &r->s;
     const float half_w = 0.5f * (float)p->med.width, sx = (float)p->med.step_x;
@@ -229,11 +229,11 @@ PPB_MC_HOT void ppb_rgb_step(const ppb_mc_params *p, const ppb_mc_rgb_params *q,
     vint survive = ppb_mc_uniform(c.v3) < 1.0f / PPB_MC_ROULETTE_M;
 #pragma unroll
     for (int k = 0; k < PPB_MC_NCH; k++) {
-        r->rgain[k] = r->rgain[k] + select((vfloat)0.0f, w[k] * (PPB_MC_ROULETTE_M - 1.0f),
-                                           roulette & survive);
+        r->rgain[k] = r->rgain[k] +
+                      select((vfloat)0.0f, w[k] * (PPB_MC_ROULETTE_M - 1.0f), roulette & survive);
         r->rloss[k] = r->rloss[k] + select((vfloat)0.0f, w[k], roulette & ~survive);
-        r->a[k] = select(r->a[k], select((vfloat)0.0f, r->a[k] * PPB_MC_ROULETTE_M, survive),
-                         roulette);
+        r->a[k] =
+            select(r->a[k], select((vfloat)0.0f, r->a[k] * PPB_MC_ROULETTE_M, survive), roulette);
     }
     amax = select(amax, select((vfloat)0.0f, amax * PPB_MC_ROULETTE_M, survive), roulette);
     vint dead = inter & (amax <= 0.0f);
@@ -270,9 +270,9 @@ PPB_MC_HOT uint ppb_rgb_refill(const ppb_mc_params *p, ppb_rgb_state *r, ppb_mc_
 
 /* Tallies every finished lane once per channel through mc.cl's ppb_mc_tally, with the channel's
  * weight W_k and its capture and roulette sums in place of the state's. */
-PPB_MC_HOT void ppb_rgb_tally(const ppb_mc_params *p, const ppb_mc_edges *e,
-                              const ppb_rgb_state *r, ppb_mc_pending *pend, ppb_mc_sums *sums,
-                              __global ulong *const *base, __global ulong *spare)
+PPB_MC_HOT void ppb_rgb_tally(const ppb_mc_params *p, const ppb_mc_edges *e, const ppb_rgb_state *r,
+                              ppb_mc_pending *pend, ppb_mc_sums *sums, __global ulong *const *base,
+                              __global ulong *spare)
 {
     vfloat w[PPB_MC_NCH];
     ppb_rgb_weights(r, w);
