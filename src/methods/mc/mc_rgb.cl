@@ -195,7 +195,7 @@ PPB_MC_HOT void ppb_rgb_step(const ppb_mc_params *p, const ppb_mc_rgb_params *q,
         vfloat gk[PPB_MC_NCH], lk[PPB_MC_NCH];
 #pragma unroll
         for (int k = 0; k < PPB_MC_NCH; k++)
-            gk[k] = (vfloat)q->g[k];
+            gk[k] = (vfloat)(fabs(q->g[k]) < 1e-4f ? 0.0f : q->g[k]); /* as the sampler draws */
         vfloat gh = ppb_rgb_pick(gk, r->hero);
         ct = ppb_rgb_hg_cos(gh, ppb_mc_uniform(c.v1));
         /* log HG(ct; g) = log(1 - g^2) - 1.5 log(1 + g^2 - 2 g ct) + const */

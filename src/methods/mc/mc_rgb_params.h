@@ -23,8 +23,9 @@ typedef struct ppb_mc_rgb_params {
     float sigma_t[PPB_MC_MAX_CH][2];
     float log_sigma_t[PPB_MC_MAX_CH][2]; /* log of the float sigma_t, rounded from double */
     float albedo[PPB_MC_MAX_CH][2];
-    /* HG asymmetry (|g| < 1e-4 is 0: the sampler draws isotropic directions there) and
-     * log(1 - g^2), the normalisation in the phase ratio. */
+    /* HG asymmetry as the config gives it (where the channels' g differ the kernel takes
+     * |g| < 1e-4 as 0, as the HG sampler then draws isotropic directions) and log(1 - g^2) of
+     * that g, the normalisation in the phase ratio. */
     float g[PPB_MC_MAX_CH];
     float log_1mg2[PPB_MC_MAX_CH];
     int same_g; /* every channel has the same g: no phase ratio, mc.cl's scalar HG sampler */
