@@ -110,10 +110,13 @@ static int check_settings(const ppb_config *cfg, long long first, long long coun
     /* Fixed-point headroom (kernels/mc_params.h): fewer than 2^31 photons per batch; with
      * several channels a weight reaches nch times a single run's (mc_rgb.cl), so 2^29. */
     uint64_t per_batch = (uint64_t)count / (uint64_t)t->batches + 1;
+    int bits = nch > 1 ? 29 : 31;
     for (int b = 0; b < t->batches; b++)
-        if (t->photons[b] + per_batch >= ((uint64_t)1 << (nch > 1 ? 29 : 31)))
-            return ppb_fail(err, "mc: more than 2^31 photons per batch would overflow the "
-                                 "fixed-point tallies; raise [mc] batches");
+        if (t->photons[b] + per_batch >= ((uint64_t)1 << bits))
+            return ppb_fail(err,
+                            "mc: more than 2^%d photons per batch would overflow the "
+                            "fixed-point tallies; raise [mc] batches",
+                            bits);
     return 0;
 }
 
