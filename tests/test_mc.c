@@ -65,15 +65,6 @@ static void assert_within(double value, double expected, double bound, const cha
         fail_msg("%s: %.6f, expected %.6f +- %.6f", what, value, expected, bound);
 }
 
-static int same_tallies(const ppb_mc_tallies *a, const ppb_mc_tallies *b)
-{
-    size_t nb = (size_t)a->batches;
-    return a->batches == b->batches && a->ncells == b->ncells &&
-           !memcmp(a->photons, b->photons, nb * sizeof *a->photons) &&
-           !memcmp(a->totals, b->totals, nb * PPB_MC_NTOT * sizeof *a->totals) &&
-           !memcmp(a->cells, b->cells, nb * PPB_MC_NTALLY * a->ncells * sizeof *a->cells);
-}
-
 /* Chandrasekhar's H-function of isotropic scattering with albedo alpha at mu, from
  * H(mu) = 1 + (alpha/2) mu H(mu) int_0^1 H(mu') / (mu + mu') dmu' (Chandrasekhar, Radiative
  * Transfer, 1960), iterated to a fixed point on n Gauss-Legendre nodes of [0, 1] (testutil.h's
@@ -296,7 +287,7 @@ static void test_bit_identical(void **state)
     for (int i = 0; i < 3; i++) {
         f.cfg.mc.workgroup = wgs[i];
         trace(&f, 0, n, &t);
-        if (!same_tallies(&ref, &t))
+        if (!ppb_mc_tallies_equal(&ref, &t))
             fail_msg("tallies differ with work-group size %d", wgs[i]);
         ppb_mc_tallies_free(&t);
     }
@@ -308,18 +299,18 @@ static void test_bit_identical(void **state)
         setenv("PPBENCH_MC_LANES", lanes[i], 1);
         trace(&f, 0, n, &t);
         unsetenv("PPBENCH_MC_LANES");
-        if (!same_tallies(&ref, &t))
+        if (!ppb_mc_tallies_equal(&ref, &t))
             fail_msg("tallies differ with %s lanes", lanes[i]);
         ppb_mc_tallies_free(&t);
     }
     f.cfg.mc.chunk = n / 4;
     trace(&f, 0, n, &t);
-    if (!same_tallies(&ref, &t))
+    if (!ppb_mc_tallies_equal(&ref, &t))
         fail_msg("tallies differ with 4 chunks");
     ppb_mc_tallies_free(&t);
     f.cfg.mc.chunk = 7777; /* uneven chunks, the last one short */
     trace(&f, 0, n, &t);
-    if (!same_tallies(&ref, &t))
+    if (!ppb_mc_tallies_equal(&ref, &t))
         fail_msg("tallies differ with 7777-photon chunks");
     ppb_mc_tallies_free(&t);
     f.cfg.mc.chunk = 0;
@@ -338,9 +329,9 @@ static void test_bit_identical(void **state)
     assert_int_equal(ppb_mc_tallies_load(&la, pa, &err), 0);
     assert_int_equal(ppb_mc_tallies_load(&lb, pb, &err), 0);
     assert_int_equal(ppb_mc_tallies_add(&lb, &la, &err), 0); /* b + a */
-    assert_true(same_tallies(&ref, &lb));
+    assert_true(ppb_mc_tallies_equal(&ref, &lb));
     assert_int_equal(ppb_mc_tallies_add(&a, &b, &err), 0); /* a + b, in memory */
-    assert_true(same_tallies(&ref, &a));
+    assert_true(ppb_mc_tallies_equal(&ref, &a));
 
     /* ... and so the same radiance bytes. */
     ppb_layout lo = ppb_scene_layout(&sc);
@@ -402,7 +393,7 @@ static void test_seeds(void **state)
     trace(&f, 0, n, &t1);
     f.cfg.mc.seed = 2;
     trace(&f, 0, n, &t2);
-    assert_false(same_tallies(&t1, &t2));
+    assert_false(ppb_mc_tallies_equal(&t1, &t2));
     f.cfg.mc.seed = 1;
     ppb_mc_totals_stats s1 = totals_of(&f, &t1, 0), s2 = totals_of(&f, &t2, 0);
     assert_within(s1.mean.R, s2.mean.R, 4 * hypot(s1.se.R, s2.se.R), "R, seed 1 vs 2");

@@ -118,6 +118,15 @@ static int add_array(uint64_t *dst, const uint64_t *src, size_t n)
     return 0;
 }
 
+int ppb_mc_tallies_equal(const ppb_mc_tallies *a, const ppb_mc_tallies *b)
+{
+    size_t nb = (size_t)a->batches;
+    return a->batches == b->batches && a->ncells == b->ncells &&
+           !memcmp(a->photons, b->photons, nb * sizeof *a->photons) &&
+           !memcmp(a->totals, b->totals, nb * PPB_MC_NTOT * sizeof *a->totals) &&
+           !memcmp(a->cells, b->cells, nb * PPB_MC_NTALLY * a->ncells * sizeof *a->cells);
+}
+
 int ppb_mc_tallies_add(ppb_mc_tallies *dst, const ppb_mc_tallies *src, ppb_err *err)
 {
     if (dst->fingerprint != src->fingerprint || dst->ncells != src->ncells)

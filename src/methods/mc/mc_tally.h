@@ -48,6 +48,10 @@ void ppb_mc_tallies_count_range(ppb_mc_tallies *t, uint64_t first, uint64_t coun
 /* Whether the photons per batch are those of the range [first, first + count): 1 or 0. */
 int ppb_mc_tallies_range_matches(const ppb_mc_tallies *t);
 
+/* 1 when a and b hold the same photons, totals and cells bit for bit (the reproducibility
+ * checks: work-group sizes, chunkings, shards, channels), else 0. */
+int ppb_mc_tallies_equal(const ppb_mc_tallies *a, const ppb_mc_tallies *b);
+
 /* dst += src, refusing tallies of another scene, seed or batch count, and overflow. */
 int ppb_mc_tallies_add(ppb_mc_tallies *dst, const ppb_mc_tallies *src, ppb_err *err);
 

@@ -89,27 +89,34 @@ static ppb_mc_params make_params(const ppb_config *cfg)
     return p;
 }
 
+/* nch channels' tallies t[0 .. nch - 1]; the fingerprint is checked for the first, whose scene
+ * cfg is (the others' media differ: ppb_mc_trace_channels). */
 static int check_settings(const ppb_config *cfg, long long first, long long count,
-                          const ppb_mc_tallies *t, ppb_err *err)
+                          const ppb_mc_tallies *t, int nch, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     if (first < 0 || count < 0)
         return ppb_fail(err, "mc: photon range [%lld, +%lld) is negative", first, count);
-    if (cfg->mc.batches != t->batches || (uint64_t)cfg->mc.seed != t->seed ||
-        ppb_mc_scene_fingerprint(sc) != t->fingerprint)
-        return ppb_fail(err, "mc: tallies were made for another scene, seed or batch count");
+    for (int c = 0; c < nch; c++)
+        if (cfg->mc.batches != t[c].batches || (uint64_t)cfg->mc.seed != t[c].seed ||
+            (c == 0 && ppb_mc_scene_fingerprint(sc) != t->fingerprint))
+            return ppb_fail(err, "mc: tallies were made for another scene, seed or batch count");
     if (sc->geometry == PPB_GEOM_SLAB && sc->step != PPB_STEP_NONE)
         return ppb_fail(err, "mc: steps are not defined in slab mode (docs/reference.md)");
     if (sc->theta_deg < 0 || sc->theta_deg >= 90)
         return ppb_fail(err, "mc: theta_deg must lie in [0, 90) (got %g)", sc->theta_deg);
     if (sc->sigma_t <= 0 || (sc->step == PPB_STEP_DENSITY && sc->sigma_t_right <= 0))
         return ppb_fail(err, "mc: sigma_t must be positive");
-    /* Fixed-point headroom (kernels/mc_params.h): fewer than 2^31 photons per batch. */
+    /* Fixed-point headroom (kernels/mc_params.h): fewer than 2^31 photons per batch; with
+     * several channels a weight reaches nch times a single run's (mc_rgb.cl), so 2^29. */
     uint64_t per_batch = (uint64_t)count / (uint64_t)t->batches + 1;
+    int bits = nch > 1 ? 29 : 31;
     for (int b = 0; b < t->batches; b++)
-        if (t->photons[b] + per_batch >= ((uint64_t)1 << 31))
-            return ppb_fail(err, "mc: more than 2^31 photons per batch would overflow the "
-                                 "fixed-point tallies; raise [mc] batches");
+        if (t->photons[b] + per_batch >= ((uint64_t)1 << bits))
+            return ppb_fail(err,
+                            "mc: more than 2^%d photons per batch would overflow the "
+                            "fixed-point tallies; raise [mc] batches",
+                            bits);
     return 0;
 }
 
@@ -195,19 +202,21 @@ typedef struct mc_run {
     ppb_ocl *ocl;
     const mc_shape *shape;
     mc_device *d;
-    size_t local;       /* work-group size */
-    long long chunk;    /* photons per launch */
-    long long first;    /* first photon of the range */
-    ppb_mc_params p;    /* first and count change per launch */
-    ppb_mc_tallies *t;  /* the caller's tallies: the device's are added to them at the end */
-    ppb_mc_tallies tmp; /* host copy of the device's tallies, shaped like t */
+    size_t local;      /* work-group size */
+    long long chunk;   /* photons per launch */
+    long long first;   /* first photon of the range */
+    ppb_mc_params p;   /* first and count change per launch */
+    int nch;           /* channels: 1 (mc.cl) or more (mc_rgb.cl, tallies one after another) */
+    ppb_mc_tallies *t; /* the caller's tallies, t[0 .. nch - 1]: the device's are added to
+                          them at the end */
+    ppb_mc_tallies tmp[PPB_MC_MAX_CH]; /* host copy of the device's tallies, shaped like t */
 } mc_run;
 
 /* The kernel adds into the device tallies launch after launch, so they start at zero and stay
  * bound to the kernel for the whole trace. */
 static int create_buffers(mc_run *r, ppb_err *err)
 {
-    size_t cb = cell_bytes(r->t), tb = total_bytes(r->t);
+    size_t cb = cell_bytes(r->t) * (size_t)r->nch, tb = total_bytes(r->t) * (size_t)r->nch;
     mc_device *d = r->d;
     cl_int rc;
     d->cells = clCreateBuffer(r->ocl->context, CL_MEM_READ_WRITE, cb, NULL, &rc);
@@ -269,8 +278,9 @@ static int prepare_run(mc_run *r, ppb_err *err)
     if (create_buffers(r, err) || pick_workgroup(r->cfg, r->ocl, r->shape, &r->local, err))
         return -1;
     r->chunk = r->cfg->mc.chunk > 0 ? r->cfg->mc.chunk : auto_chunk(r->shape);
-    if (alloc_host_copy(r->t, &r->tmp, err))
-        return -1;
+    for (int c = 0; c < r->nch; c++)
+        if (alloc_host_copy(&r->t[c], &r->tmp[c], err))
+            return -1;
     r->p = make_params(r->cfg);
     return 0;
 }
@@ -279,17 +289,20 @@ static int prepare_run(mc_run *r, ppb_err *err)
  * photons, so the per-batch counts are rebuilt from the range (batch = index % batches). */
 static int read_tallies(mc_run *r, long long done, ppb_err *err)
 {
-    ppb_mc_tallies *tmp = &r->tmp;
-    memset(tmp->photons, 0, (size_t)tmp->batches * sizeof *tmp->photons);
-    ppb_mc_tallies_count_range(tmp, (uint64_t)r->first, (uint64_t)done);
-    cl_command_queue q = r->ocl->queue;
-    if (ppb_cl_check(clEnqueueReadBuffer(q, r->d->cells, CL_TRUE, 0, cell_bytes(tmp), tmp->cells, 0,
-                                         NULL, NULL),
-                     "clEnqueueReadBuffer(mc cells)", err) ||
-        ppb_cl_check(clEnqueueReadBuffer(q, r->d->totals, CL_TRUE, 0, total_bytes(tmp), tmp->totals,
-                                         0, NULL, NULL),
-                     "clEnqueueReadBuffer(mc totals)", err))
-        return -1;
+    for (int c = 0; c < r->nch; c++) {
+        ppb_mc_tallies *tmp = &r->tmp[c];
+        memset(tmp->photons, 0, (size_t)tmp->batches * sizeof *tmp->photons);
+        ppb_mc_tallies_count_range(tmp, (uint64_t)r->first, (uint64_t)done);
+        cl_command_queue q = r->ocl->queue;
+        size_t cb = cell_bytes(tmp), tb = total_bytes(tmp);
+        if (ppb_cl_check(clEnqueueReadBuffer(q, r->d->cells, CL_TRUE, cb * (size_t)c, cb,
+                                             tmp->cells, 0, NULL, NULL),
+                         "clEnqueueReadBuffer(mc cells)", err) ||
+            ppb_cl_check(clEnqueueReadBuffer(q, r->d->totals, CL_TRUE, tb * (size_t)c, tb,
+                                             tmp->totals, 0, NULL, NULL),
+                         "clEnqueueReadBuffer(mc totals)", err))
+            return -1;
+    }
     return 0;
 }
 
@@ -315,13 +328,18 @@ static int noise_now(const ppb_config *cfg, const ppb_mc_tallies *t, ppb_mc_tall
     return 0;
 }
 
-/* Whether the first done photons already meet cfg->mc.target_noise. */
+/* Whether the first done photons already meet cfg->mc.target_noise (every channel). */
 static int noise_reached(mc_run *r, long long done, int *reached, ppb_err *err)
 {
-    double noise;
-    if (read_tallies(r, done, err) || noise_now(r->cfg, r->t, &r->tmp, &noise, err))
+    if (read_tallies(r, done, err))
         return -1;
-    *reached = noise < r->cfg->mc.target_noise;
+    *reached = 1;
+    for (int c = 0; c < r->nch; c++) {
+        double noise;
+        if (noise_now(r->cfg, &r->t[c], &r->tmp[c], &noise, err))
+            return -1;
+        *reached = *reached && noise < r->cfg->mc.target_noise;
+    }
     return 0;
 }
 
@@ -399,10 +417,11 @@ static int trace_timed(mc_run *r, int quiet, long long count, long long *done,
 /* The device's tallies reach t in one addition at the end, so a trace that fails on the way
  * leaves t as it was. */
 static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape, mc_device *d,
-                           long long first, long long count, ppb_mc_tallies *t,
+                           long long first, long long count, ppb_mc_tallies *t, int nch,
                            ppb_mc_trace_info *info, ppb_err *err)
 {
-    mc_run r = {.cfg = ctx->cfg, .ocl = ocl, .shape = shape, .d = d, .first = first, .t = t};
+    mc_run r = {
+        .cfg = ctx->cfg, .ocl = ocl, .shape = shape, .d = d, .first = first, .t = t, .nch = nch};
     long long done = 0;
     int status = prepare_run(&r, err);
     if (status == 0)
@@ -410,21 +429,28 @@ static int trace_on_device(ppb_run_ctx *ctx, ppb_ocl *ocl, const mc_shape *shape
     if (status == 0) {
         info->traced = done;
         status = read_tallies(&r, done, err);
-        if (status == 0)
-            status = ppb_mc_tallies_add(t, &r.tmp, err);
+        /* every channel's tallies are added only once all are read: t changes whole or not */
+        for (int c = 0; c < nch && status == 0; c++)
+            status = ppb_mc_tallies_add(&t[c], &r.tmp[c], err);
     }
-    ppb_mc_tallies_free(&r.tmp);
+    for (int c = 0; c < nch; c++)
+        ppb_mc_tallies_free(&r.tmp[c]);
     return status;
 }
 
-int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
-                 ppb_mc_trace_info *info, ppb_err *err)
+/* ppb_mc_trace and ppb_mc_trace_channels: the one kernel (mc.cl, ch NULL) or the other
+ * (mc_rgb.cl with ch as its extra argument). */
+static int trace_kernel(ppb_run_ctx *ctx, const ppb_mc_rgb_params *ch, long long first,
+                        long long count, ppb_mc_tallies *t, ppb_mc_trace_info *info, ppb_err *err)
 {
+    int nch = ch ? ch->nch : 1;
     ppb_mc_trace_info local_info;
     if (!info)
         info = &local_info;
     memset(info, 0, sizeof *info);
-    if (check_settings(ctx->cfg, first, count, t, err))
+    if (nch < 1 || nch > PPB_MC_MAX_CH)
+        return ppb_fail(err, "mc: %d channels (1 to %d)", nch, PPB_MC_MAX_CH);
+    if (check_settings(ctx->cfg, first, count, t, nch, err))
         return -1;
     ppb_ocl *ocl;
     if (ppb_ctx_ocl(ctx, &ocl, err))
@@ -439,31 +465,79 @@ int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tall
     mc_shape shape;
     if (device_shape(ocl, &shape, err))
         return -1;
-    char opts[64];
-    snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d -D PPB_MC_CPU_PREFETCH=%d", shape.lanes,
-             shape.cpu);
+    char opts[96];
+    int n = snprintf(opts, sizeof opts, "-D PPB_MC_LANES=%d -D PPB_MC_CPU_PREFETCH=%d", shape.lanes,
+                     shape.cpu);
+    if (ch)
+        snprintf(opts + n, sizeof opts - (size_t)n, " -D PPB_MC_NCH=%d", nch);
     mc_device d = {0};
-    int status = ppb_ocl_build(ocl, PPB_MC_KERNEL, opts, &d.prog, err);
+    int status = ppb_ocl_build(ocl, ch ? PPB_MC_RGB_KERNEL : PPB_MC_KERNEL, opts, &d.prog, err);
     if (status == 0)
-        status = ppb_ocl_kernel(d.prog, "ppb_mc_trace_kernel", &d.kernel, err);
+        status = ppb_ocl_kernel(d.prog, ch ? "ppb_mc_rgb_kernel" : "ppb_mc_trace_kernel", &d.kernel,
+                                err);
+    if (status == 0 && ch)
+        status = ppb_cl_check(clSetKernelArg(d.kernel, PPB_MC_RGB_ARG_CHANNELS, sizeof *ch, ch),
+                              "clSetKernelArg(mc channels)", err);
     if (status == 0)
-        status = trace_on_device(ctx, ocl, &shape, &d, first, count, t, info, err);
+        status = trace_on_device(ctx, ocl, &shape, &d, first, count, t, nch, info, err);
     mc_device_release(&d);
     return status;
+}
+
+int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
+                 ppb_mc_trace_info *info, ppb_err *err)
+{
+    return trace_kernel(ctx, NULL, first, count, t, info, err);
+}
+
+int ppb_mc_trace_channels(ppb_run_ctx *ctx, const ppb_mc_rgb_params *ch, long long first,
+                          long long count, ppb_mc_tallies *t, ppb_mc_trace_info *info, ppb_err *err)
+{
+    return trace_kernel(ctx, ch, first, count, t, info, err);
+}
+
+/* The tallies live three times (host, its copy read back for noise checks, the device
+ * buffer), each batches x 2 tallies x cells of 8 bytes per channel; checked before any work. */
+static int check_memory(const ppb_config *cfg, int nch, ppb_err *err)
+{
+    double tally = (double)nch * cfg->mc.batches * PPB_MC_NTALLY *
+                   (double)ppb_scene_layout(&cfg->scene).ncells * sizeof(uint64_t);
+    char detail[128];
+    if (nch > 1)
+        snprintf(detail, sizeof detail, "tallies of %d channels x %d batches, %.3g GB x 3", nch,
+                 cfg->mc.batches, tally / 1e9);
+    else
+        snprintf(detail, sizeof detail, "tallies of %d batches, %.3g GB x 3", cfg->mc.batches,
+                 tally / 1e9);
+    return ppb_memory_check(3.0 * tally, cfg->memory_limit, "mc", detail, err);
+}
+
+/* Said, not hidden: interactions past the event cap were rouletted (mc_params.h). */
+static void note_capped(const ppb_config *cfg, const ppb_mc_tallies *t)
+{
+    uint64_t capped = 0;
+    for (int b = 0; b < t->batches; b++)
+        capped += t->totals[(size_t)b * PPB_MC_NTOT + PPB_MC_T_CAPPED];
+    if (capped)
+        fprintf(stderr,
+                "%s: mc: note: %llu interactions past the event cap of %d scatterings per "
+                "photon were Russian-rouletted (unbiased; it bounds the work per photon)\n",
+                cfg->name, (unsigned long long)capped, PPB_MC_EVENT_CAP);
+}
+
+/* study-score's switch (docs/reference.md, Keys: shipped references): 1 when no reference may
+ * be traced unasked. */
+static int no_trace(void)
+{
+    const char *v = getenv("PPBENCH_MC_NO_TRACE");
+    return v && strcmp(v, "1") == 0;
 }
 
 int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
     ppb_mc_tallies t;
-    /* The tallies live three times (host, its copy read back for noise checks, the
-     * device buffer), each batches x 2 tallies x cells of 8 bytes; estimated first. */
-    double tally = (double)cfg->mc.batches * PPB_MC_NTALLY *
-                   (double)ppb_scene_layout(&cfg->scene).ncells * sizeof(uint64_t);
-    char detail[128];
-    snprintf(detail, sizeof detail, "tallies of %d batches, %.3g GB x 3", cfg->mc.batches,
-             tally / 1e9);
-    if (ppb_memory_check(3.0 * tally, cfg->memory_limit, "mc", detail, err))
+    if (check_memory(cfg, 1, err))
         return -1;
     ppb_mc_trace_info info = {0};
     int status = 0;
@@ -480,7 +554,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
                     (unsigned long long)t.count,
                     ctx->mc_reference_shipped ? "shipped reference" : "reference cache",
                     ctx->mc_reference_shipped ? ctx->mc_reference : ctx->ref_cache);
-    } else if (getenv("PPBENCH_MC_NO_TRACE") && strcmp(getenv("PPBENCH_MC_NO_TRACE"), "1") == 0) {
+    } else if (no_trace()) {
         /* study-score: a reference neither cached nor shipped is not traced unasked
          * (docs/reference.md, Keys: shipped references). */
         return ppb_fail(err,
@@ -496,15 +570,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
             ppb_mc_cache_put(ctx, chunk, &t, info.traced);
     }
     if (status == 0) {
-        /* Said, not hidden: interactions past the event cap were rouletted (mc_params.h). */
-        uint64_t capped = 0;
-        for (int b = 0; b < t.batches; b++)
-            capped += t.totals[(size_t)b * PPB_MC_NTOT + PPB_MC_T_CAPPED];
-        if (capped)
-            fprintf(stderr,
-                    "%s: mc: note: %llu interactions past the event cap of %d scatterings per "
-                    "photon were Russian-rouletted (unbiased; it bounds the work per photon)\n",
-                    cfg->name, (unsigned long long)capped, PPB_MC_EVENT_CAP);
+        note_capped(cfg, &t);
         ppb_mc_tallies_to_results(&t, &cfg->scene, &out[0], &out[1]);
         for (int i = 0; i < 2; i++) {
             out[i].partial = info.interrupted;
@@ -512,6 +578,136 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
         }
     }
     ppb_mc_tallies_free(&t);
+    return status;
+}
+
+/* Whether a and b trace the same photons (everything of [mc] but nothing else). */
+static int same_mc_settings(const ppb_mc_settings *a, const ppb_mc_settings *b)
+{
+    return a->photons == b->photons && a->batches == b->batches && a->seed == b->seed &&
+           a->workgroup == b->workgroup && a->chunk == b->chunk && a->first == b->first &&
+           a->target_noise == b->target_noise;
+}
+
+int ppb_mc_rgb_params_of(const ppb_config *cfgs, int nch, ppb_mc_rgb_params *ch, ppb_err *err)
+{
+    if (nch < 1 || nch > PPB_MC_MAX_CH)
+        return ppb_fail(err, "mc: %d channels in one run (1 to %d)", nch, PPB_MC_MAX_CH);
+    memset(ch, 0, sizeof *ch);
+    ch->nch = nch;
+    ch->same_g = 1;
+    const ppb_scene *s0 = &cfgs[0].scene;
+    uint64_t fp0 = ppb_mc_scene_fingerprint(s0);
+    for (int c = 0; c < nch; c++) {
+        const ppb_scene *sc = &cfgs[c].scene;
+        /* Channel c's scene with channel 0's coefficients must be channel 0's scene. */
+        ppb_scene same = *sc;
+        same.sigma_t = s0->sigma_t, same.sigma_t_right = s0->sigma_t_right;
+        same.albedo = s0->albedo, same.albedo_right = s0->albedo_right, same.g = s0->g;
+        if (ppb_mc_scene_fingerprint(&same) != fp0)
+            return ppb_fail(err,
+                            "mc: channel %d's experiment differs from channel 0's beyond the "
+                            "medium's sigma_t, albedo and g (geometry, step, n, light or bins): "
+                            "one path per photon serves every channel only in the same tube",
+                            c);
+        if (!same_mc_settings(&cfgs[c].mc, &cfgs[0].mc))
+            return ppb_fail(err,
+                            "mc: channel %d's [mc] settings differ from channel 0's: the "
+                            "channels are traced by the same photons",
+                            c);
+        if (sc->sigma_t <= 0 || (sc->step == PPB_STEP_DENSITY && sc->sigma_t_right <= 0))
+            return ppb_fail(err, "mc: channel %d: sigma_t must be positive", c);
+        /* The float values mc.cl reads (its medium[] array), and the logarithm of the float
+         * sigma_t for the density ratio sigma_k / sigma_h (mc_rgb.cl). */
+        ppb_medium M = ppb_medium_of(sc);
+        for (int side = 0; side < 2; side++) {
+            double x = side ? M.step_x : M.step_x - 1.0;
+            ch->sigma_t[c][side] = (float)ppb_medium_sigma_t(&M, x);
+            ch->log_sigma_t[c][side] = (float)log((double)ch->sigma_t[c][side]);
+            ch->albedo[c][side] = (float)ppb_medium_albedo(&M, x);
+        }
+        ch->g[c] = (float)sc->g;
+        double g = fabs(ch->g[c]) < 1e-4f ? 0.0 : (double)ch->g[c]; /* as the sampler uses it */
+        ch->log_1mg2[c] = (float)log(1.0 - g * g);
+        ch->same_g = ch->same_g && ch->g[c] == ch->g[0];
+    }
+    return 0;
+}
+
+/* Every channel's single-channel reference from the cache or the shipped layer (mc_cache.h),
+ * into t: 1 when all nch are there (ctx->mc_reference then names the last), else 0 with t
+ * freed. */
+static int cached_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_mc_tallies *t,
+                           ppb_err *err)
+{
+    if (!ctx->ref_cache)
+        return 0;
+    const ppb_config *own = ctx->cfg;
+    int found = 0;
+    for (; found < nch; found++) {
+        long long chunk = 0;
+        ctx->cfg = &cfgs[found];
+        if (cfgs[found].mc.target_noise > 0 && ppb_mc_chunk(ctx, &chunk, err))
+            break;
+        if (!ppb_mc_cache_get(ctx, chunk, &t[found]))
+            break;
+    }
+    ctx->cfg = own;
+    if (found == nch)
+        return 1;
+    for (int c = 0; c < found; c++)
+        ppb_mc_tallies_free(&t[c]);
+    ctx->mc_reference[0] = '\0';
+    ctx->mc_reference_shipped = 0;
+    return 0;
+}
+
+int ppb_mc_run_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_result *out,
+                        ppb_err *err)
+{
+    ppb_mc_rgb_params ch;
+    if (ppb_mc_rgb_params_of(cfgs, nch, &ch, err) || check_memory(&cfgs[0], nch, err))
+        return -1;
+    ctx->mc_reference[0] = '\0';
+    ctx->mc_shipped_key[0] = '\0';
+    ctx->mc_reference_shipped = 0;
+    ppb_mc_tallies t[PPB_MC_MAX_CH];
+    memset(t, 0, sizeof t);
+    ppb_mc_trace_info info = {0};
+    int status = 0;
+    if (cached_channels(ctx, cfgs, nch, t, err)) {
+        /* Each channel's own reference was traced before: those, not a new trace. */
+        if (ctx->quiet < 2)
+            fprintf(stderr, "%s: mc: %d channels' references from the %s, 0 traced\n", cfgs[0].name,
+                    nch, ctx->mc_reference_shipped ? "shipped references" : "reference cache");
+    } else if (no_trace()) {
+        return ppb_fail(err,
+                        "mc: no reference for every channel in the cache (%s) nor the "
+                        "shipped layer (%s), and PPBENCH_MC_NO_TRACE=1: nothing traced "
+                        "(set PPBENCH_MC_NO_TRACE=0 to trace it)",
+                        ctx->ref_cache ? ctx->ref_cache : "none", ppb_mc_shipped_dir());
+    } else {
+        /* Traced by hero sampling, and not stored (docs/methods.md says why). */
+        for (int c = 0; c < nch && status == 0; c++)
+            status = ppb_mc_tallies_init(&t[c], &cfgs[c].scene, (uint64_t)cfgs[c].mc.seed,
+                                         cfgs[c].mc.batches, err);
+        const ppb_config *own = ctx->cfg;
+        ctx->cfg = &cfgs[0]; /* the trace's scene and settings; the media come from ch */
+        if (status == 0)
+            status = ppb_mc_trace_channels(ctx, &ch, cfgs[0].mc.first, cfgs[0].mc.photons, t, &info,
+                                           err);
+        ctx->cfg = own;
+    }
+    for (int c = 0; c < nch && status == 0; c++) {
+        note_capped(&cfgs[c], &t[c]);
+        ppb_mc_tallies_to_results(&t[c], &cfgs[c].scene, &out[2 * c], &out[2 * c + 1]);
+        for (int i = 2 * c; i < 2 * c + 2; i++) {
+            out[i].partial = info.interrupted;
+            out[i].photons = info.traced;
+        }
+    }
+    for (int c = 0; c < nch; c++)
+        ppb_mc_tallies_free(&t[c]);
     return status;
 }
 

@@ -9,8 +9,12 @@
 
 #include <stdio.h>
 
+#include "methods/mc/mc_rgb_params.h"
 #include "methods/mc/mc_tally.h"
 #include "methods/method.h"
+
+/* The multi-channel kernel, in the source tree (runtime/ocl.h); it includes mc.cl. */
+#define PPB_MC_RGB_KERNEL "src/methods/mc/mc_rgb.cl"
 
 /* The method: traces cfg->mc.photons photons starting at cfg->mc.first and fills out[0] (mc)
  * and out[1] (mc1). Interrupted runs are marked partial with the photons actually traced. */
@@ -33,6 +37,25 @@ typedef struct ppb_mc_trace_info {
  * a run of that many photons. info may be NULL. */
 int ppb_mc_trace(ppb_run_ctx *ctx, long long first, long long count, ppb_mc_tallies *t,
                  ppb_mc_trace_info *info, ppb_err *err);
+
+/* ppb_mc_trace for ch->nch channels at once by hero-channel sampling (mc_rgb.cl; docs/methods.md,
+ * Monte Carlo: several channels in one run): ctx->cfg is channel 0's experiment (everything but
+ * the media, which ch holds), t[c] channel c's tallies (ppb_mc_tallies_init with channel c's
+ * scene). The same photon range, chunks, stops and reproducibility as ppb_mc_trace; t changes
+ * only when the trace succeeds. */
+int ppb_mc_trace_channels(ppb_run_ctx *ctx, const ppb_mc_rgb_params *ch, long long first,
+                          long long count, ppb_mc_tallies *t, ppb_mc_trace_info *info,
+                          ppb_err *err);
+
+/* The channels' media of cfgs[0 .. nch - 1] for ppb_mc_trace_channels; refuses, naming the
+ * channel, experiments that differ in anything but the medium's sigma_t, albedo and g (both
+ * sides of a step) or in their [mc] settings, and nch outside 1 .. PPB_MC_MAX_CH. */
+int ppb_mc_rgb_params_of(const ppb_config *cfgs, int nch, ppb_mc_rgb_params *ch, ppb_err *err);
+
+/* The registry's run_channels for mc (method.h): every channel's mc and mc1 from one trace,
+ * out[2 c] and out[2 c + 1]. Not cached (docs/methods.md says why). */
+int ppb_mc_run_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_result *out,
+                        ppb_err *err);
 
 /* Expected scattering events per photon at cfg's medium (an order of magnitude). */
 double ppb_mc_events_per_photon(const ppb_config *cfg);

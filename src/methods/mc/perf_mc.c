@@ -6,6 +6,7 @@
 
 #include "base/csv_read.h"
 #include "methods/mc/method_mc.h"
+#include "model/materials.h"
 #include "model/metrics.h"
 
 /* Photons per timed case: enough for a few seconds on a 2-core CPU (the launches then dominate
@@ -131,6 +132,87 @@ static int have_pmcxcl(void)
     return system("python3 -c 'import pmcxcl' >/dev/null 2>&1") == 0;
 }
 
+/* The multi-channel cases: a material of Jensen et al. 2001 (per mm, its n) in a W x H mm tube,
+ * its three channels traced by one hero-sampled run (ppb_mc_trace_channels) and by three
+ * single-channel runs of the same photons each. Per channel: the Table 2 noise of each and the
+ * noise the separate run would have had in a third of the hero run's time (noise falls as
+ * 1/sqrt(time)), so that "equal time" compares one hero run with three runs sharing its time. */
+static int perf_channels(ppb_run_ctx *ctx, const char *material, double w, double h,
+                         long long photons, FILE *out, ppb_err *err)
+{
+    ppb_config cfgs[3];
+    const ppb_material *m = ppb_material_find(material);
+    if (!m)
+        return ppb_fail(err, "perf: %s is not in the materials table", material);
+    for (int c = 0; c < 3; c++) {
+        if (perf_config(ctx, 0.0, &cfgs[c], err))
+            return -1;
+        ppb_scene *sc = &cfgs[c].scene;
+        sc->width = w, sc->height = h, sc->step = PPB_STEP_NONE;
+        ppb_material_medium(m, (ppb_channel)c, &sc->sigma_t, &sc->albedo, &sc->g, &sc->n);
+    }
+    ppb_mc_rgb_params ch;
+    if (ppb_mc_rgb_params_of(cfgs, 3, &ch, err))
+        return -1;
+    ppb_run_ctx sub = *ctx;
+    sub.cfg = &cfgs[0];
+    sub.quiet = 1;
+    ppb_mc_tallies t[3];
+    memset(t, 0, sizeof t);
+    int rc = 0;
+    for (int c = 0; c < 3 && rc == 0; c++)
+        rc = ppb_mc_tallies_init(&t[c], &cfgs[c].scene, (uint64_t)cfgs[c].mc.seed,
+                                 cfgs[c].mc.batches, err);
+    ppb_mc_trace_info info;
+    /* Warm-up (the kernel's build), then the timed run. */
+    if (rc == 0)
+        rc = ppb_mc_trace_channels(&sub, &ch, 0, 20000, t, &info, err);
+    for (int c = 0; c < 3 && rc == 0; c++) {
+        ppb_mc_tallies_free(&t[c]);
+        rc = ppb_mc_tallies_init(&t[c], &cfgs[c].scene, (uint64_t)cfgs[c].mc.seed,
+                                 cfgs[c].mc.batches, err);
+    }
+    if (rc == 0)
+        rc = ppb_mc_trace_channels(&sub, &ch, 0, photons, t, &info, err);
+    if (rc == 0 && info.traced < photons)
+        rc = ppb_fail(err, "perf: interrupted after %lld photons", info.traced);
+    double hero_s = info.seconds, hero_noise[3] = {0, 0, 0}, hero_ev = 0;
+    for (int c = 0; c < 3 && rc == 0; c++) {
+        ppb_mc_totals_stats st;
+        ppb_mc_tallies_totals(&t[c], &cfgs[c].scene, 0, &st);
+        hero_ev = st.events_per_photon;
+        hero_noise[c] = table2_noise(&t[c], &cfgs[c].scene, err);
+        if (isnan(hero_noise[c]))
+            rc = -1;
+    }
+    for (int c = 0; c < 3; c++)
+        ppb_mc_tallies_free(&t[c]);
+    if (rc)
+        return -1;
+    fprintf(out,
+            "three channels (%s, %g x %g mm tube, n = %g): one hero-sampled run of %lld "
+            "photons, %.3g s, %.4g photons/s, %.3f events/photon\n",
+            material, w, h, cfgs[0].scene.n, photons, hero_s, (double)photons / hero_s, hero_ev);
+    fprintf(out, "%-8s %10s %10s %10s %12s %16s\n", "channel", "hero s", "noise", "single s",
+            "single noise", "single at T/3");
+    double single_total = 0;
+    const char *names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; c++) {
+        double sec, ev, noise;
+        if (perf_trace(ctx, &cfgs[c], 20000, &sec, &ev, &noise, err) ||
+            perf_trace(ctx, &cfgs[c], photons, &sec, &ev, &noise, err))
+            return -1;
+        single_total += sec;
+        fprintf(out, "%-8s %10.3g %9.3f%% %10.3g %11.3f%% %15.3f%%\n", names[c], hero_s,
+                100 * hero_noise[c], sec, 100 * noise, 100 * noise * sqrt(sec / (hero_s / 3.0)));
+    }
+    fprintf(out,
+            "time for all three channels: hero %.3g s, three single runs %.3g s (%.2f x); "
+            "noise per channel at equal time: compare the noise column with the last\n",
+            hero_s, single_total, single_total / hero_s);
+    return 0;
+}
+
 int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
 {
     ppb_ocl *ocl;
@@ -164,6 +246,11 @@ int ppb_perf_mc(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
                 ev / sec >= 20e6 ? "(>= 20 M events/s target)"
                                  : "(below the 20 M events/s target)");
     }
+
+    /* Short paths (six events a photon), then long ones (marble, a tenth of the photons). */
+    if (perf_channels(ctx, "skimmilk", 4, 2, photons, out, err) ||
+        perf_channels(ctx, "marble", 10, 3, photons / 10 > 20000 ? photons / 10 : 20000, out, err))
+        return -1;
 
     /* MCX-CL on the same device, same run, on the equivalent slab: ours in slab mode (the
      * same medium, thickness and beam), photons/s against photons/s. */
