@@ -9,10 +9,18 @@
 #include "base/memory.h"
 #include "kernels/ppb_object.h"
 #include "methods/mc3d/mc3d_params.h"
+#include "methods/registry.h"
 
 /* Host and kernel agree on the parameter block passed by value (mc3d_params.h). */
 _Static_assert(sizeof(ppb_mc3d_params) == 5 * 8 + 26 * 8 + 8 * 4,
                "ppb_mc3d_params layout changed: check mc3d.cl");
+
+/* mc3d takes the Monte Carlo's settings section, the tube reference's ([mc]: photons,
+ * batches, seed, workgroup, chunk, first). */
+static const char *mc_section(void)
+{
+    return ppb_method_reference()->section;
+}
 
 typedef struct mc3d_dev {
     cl_program prog;
@@ -132,7 +140,7 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
     /* The fixed-point bounds (mc3d_params.h): a batch's photons times their events. */
     if ((double)cfg->mc.photons / B > 2147483647.0 ||
         (double)cfg->mc.photons / B * PPB_MC3D_EVENT_CAP > 1.8e10 * 64)
-        return ppb_config_key_fail(cfg, "mc", "photons", err,
+        return ppb_config_key_fail(cfg, mc_section(), "photons", err,
                                    "mc3d: %lld photons in %d batches overflow a batch's "
                                    "fixed-point tallies (mc3d_params.h); raise [mc] batches",
                                    cfg->mc.photons, B);
@@ -186,7 +194,7 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
             goto done;
     size_t local = cfg->mc.workgroup > 0 ? (size_t)cfg->mc.workgroup : 0;
     if (local > ocl->max_workgroup) {
-        ppb_config_key_fail(cfg, "mc", "workgroup", err,
+        ppb_config_key_fail(cfg, mc_section(), "workgroup", err,
                             "mc3d: %zu exceeds the device's maximum work-group size %zu", local,
                             ocl->max_workgroup);
         goto done;
