@@ -75,8 +75,8 @@ static void done(void)
 static void test_energy(void **state)
 {
     (void)state;
-    const char *sets[] = {"object.shape=sphere", "object.nx=16",          "object.ny=16",
-                          "object.nz=16",        "object.voxel=0.25",     "medium.albedo=0.9",
+    const char *sets[] = {"object.shape=sphere", "object.grid_x=16",      "object.grid_y=16",
+                          "object.grid_z=16",    "object.voxel=0.25",     "medium.albedo=0.9",
                           "medium.g=0.5",        "object.light_theta=30", "mc.photons=400000",
                           "mc.batches=8"};
     run(sets, 10);
@@ -97,7 +97,7 @@ static void test_energy(void **state)
 static void test_hits(void **state)
 {
     (void)state;
-    const char *sets[] = {"object.nx=16",        "object.ny=8",       "object.nz=12",
+    const char *sets[] = {"object.grid_x=16",    "object.grid_y=8",   "object.grid_z=12",
                           "object.voxel=0.25",   "medium.albedo=0.5", "object.light_theta=30",
                           "object.light_phi=20", "mc.photons=200000", "mc.batches=8"};
     run(sets, 9);
@@ -113,22 +113,13 @@ static void test_hits(void **state)
 /* The slab-like box: 24 x 1 x 24 mfp (voxels of 0.5), albedo 0.9, g = 0, lit along -y on its
  * top face; its middle 8 x 8 mfp, 8 mfp from every edge, is the plane-parallel slab's (a
  * grazing path to the edge has transmittance e^-8 = 3e-4). */
-static const char *slab_sets[] = {"object.nx=48",
-                                  "object.ny=2",
-                                  "object.nz=48",
-                                  "object.voxel=0.5",
-                                  "medium.albedo=0.9",
-                                  "medium.g=0",
-                                  "object.patch=16",
-                                  "bins.theta=8",
-                                  "bins.phi=1",
-                                  "object.image_width=12",
-                                  "object.image_height=12",
-                                  "mc.photons=600000",
-                                  "mc.batches=16",
-                                  "object.light_theta=0",
-                                  "object.camera_theta=0",
-                                  "object.camera_phi=0"};
+static const char *slab_sets[] = {
+    "object.grid_x=48",      "object.grid_y=2",        "object.grid_z=48",
+    "object.voxel=0.5",      "medium.albedo=0.9",      "medium.g=0",
+    "object.patch=16",       "bins.theta=8",           "bins.phi=1",
+    "object.image_width=12", "object.image_height=12", "mc.photons=600000",
+    "mc.batches=16",         "object.light_theta=0",   "object.camera_theta=0",
+    "object.camera_phi=0"};
 enum { NSLAB = sizeof slab_sets / sizeof slab_sets[0] };
 
 /* The middle top patch: axis y, side +1, centroid at (12, 1, 12). */
@@ -277,8 +268,8 @@ static void test_slab_oblique(void **state)
 static void test_reproducible(void **state)
 {
     (void)state;
-    const char *sets[] = {"object.shape=yokan",    "object.nx=10",           "object.ny=10",
-                          "object.nz=10",          "mc.photons=20000",       "mc.batches=4",
+    const char *sets[] = {"object.shape=yokan",    "object.grid_x=10",       "object.grid_y=10",
+                          "object.grid_z=10",      "mc.photons=20000",       "mc.batches=4",
                           "object.image_width=16", "object.image_height=16", NULL};
     run(sets, 8);
     size_t nc = (size_t)F.p.npatch * F.o.ntheta * F.o.nphi, np = 16 * 16;

@@ -69,9 +69,9 @@ static void test_shapes_and_file(void **state)
     ppb_err err;
     assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
     const char *sets[][3] = {{"object", "shape", "yokan"},
-                             {"object", "nx", "10"},
-                             {"object", "ny", "8"},
-                             {"object", "nz", "6"},
+                             {"object", "grid_x", "10"},
+                             {"object", "grid_y", "8"},
+                             {"object", "grid_z", "6"},
                              {"object", "inclusion_radius", "0.3"},
                              {"medium", "albedo", "0.8"}};
     for (int i = 0; i < 6; i++)
