@@ -27,6 +27,7 @@
 #include "drivers/slurm.h"
 #include "drivers/sweep.h"
 #include "io/scene_json.h"
+#include "methods/object_registry.h"
 #include "methods/registry.h"
 #include "physics/ppsolver.h"
 #include "model/config.h"
@@ -986,6 +987,9 @@ static void usage(FILE *out)
                  "methods:\n");
     for (int i = 0; i < ppb_method_count(); i++)
         fprintf(out, "  %-8s %s\n", ppb_method_at(i)->id, ppb_method_at(i)->summary);
+    fprintf(out, "\nobject methods (`ppbench object`):\n");
+    for (int i = 0; i < ppb_object_method_count(); i++)
+        fprintf(out, "  %-8s %s\n", ppb_object_method_at(i)->id, ppb_object_method_at(i)->summary);
     fprintf(out,
             "\n"
             "examples:\n"

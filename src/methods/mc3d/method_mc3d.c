@@ -7,6 +7,7 @@
 
 #include "base/clock.h"
 #include "base/memory.h"
+#include "base/progress.h"
 #include "kernels/ppb_object.h"
 #include "methods/mc3d/mc3d_params.h"
 #include "methods/registry.h"
@@ -202,6 +203,10 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
     long long chunk = cfg->mc.chunk > 0 ? cfg->mc.chunk : 1 << 16;
     double t0 = ppb_now();
     for (long long done_n = 0; done_n < cfg->mc.photons; done_n += chunk) {
+        if (ppb_interrupted()) { /* between launches: nothing partial is written */
+            ppb_fail(err, "mc3d: interrupted after %lld of %lld photons", done_n, cfg->mc.photons);
+            goto done;
+        }
         long long n = cfg->mc.photons - done_n < chunk ? cfg->mc.photons - done_n : chunk;
         P.first = (ppb_u64)(cfg->mc.first + done_n), P.count = (ppb_u64)n;
         size_t global = (size_t)n;
