@@ -47,18 +47,18 @@ static int mat_at(const ppb_object *o, const double *x)
     return o->mat[ppb_object_voxel(o, c[0], c[1], c[2])];
 }
 
-/* The first material other than 0 a ray from x along d meets inside the grid (-1: none), sampled
- * every quarter voxel (a region label, not a transport quantity). */
-static int ray_meets(const ppb_object *o, const double *x0, const double *d)
+/* Whether a ray from x0 along d meets material want (want 0: any medium) inside the grid,
+ * sampled every quarter voxel (a region label, not a transport quantity). */
+static int ray_meets(const ppb_object *o, const double *x0, const double *d, int want)
 {
     double span = o->voxel * (o->nx + o->ny + o->nz), step = 0.25 * o->voxel;
     for (double t = step; t < span; t += step) {
         double x[3] = {x0[0] + t * d[0], x0[1] + t * d[1], x0[2] + t * d[2]};
         int m = mat_at(o, x);
-        if (m > 0)
-            return m;
+        if (want ? m == want : m > 0)
+            return 1;
     }
-    return -1;
+    return 0;
 }
 
 /* Regions of every patch (object.h, PPB_REGION_*) and of every pixel. */
@@ -92,11 +92,11 @@ static int label_regions(obj_run *r, ppb_err *err)
         for (int k = 0; k < 3; k++)
             x[k] = pa->c[k] + 1e-3 * o->voxel * pa->n[k];
         double cosl = pa->n[0] * tl[0] + pa->n[1] * tl[1] + pa->n[2] * tl[2];
-        if (cosl <= 0 || ray_meets(o, x, tl) > 0)
+        if (cosl <= 0 || ray_meets(o, x, tl, 0))
             pa->region |= PPB_REGION_SHADOW;
         for (int k = 0; k < 3; k++)
             x[k] = pa->c[k] - 1e-3 * o->voxel * pa->n[k];
-        if (o->nmat >= 2 && ray_meets(o, x, in) == 2)
+        if (o->nmat >= 2 && ray_meets(o, x, in, 2))
             pa->region |= PPB_REGION_INCLUSION;
     }
     size_t npix = (size_t)o->img_w * o->img_h;
