@@ -103,7 +103,7 @@ static void test_refusals(void **state)
         {"[experiment]\nmethods = mc3d\n[object]\ngrid_x = 0\n", "objbad4.ini:4: [object] grid_x",
          "out of range"}};
     for (int i = 0; i < 4; i++) {
-        char name[16];
+        char name[32];
         snprintf(name, sizeof name, "objbad%d", i + 1);
         const char *cfg = cli_config(name, cases[i][0]);
         snprintf(args, sizeof args, "object --quiet --out %s %s", dir, cfg);
