@@ -61,7 +61,52 @@ static int ray_meets(const ppb_object *o, const double *x0, const double *d, int
     return 0;
 }
 
-/* Regions of every patch (object.h, PPB_REGION_*) and of every pixel. */
+/* The patch a view ray from x (outside the grid) along d first enters the medium through, or
+ * -1: an exact voxel traversal (Amanatides & Woo 1987) from the grid box's entry; the face
+ * entered is the one crossed by the last step, or the box's face when the ray's first voxel
+ * is medium. */
+static int visible_patch(const ppb_object *o, const ppb_object_patches *p, const double *x0,
+                         const double *d)
+{
+    int n[3] = {o->nx, o->ny, o->nz}, c[3], step[3], axis = 0;
+    double h = o->voxel, lo = -INFINITY, hi = INFINITY, tmax[3], tdelta[3];
+    for (int a = 0; a < 3; a++) {
+        if (d[a] == 0) {
+            if (x0[a] < 0 || x0[a] > n[a] * h)
+                return -1;
+            continue;
+        }
+        double t0 = -x0[a] / d[a], t1 = (n[a] * h - x0[a]) / d[a];
+        if (fmin(t0, t1) > lo)
+            lo = fmin(t0, t1), axis = a;
+        hi = fmin(hi, fmax(t0, t1));
+    }
+    if (!(lo <= hi) || hi <= 0)
+        return -1;
+    double t = fmax(lo, 0.0);
+    for (int a = 0; a < 3; a++) {
+        int ci = (int)floor((x0[a] + t * d[a]) / h);
+        c[a] = ci < 0 ? 0 : ci >= n[a] ? n[a] - 1 : ci;
+        step[a] = d[a] > 0 ? 1 : -1;
+        tmax[a] = d[a] == 0 ? INFINITY : ((c[a] + (d[a] > 0)) * h - x0[a]) / d[a];
+        tdelta[a] = d[a] == 0 ? INFINITY : h / fabs(d[a]);
+    }
+    for (;;) {
+        size_t v = ppb_object_voxel(o, c[0], c[1], c[2]);
+        if (o->mat[v])
+            return p->face_patch[6 * v + (size_t)ppb_obj_face(axis, -step[axis])];
+        int a = tmax[0] < tmax[1] ? (tmax[0] < tmax[2] ? 0 : 2) : (tmax[1] < tmax[2] ? 1 : 2);
+        c[a] += step[a];
+        if (c[a] < 0 || c[a] >= n[a])
+            return -1;
+        tmax[a] += tdelta[a];
+        axis = a;
+    }
+}
+
+/* Regions of every patch (object.h, PPB_REGION_*) and of every pixel: a pixel takes the
+ * face, edge, corner and shadow labels of the patch its view ray first enters (through the
+ * pixel's centre), and the inclusion's when the ray crosses material 2 anywhere. */
 static int label_regions(obj_run *r, ppb_err *err)
 {
     const ppb_object *o = &r->o;
@@ -121,7 +166,10 @@ static int label_regions(obj_run *r, ppb_err *err)
                                x[2] + t * o->view_dir[2]};
                 hit = mat_at(o, y) == 2;
             }
-            r->pix_region[(size_t)row * o->img_w + col] = hit ? PPB_REGION_INCLUSION : 0;
+            int q = visible_patch(o, p, x, o->view_dir);
+            r->pix_region[(size_t)row * o->img_w + col] =
+                (unsigned char)((q >= 0 ? p->patch[q].region & ~PPB_REGION_INCLUSION : 0) |
+                                (hit ? PPB_REGION_INCLUSION : 0));
         }
     return 0;
 }
@@ -211,9 +259,6 @@ static int write_regions(const obj_run *r, int ref, const char *dir, ppb_err *er
                         stat_add(&sp, X->patch_rad[c], R->patch_rad[c], R->patch_se[c]);
                     }
             stat_row(af.f, X->method, "patches", regions[g].name, &sp);
-            if (regions[g].bit &
-                (PPB_REGION_FACE | PPB_REGION_EDGE | PPB_REGION_CORNER | PPB_REGION_SHADOW))
-                continue; /* labels of patches only */
             for (size_t q = 0; q < npix; q++)
                 if ((R->img[q] > 0 || X->img[q] > 0) &&
                     (!regions[g].bit || (r->pix_region[q] & regions[g].bit)))
