@@ -88,6 +88,36 @@ static void test_output_set(void **state)
     assert_int_equal(tu_sh("cmp -s %s/radiance.csv %s/radiance.csv", dir, vox), 0);
 }
 
+/* The regions of a 4^3 voxel box lit and seen from +y, one face a patch, one bin: by the
+ * box's geometry each face has 4 corner voxels (boundary faces of three axes), 8 edge voxels and
+ * 4 inner ones, so 24 corner, 48 edge and 24 face patches; every patch but the top's 16 is
+ * shadowed (facing away, or grazing the light); the 8 x 8 pixels see the top face, 2 x 2 pixels
+ * a voxel: 16 face pixels, 32 edge, 16 corner, none shadowed. */
+static void test_regions(void **state)
+{
+    (void)state;
+    const char *cfg = cli_config("objreg", "[experiment]\nmethods = mc3d\n[object]\nshape = box\n"
+                                           "grid_x = 4\ngrid_y = 4\ngrid_z = 4\nvoxel = 0.5\n"
+                                           "light_theta = 0\ncamera_theta = 0\npatch = 1\n"
+                                           "image_width = 8\nimage_height = 8\n[bins]\n"
+                                           "theta = 1\nphi = 1\n[mc]\nphotons = 20000\n"
+                                           "batches = 4\n");
+    char dir[1400], args[6000], path[1600];
+    snprintf(dir, sizeof dir, "%s/out", tu_scratch("objreg-out"));
+    snprintf(args, sizeof args, "object --quiet --out %s %s", dir, cfg);
+    cli_expect(args, 0, "");
+    snprintf(path, sizeof path, "%s/regions.csv", dir);
+    const char *t = tu_read_text(path);
+    const char *want[] = {
+        "mc3d,patches,all,96,",     "mc3d,patches,faces,24,",    "mc3d,patches,edges,48,",
+        "mc3d,patches,corners,24,", "mc3d,patches,shadowed,80,", "mc3d,patches,inclusion,0,",
+        "mc3d,pixels,all,64,",      "mc3d,pixels,faces,16,",     "mc3d,pixels,edges,32,",
+        "mc3d,pixels,corners,16,",  "mc3d,pixels,shadowed,0,"};
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+        if (!strstr(t, want[i]))
+            fail_msg("regions.csv lacks %s:\n%s", want[i], t);
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -117,6 +147,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_output_set),
+        cmocka_unit_test(test_regions),
         cmocka_unit_test(test_refusals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
