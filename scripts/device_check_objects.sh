@@ -3,7 +3,8 @@
 # machine (docs/performance.md, "On a GPU"): test_mc3d on the GPU's OpenCL device, the five
 # configs/objects/*.ini at 1e7 photons (seconds, events/s, energy balance), and the same bytes
 # across work-group sizes there. Needs scripts/device_bundle.sh's .devlibs/ with test_mc3d
-# copied into .devlibs/bin (docs/performance.md). Under 5 minutes. Writes $OUT/objects.txt.
+# copied into .devlibs/bin (docs/performance.md). Under 5 minutes. Writes $OUT/objects.txt. A dry
+# run here: PPB_CHECK_DEVICE=pthread PPB_CHECK_PHOTONS=1e5 OUT=/tmp/oc bash scripts/device_check_objects.sh
 set -uo pipefail
 cd "$(dirname "$0")/.."
 out=$(realpath -m "${OUT:-build/device_check_objects}")
@@ -11,19 +12,10 @@ mkdir -p "$out"
 work=$(mktemp -d)
 say() { echo "objects: $*" | tee -a "$out/objects.txt"; }
 bin=./ppbench tests=build/tests
-if [ -x .devlibs/bin/ppbench ]; then
-  bin=.devlibs/bin/ppbench tests=.devlibs/bin
-  export LD_LIBRARY_PATH=$PWD/.devlibs/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-  export PPBENCH_SOURCE=$PWD
-  lib=$(find /usr/local/nvidia /usr/lib/x86_64-linux-gnu /usr/lib64 /usr/lib -maxdepth 3 \
-          -name 'libnvidia-opencl.so*' 2>/dev/null | head -1)
-  if [ -n "$lib" ]; then
-    mkdir -p "$work/vendors" && echo "$lib" > "$work/vendors/nvidia.icd"
-    export OCL_ICD_VENDORS=$work/vendors
-  fi
-fi
+. scripts/device_env.sh
+device_env "$work"
 $bin devices > "$work/devices.txt" 2>&1
-gpu=${PPB_CHECK_DEVICE:-$(grep -i -m1 -E 'nvidia|cuda|amd|gpu' "$work/devices.txt" | sed 's/^ *\([0-9]*\).*/\1/')}
+gpu=$(device_gpu "$work/devices.txt")
 say "devices: gpu=${gpu:-none} ($(tr '\n' ';' < "$work/devices.txt"))"
 [ -n "$gpu" ] || exit 1
 export PPBENCH_DEVICE=$gpu PPBENCH_CACHE=
@@ -32,8 +24,8 @@ PPBENCH=$PWD/$bin TMPDIR=$work/tmp timeout 120 "$tests/test_mc3d" > "$out/test_m
 say "test_mc3d on the GPU: rc $? ($(grep -E 'PASSED|FAILED' "$out/test_mc3d.log" | tr '\n' ' '))"
 for c in box cube_two_faces sphere yokan blob; do
   /usr/bin/time -f "%e" -o "$work/$c.time" timeout 100 $bin object --out "$work/$c" \
-    --set mc.photons=1e7 --set mc.batches=32 "configs/objects/$c.ini" > "$work/$c.log" 2>&1
-  say "$c 1e7: rc $?, $(cat "$work/$c.time") s wall; $(tail -1 "$work/$c.log")"
+    --set mc.photons=${PPB_CHECK_PHOTONS:-1e7} --set mc.batches=32 "configs/objects/$c.ini" > "$work/$c.log" 2>&1
+  say "$c ${PPB_CHECK_PHOTONS:-1e7}: rc $?, $(cat "$work/$c.time") s wall; $(tail -1 "$work/$c.log")"
 done
 for wg in 64 256; do
   timeout 60 $bin object --quiet --out "$work/wg$wg" --set mc.photons=2e6 --set mc.workgroup=$wg \

@@ -179,13 +179,19 @@ static void out_path(const char *dir, const char *file, char *buf, size_t n)
     snprintf(buf, n, "%s/%s", dir, file);
 }
 
+/* Opens dir/file for writing under its temporary name (base/atomic_file.h). */
+static int open_in(const char *dir, const char *file, ppb_afile *af, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 64];
+    out_path(dir, file, path, sizeof path);
+    return ppb_afile_open(af, path, err);
+}
+
 /* radiance.csv: one row per (method, patch, bin). */
 static int write_radiance(const obj_run *r, const char *dir, ppb_err *err)
 {
-    char path[PPB_PATH_MAX + 64];
-    out_path(dir, "radiance.csv", path, sizeof path);
     ppb_afile af;
-    if (ppb_afile_open(&af, path, err))
+    if (open_in(dir, "radiance.csv", &af, err))
         return -1;
     fprintf(af.f,
             "method,patch,axis,side,cx,cy,cz,area,region,bin,theta_bin,phi_bin,radiance,se\n");
@@ -239,10 +245,8 @@ enum { NREGIONS = sizeof regions / sizeof regions[0] };
  * per region, over patch cells and over pixels. */
 static int write_regions(const obj_run *r, int ref, const char *dir, ppb_err *err)
 {
-    char path[PPB_PATH_MAX + 64];
-    out_path(dir, "regions.csv", path, sizeof path);
     ppb_afile af;
-    if (ppb_afile_open(&af, path, err))
+    if (open_in(dir, "regions.csv", &af, err))
         return -1;
     fprintf(af.f, "method,over,region,count,rms,rms_rel,ref_mean,ref_se_mean\n");
     int nb = r->o.ntheta * r->o.nphi;
@@ -271,10 +275,8 @@ static int write_regions(const obj_run *r, int ref, const char *dir, ppb_err *er
 
 static int write_small(const obj_run *r, const char *dir, ppb_err *err)
 {
-    char path[PPB_PATH_MAX + 64];
     ppb_afile af;
-    out_path(dir, "timings.csv", path, sizeof path);
-    if (ppb_afile_open(&af, path, err))
+    if (open_in(dir, "timings.csv", &af, err))
         return -1;
     fprintf(af.f, "method,seconds,photons\n");
     for (int m = 0; m < r->n; m++)
@@ -283,8 +285,7 @@ static int write_small(const obj_run *r, const char *dir, ppb_err *err)
         return -1;
     if (r->have_totals) {
         const ppb_mc3d_totals *t = &r->totals;
-        out_path(dir, "totals.csv", path, sizeof path);
-        if (ppb_afile_open(&af, path, err))
+        if (open_in(dir, "totals.csv", &af, err))
             return -1;
         fprintf(af.f, "launched,hits,escaped,escaped_se,ballistic,absorbed,absorbed_se,rgain,"
                       "rloss,balance,events,capped,entry_area\n");
@@ -295,14 +296,12 @@ static int write_small(const obj_run *r, const char *dir, ppb_err *err)
         if (ppb_afile_commit(&af, err))
             return -1;
     }
-    out_path(dir, "config.ini", path, sizeof path);
-    if (ppb_afile_open(&af, path, err))
+    if (open_in(dir, "config.ini", &af, err))
         return -1;
     ppb_config_write_ini(r->cfg, af.f);
     if (ppb_afile_commit(&af, err))
         return -1;
-    out_path(dir, "provenance.txt", path, sizeof path);
-    if (ppb_afile_open(&af, path, err))
+    if (open_in(dir, "provenance.txt", &af, err))
         return -1;
     char when[64];
     time_t now = time(NULL);
