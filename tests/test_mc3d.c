@@ -37,6 +37,9 @@ static int teardown(void **state)
 }
 
 /* Loads the defaults with sets[] ("section.key=value"), builds the object and traces it. */
+/* Changes the built object before it is traced (NULL: none). */
+static void (*edit_object)(ppb_object *o);
+
 static void run(const char *const *sets, int nsets)
 {
     ppb_err err;
@@ -50,7 +53,11 @@ static void run(const char *const *sets, int nsets)
             fail_msg("%s", err.msg);
     }
     F.ctx.cfg = &F.cfg;
-    if (ppb_object_build(&F.cfg, &F.o, &err) || ppb_object_patches_build(&F.o, &F.p, &err))
+    if (ppb_object_build(&F.cfg, &F.o, &err))
+        fail_msg("%s", err.msg);
+    if (edit_object)
+        edit_object(&F.o);
+    if (ppb_object_patches_build(&F.o, &F.p, &err))
         fail_msg("%s", err.msg);
     int nb = F.o.ntheta * F.o.nphi;
     for (int i = 0; i < 2; i++)
@@ -136,11 +143,11 @@ static int middle_patch(void)
 }
 
 /* Mean and standard error of the image over the pixels whose view ray meets the top face
- * (y = 1) within the middle 8 x 8 mfp (their centres). */
-static void middle_pixels(const ppb_object_result *r, double *mean, double *se)
+ * (y = top) within the middle 8 x 8 mfp (their centres). */
+static void middle_pixels(const ppb_object_result *r, double *mean, double *se, double top)
 {
     double c[3] = {-F.o.view_dir[0], -F.o.view_dir[1], -F.o.view_dir[2]};
-    ppb_obj_camera cam = ppb_obj_camera_make(c, 24, 1, 24, F.o.img_w, F.o.img_h);
+    ppb_obj_camera cam = ppb_obj_camera_make(c, 24, top, 24, F.o.img_w, F.o.img_h);
     double s = 0, v = 0;
     int n = 0;
     for (int row = 0; row < F.o.img_h; row++)
@@ -149,7 +156,7 @@ static void middle_pixels(const ppb_object_result *r, double *mean, double *se)
             double x[3];
             for (int k = 0; k < 3; k++)
                 x[k] = pr * cam.r[k] + pu * cam.u[k];
-            double t = (1.0 - x[1]) / c[1]; /* along c to the plane y = 1 */
+            double t = (top - x[1]) / c[1]; /* along c to the top face, y = top */
             double px = x[0] + t * c[0], pz = x[2] + t * c[2];
             if (fabs(px - 12) < 4 && fabs(pz - 12) < 4) {
                 size_t q = (size_t)row * F.o.img_w + col;
@@ -201,7 +208,7 @@ static void test_slab(void **state)
            F.t.events, F.r[0].seconds);
     assert_close(R, Rpp, 4 * sqrt(Rv) + 2e-3 * Rpp);
     double img, img_se;
-    middle_pixels(&F.r[0], &img, &img_se);
+    middle_pixels(&F.r[0], &img, &img_se, 1);
     size_t c0 = (size_t)q * nt, c1 = c0 + 1;
     double ext = 1.5 * F.r[0].patch_rad[c0] - 0.5 * F.r[0].patch_rad[c1];
     double ext_se = hypot(1.5 * F.r[0].patch_se[c0], 0.5 * F.r[0].patch_se[c1]);
@@ -220,7 +227,7 @@ static void test_slab(void **state)
         size_t c = (size_t)q * nt + b;
         assert_close(F.r[1].patch_rad[c], avg, 4 * F.r[1].patch_se[c] + 1e-12);
     }
-    middle_pixels(&F.r[1], &img, &img_se);
+    middle_pixels(&F.r[1], &img, &img_se, 1);
     printf("slab: once-scattered image %.6f +- %.6f, closed form %.6f\n", img, img_se,
            ss_slab(0.9, 1, 1));
     assert_close(img, ss_slab(0.9, 1, 1), 4 * img_se);
@@ -252,13 +259,55 @@ static void test_slab_oblique(void **state)
     double Lpp = pp_radiance(s, 0, c);
     pp_free(s);
     double img, img_se;
-    middle_pixels(&F.r[0], &img, &img_se);
+    middle_pixels(&F.r[0], &img, &img_se, 1);
     printf("oblique slab: image %.5f +- %.5f, pp %.5f\n", img, img_se, Lpp);
     assert_close(img, Lpp, 4 * img_se + 5e-3 * Lpp);
     double cosang = F.o.light_dir[0] * c[0] + F.o.light_dir[1] * c[1] + F.o.light_dir[2] * c[2];
     double L1 = 0.9 * ppb_hg_phase(0.5, cosang) * mu0 / (mu0 + mu) * (1 - exp(-(1 / mu0 + 1 / mu)));
-    middle_pixels(&F.r[1], &img, &img_se);
+    middle_pixels(&F.r[1], &img, &img_se, 1);
     printf("oblique slab: once-scattered image %.6f +- %.6f, closed form %.6f\n", img, img_se, L1);
+    assert_close(img, L1, 4 * img_se);
+    done();
+}
+
+/* The lower half of the slab box (y < 1 of its 2 mfp) made a second material, sigma_t 3,
+ * albedo 0.5. */
+static void two_layers(ppb_object *o)
+{
+    o->nmat = 2;
+    o->material[2].sigma_t = 3, o->material[2].albedo = 0.5;
+    for (int k = 0; k < o->nz; k++)
+        for (int j = 0; j < o->ny / 2; j++)
+            for (int i = 0; i < o->nx; i++)
+                o->mat[ppb_object_voxel(o, i, j, k)] = 2;
+}
+
+/* Two layers (the exact traversal across a change of sigma_t): 1 mfp of optical depth t1 = 1 at
+ * albedo a1 = 0.9 over 1 mfp of sigma_t 3 (t2 = 3) at albedo a2 = 0.5, lit and seen at 30 and
+ * 50 degrees, g = 0.5. Its
+ * once-scattered radiance in closed form, the layers' single scattering each attenuated by
+ * what lies above: with k = 1 / mu0 + 1 / mu, P = p(w_L . c) mu0 / (mu0 + mu),
+ * L1 = P [a1 (1 - exp(-t1 k)) + a2 exp(-t1 k) (1 - exp(-t2 k))]. */
+static void test_two_layers(void **state)
+{
+    (void)state;
+    const char *sets[NSLAB + 5];
+    for (int i = 0; i < NSLAB; i++)
+        sets[i] = slab_sets[i];
+    sets[NSLAB] = "object.light_theta=30", sets[NSLAB + 1] = "object.light_phi=180";
+    sets[NSLAB + 2] = "object.camera_theta=50", sets[NSLAB + 3] = "medium.g=0.5";
+    sets[NSLAB + 4] = "object.grid_y=4";
+    edit_object = two_layers;
+    run(sets, NSLAB + 5);
+    edit_object = NULL;
+    double c[3] = {-F.o.view_dir[0], -F.o.view_dir[1], -F.o.view_dir[2]};
+    double mu0 = -F.o.light_dir[1], mu = c[1], k = 1 / mu0 + 1 / mu;
+    double cosang = F.o.light_dir[0] * c[0] + F.o.light_dir[1] * c[1] + F.o.light_dir[2] * c[2];
+    double P = ppb_hg_phase(0.5, cosang) * mu0 / (mu0 + mu);
+    double L1 = P * (0.9 * (1 - exp(-1 * k)) + 0.5 * exp(-1 * k) * (1 - exp(-3 * k)));
+    double img, img_se;
+    middle_pixels(&F.r[1], &img, &img_se, 2);
+    printf("two layers: once-scattered image %.6f +- %.6f, closed form %.6f\n", img, img_se, L1);
     assert_close(img, L1, 4 * img_se);
     done();
 }
@@ -293,9 +342,9 @@ static void test_reproducible(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_energy),       cmocka_unit_test(test_hits),
-        cmocka_unit_test(test_slab),         cmocka_unit_test(test_slab_oblique),
-        cmocka_unit_test(test_reproducible),
+        cmocka_unit_test(test_energy),     cmocka_unit_test(test_hits),
+        cmocka_unit_test(test_slab),       cmocka_unit_test(test_slab_oblique),
+        cmocka_unit_test(test_two_layers), cmocka_unit_test(test_reproducible),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
