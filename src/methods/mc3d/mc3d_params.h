@@ -19,11 +19,12 @@ typedef uint64_t ppb_u64;
 #define PPB_MC3D_KERNEL "src/methods/mc3d/mc3d.cl"
 
 /* An exit weight w is tallied as round(w 2^32), an image contribution c (a weight times the
- * phase function, at most 62 at |g| <= 0.95, times a transmittance) as round(c 2^24). Exit
- * weights are below 1 but for roulette survivors, so a batch's cells stay below 2^64 while it
- * holds fewer than 2^31 photons; its pixels while its photons times their events stay below
- * 2^40 / 62, about 1.8e10. The host refuses a batch larger than either bound allows with its
- * events per photon capped (method_mc3d.c). Resolution: 2^-24 = 6e-8 per contribution. */
+ * phase function, whose peak is (1 + |g|) / (4 pi (1 - |g|)^2) <= 62 at |g| <= 0.95, times a
+ * transmittance) as round(c 2^24). Exit weights are below 1 but for roulette survivors, so a
+ * batch's cells stay below 2^64 while it holds fewer than 2^31 photons (checked before the
+ * trace); its pixels while its events times the largest weight times the phase function's peak
+ * stay below 2^40 (checked on each batch's event count after the trace: about 1.8e10 events a
+ * batch at g = 0.95). Resolution: 2^-24 = 6e-8 per contribution. */
 #define PPB_MC3D_SCALE     4294967296.0
 #define PPB_MC3D_PIX_SCALE 16777216.0
 

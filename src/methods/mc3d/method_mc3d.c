@@ -138,9 +138,9 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
              nvox, B, ncells, npix);
     if (ppb_memory_check(bytes, cfg->memory_limit, "mc3d", detail, err))
         return -1;
-    /* The fixed-point bounds (mc3d_params.h): a batch's photons times their events. */
-    if ((double)cfg->mc.photons / B > 2147483647.0 ||
-        (double)cfg->mc.photons / B * PPB_MC3D_EVENT_CAP > 1.8e10 * 64)
+    /* The fixed-point bound of the cells (mc3d_params.h): fewer than 2^31 photons a batch; the
+     * pixels' bound is checked on the batches' event counts after the trace. */
+    if ((double)cfg->mc.photons / B > 2147483647.0)
         return ppb_config_key_fail(cfg, mc_section(), "photons", err,
                                    "mc3d: %lld photons in %d batches overflow a batch's "
                                    "fixed-point tallies (mc3d_params.h); raise [mc] batches",
@@ -202,6 +202,10 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
     }
     long long chunk = cfg->mc.chunk > 0 ? cfg->mc.chunk : 1 << 16;
     double t0 = ppb_now();
+    char label[128];
+    snprintf(label, sizeof label, "%s: mc3d", o->name);
+    ppb_progress prog;
+    ppb_progress_begin(&prog, label, "photons", (double)cfg->mc.photons, ctx->quiet);
     for (long long done_n = 0; done_n < cfg->mc.photons; done_n += chunk) {
         if (ppb_interrupted()) { /* between launches: nothing partial is written */
             ppb_fail(err, "mc3d: interrupted after %lld of %lld photons", done_n, cfg->mc.photons);
@@ -219,7 +223,9 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
                          "clEnqueueNDRangeKernel(ppb_mc3d_kernel)", err) ||
             ppb_cl_check(clFinish(ocl->queue), "clFinish(mc3d)", err))
             goto done;
+        ppb_progress_update(&prog, (double)(done_n + n));
     }
+    ppb_progress_end(&prog, (double)cfg->mc.photons);
     double secs = ppb_now() - t0;
     if (ppb_cl_check(
             clEnqueueReadBuffer(ocl->queue, d.buf[3], CL_TRUE, 0, tb[3], cells, 0, NULL, NULL),
@@ -231,6 +237,21 @@ int ppb_mc3d_trace(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patch
             clEnqueueReadBuffer(ocl->queue, d.buf[5], CL_TRUE, 0, tb[5], totals, 0, NULL, NULL),
             "clEnqueueReadBuffer(mc3d totals)", err))
         goto done;
+    /* The pixels' fixed-point bound (mc3d_params.h): a batch's contributions, each at most its
+     * weight (1, or the capped roulette's 8 x PPB_MC3D_CAP_WMAX) times the phase function's
+     * peak, one per event, must stay below 2^64 / 2^24. */
+    double pmax = ppb_hg_phase(o->g, o->g >= 0 ? 1.0 : -1.0);
+    for (int b = 0; b < B; b++) {
+        const uint64_t *tb_ = totals + (size_t)b * PPB_MC3D_NTOT;
+        double wmax = tb_[PPB_MC3D_T_CAPPED] ? 8.0 * PPB_MC3D_CAP_WMAX : 1.0;
+        if ((double)tb_[PPB_MC3D_T_EVENTS] * wmax * pmax >= 0x1p64 / PPB_MC3D_PIX_SCALE) {
+            ppb_config_key_fail(cfg, mc_section(), "batches", err,
+                                "mc3d: batch %d's %llu events may overflow its fixed-point "
+                                "pixels (mc3d_params.h): raise [mc] batches",
+                                b, (unsigned long long)tb_[PPB_MC3D_T_EVENTS]);
+            goto done;
+        }
+    }
     /* Photon i is in batch i mod B. */
     long long N = cfg->mc.photons, first = cfg->mc.first;
     for (int b = 0; b < B; b++) {
