@@ -1,8 +1,8 @@
 /* test_object_cli.c: `ppbench object` end to end (drivers/object.c; docs/reference.md, Objects).
  * Expected: the output set's files with the headers the reference documents, the energy
- * balance of totals.csv (conservation: 1 to the fixed-point rounding), the set's own config.ini
- * and its object.vox (read back as shape = file) reproducing radiance.csv byte for byte (the
- * same photons through the same voxels), and bad configs refused with exit 2 naming file:line:
+ * balance of totals_mc3d.csv (conservation: 1 to the fixed-point rounding), the set's own
+ * config.ini and its object.vox (read back as shape = file) reproducing radiance.csv byte for byte
+ * (the same photons through the same voxels), and bad configs refused with exit 2 naming file:line:
  * [section] key before anything is written. */
 #include "cliutil.h"
 
@@ -47,8 +47,8 @@ static void test_output_set(void **state)
         {"radiance.csv",
          "method,patch,axis,side,cx,cy,cz,area,region,bin,theta_bin,phi_bin,radiance,se"},
         {"regions.csv", "method,over,region,count,rms,rms_rel,ref_mean,ref_se_mean"},
-        {"totals.csv", "launched,hits,escaped,escaped_se,ballistic,absorbed,absorbed_se,rgain,"
-                       "rloss,balance,events,capped,entry_area"},
+        {"totals_mc3d.csv", "launched,hits,escaped,escaped_se,ballistic,absorbed,absorbed_se,rgain,"
+                            "rloss,balance,events,capped,entry_area"},
         {"timings.csv", "method,seconds,photons"},
         {"provenance.txt", "# ppbench provenance: what produced the files beside this one"}};
     for (int i = 0; i < 5; i++) {
@@ -62,7 +62,7 @@ static void test_output_set(void **state)
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
         assert_int_equal(access(path, R_OK), 0);
     }
-    snprintf(path, sizeof path, "%s/totals.csv", dir);
+    snprintf(path, sizeof path, "%s/totals_mc3d.csv", dir);
     const char *t = strchr(tu_read_text(path), '\n') + 1;
     double v[13];
     assert_int_equal(sscanf(t, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1],

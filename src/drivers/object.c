@@ -13,7 +13,6 @@
 #include "io/image_exr.h"
 #include "io/image_png.h"
 #include "kernels/ppb_object.h"
-#include "methods/mc3d/method_mc3d.h"
 #include "methods/object_registry.h"
 #include "model/object_build.h"
 
@@ -27,8 +26,6 @@ typedef struct obj_run {
     int n;
     ppb_object_result res[MAX_RES];
     double seconds[MAX_RES];
-    ppb_mc3d_totals totals; /* the reference's, when it ran */
-    int have_totals;
     unsigned char *pix_region; /* per pixel: PPB_REGION_INCLUSION where the view meets it */
     char device[512];
     ppb_ocl_versions ocl_versions;
@@ -182,7 +179,7 @@ static void out_path(const char *dir, const char *file, char *buf, size_t n)
 /* Opens dir/file for writing under its temporary name (base/atomic_file.h). */
 static int open_in(const char *dir, const char *file, ppb_afile *af, ppb_err *err)
 {
-    char path[PPB_PATH_MAX + 64];
+    char path[PPB_PATH_MAX + 128];
     out_path(dir, file, path, sizeof path);
     return ppb_afile_open(af, path, err);
 }
@@ -283,19 +280,16 @@ static int write_small(const obj_run *r, const char *dir, ppb_err *err)
         fprintf(af.f, "%s,%.4f,%lld\n", r->res[m].method, r->seconds[m], r->res[m].photons);
     if (ppb_afile_commit(&af, err))
         return -1;
-    if (r->have_totals) {
-        const ppb_mc3d_totals *t = &r->totals;
-        if (open_in(dir, "totals.csv", &af, err))
-            return -1;
-        fprintf(af.f, "launched,hits,escaped,escaped_se,ballistic,absorbed,absorbed_se,rgain,"
-                      "rloss,balance,events,capped,entry_area\n");
-        fprintf(af.f, "%lld,%lld,%.9g,%.3g,%.9g,%.9g,%.3g,%.3g,%.3g,%.12g,%lld,%lld,%.9g\n",
-                t->launched, t->hits, t->escaped, t->escaped_se, t->ballistic, t->absorbed,
-                t->absorbed_se, t->rgain, t->rloss, t->escaped + t->absorbed + t->rloss - t->rgain,
-                t->events, t->capped, t->proj_area);
-        if (ppb_afile_commit(&af, err))
-            return -1;
-    }
+    for (int m = 0; m < r->n; m++)
+        if (r->res[m].totals_csv) {
+            char name[64];
+            snprintf(name, sizeof name, "totals_%s.csv", r->res[m].method);
+            if (open_in(dir, name, &af, err))
+                return -1;
+            fputs(r->res[m].totals_csv, af.f);
+            if (ppb_afile_commit(&af, err))
+                return -1;
+        }
     if (open_in(dir, "config.ini", &af, err))
         return -1;
     ppb_config_write_ini(r->cfg, af.f);
@@ -474,14 +468,11 @@ int ppb_object_command(const ppb_config *cfg, const char *device, int quiet, con
                                        r.o.img_w, r.o.img_h, err))
                 goto out;
         double t0 = ppb_now();
-        int st = m == rm ? ppb_mc3d_trace(&ctx, &r.o, &r.p, &r.res[r.n], &r.totals, err)
-                         : m->run(&ctx, &r.o, &r.p, &r.res[r.n], err);
+        int st = m->run(&ctx, &r.o, &r.p, &r.res[r.n], err);
         if (st) {
             r.n += k;
             goto out;
         }
-        if (m == rm)
-            r.have_totals = 1;
         for (int j = 0; j < k; j++) {
             r.seconds[r.n + j] = ppb_now() - t0;
             if (check_result(&r.res[r.n + j], err)) {
@@ -505,12 +496,6 @@ int ppb_object_command(const ppb_config *cfg, const char *device, int quiet, con
     }
     if (ppb_adir_commit(&ad, err))
         goto out;
-    if (!quiet && r.have_totals)
-        fprintf(stderr,
-                "%s: mc3d: %lld photons, %lld reached the object; escaped %.6f + absorbed "
-                "%.6f = %.6f; %.3g events/s\n",
-                cfg->name, r.totals.launched, r.totals.hits, r.totals.escaped, r.totals.absorbed,
-                r.totals.escaped + r.totals.absorbed, r.totals.events / fmax(r.seconds[0], 1e-9));
     code = 0;
 out:
     for (int i = 0; i < r.n; i++)

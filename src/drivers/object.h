@@ -2,8 +2,9 @@
  * three-dimensional object, runs every object method the config names (methods/object_registry.h),
  * scores each against the object Monte Carlo per patch and per pixel, over the whole object and
  * per region (faces, edges, corners, shadowed patches, the inclusion), and writes the output
- * set whole or not at all: radiance.csv, regions.csv, totals.csv, timings.csv, images (linear
- * EXR and PNG, the error images), the object's voxel file, provenance.txt and config.ini. */
+ * set whole or not at all: radiance.csv, regions.csv, totals_<method>.csv, timings.csv, images
+ * (linear EXR and PNG, the error images), the object's voxel file, provenance.txt and config.ini.
+ */
 #ifndef PPB_DRIVER_OBJECT_H
 #define PPB_DRIVER_OBJECT_H
 

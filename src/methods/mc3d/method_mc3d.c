@@ -314,5 +314,29 @@ done:
 int ppb_object_method_mc3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
                            ppb_object_result *out, ppb_err *err)
 {
-    return ppb_mc3d_trace(ctx, o, p, out, NULL, err);
+    ppb_mc3d_totals t;
+    if (ppb_mc3d_trace(ctx, o, p, out, &t, err))
+        return -1;
+    char *csv = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&csv, &len);
+    if (!f)
+        return ppb_fail(err, "mc3d: out of memory for its totals");
+    fprintf(f, "launched,hits,escaped,escaped_se,ballistic,absorbed,absorbed_se,rgain,rloss,"
+               "balance,events,capped,entry_area\n");
+    fprintf(f, "%lld,%lld,%.9g,%.3g,%.9g,%.9g,%.3g,%.3g,%.3g,%.12g,%lld,%lld,%.9g\n", t.launched,
+            t.hits, t.escaped, t.escaped_se, t.ballistic, t.absorbed, t.absorbed_se, t.rgain,
+            t.rloss, t.escaped + t.absorbed + t.rloss - t.rgain, t.events, t.capped, t.proj_area);
+    if (fclose(f) != 0) {
+        free(csv);
+        return ppb_fail(err, "mc3d: out of memory for its totals");
+    }
+    out[0].totals_csv = csv;
+    if (!ctx->quiet)
+        fprintf(stderr,
+                "%s: mc3d: %lld photons, %lld reached the object; escaped %.6f + absorbed %.6f = "
+                "%.6f; %.3g events/s\n",
+                o->name, t.launched, t.hits, t.escaped, t.absorbed, t.escaped + t.absorbed,
+                (double)t.events / fmax(out[0].seconds, 1e-9));
+    return 0;
 }
