@@ -907,7 +907,8 @@ static const command commands[] = {
      "ppbench scene --out /tmp/scene configs/uniform_g0_normal.ini", OPT_OUT | OPT_SET, 1,
      cmd_scene},
     {"object", "CONFIG", 0,
-     "render a three-dimensional object ([object]) with the\nobject methods, scored against mc3d "
+     "render a three-dimensional object ([object]) with the\nobject methods, scored against the "
+     "Monte Carlo "
      "per patch and pixel\n(docs/reference.md, Objects)",
      "ppbench object --out /tmp/sphere configs/objects/sphere.ini",
      OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET, 1, cmd_object},
