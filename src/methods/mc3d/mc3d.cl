@@ -207,6 +207,10 @@ __kernel void ppb_mc3d_kernel(const ppb_mc3d_params P, __global const float *sig
         cam.c[k] = P.cam_c[k], cam.r[k] = P.cam_r[k], cam.u[k] = P.cam_u[k];
     cam.r0 = P.cam_r0, cam.u1 = P.cam_u1, cam.pixel = P.cam_pixel, cam.w = P.img_w, cam.h = P.img_h;
     int hit = 0;
+    /* A photon's absorbed weight and events, added to the totals once when it ends (fewer
+     * atomic additions; still one rounding per photon, so still order-independent). */
+    double absorbed = 0.0;
+    ulong events = 0;
     for (uint k = 0;; k++) {
         ctr.v[2] = k, ctr.v[3] = 0u;
         rnd = philox4x32(ctr, key);
@@ -219,16 +223,16 @@ __kernel void ppb_mc3d_kernel(const ppb_mc3d_params P, __global const float *sig
                     atom_add(tot + PPB_MC3D_T_HITS, 1UL); /* else counted at its collision */
                 }
             }
-            return;
+            break;
         }
         if (ex.nscat == 0)
             atom_add(tot + PPB_MC3D_T_HITS, 1UL);
         long vox = mc3d_voxel(&P, r.c);
         double a = alb[vox];
-        mc3d_add(tot + PPB_MC3D_T_ABSORBED, ex.w * (1.0 - a), PPB_MC3D_SCALE);
+        absorbed += ex.w * (1.0 - a);
         ex.w *= a;
         ex.nscat++;
-        atom_add(tot + PPB_MC3D_T_EVENTS, 1UL);
+        events++;
         /* Next-event estimate toward the camera: the scattered radiance leaving along c,
          * w p(d . c) exp(-tau to the grid's edge), per unit pixel area (applied by the host). */
         long px = ppb_obj_camera_pixel(&cam, r.p[0], r.p[1], r.p[2]);
@@ -254,11 +258,14 @@ __kernel void ppb_mc3d_kernel(const ppb_mc3d_params P, __global const float *sig
                 ex.w *= PPB_MC3D_ROULETTE_M;
             } else {
                 mc3d_add(tot + PPB_MC3D_T_RLOSS, ex.w, PPB_MC3D_SCALE);
-                return;
+                break;
             }
         }
         double mu = mc3d_hg_cos(P.g, mc3d_uniform(rnd.v[1]));
         double phi = 2.0 * PPB_PI * mc3d_uniform(rnd.v[2]);
         mc3d_turn(r.d, mu, sin(phi), cos(phi));
     }
+    mc3d_add(tot + PPB_MC3D_T_ABSORBED, absorbed, PPB_MC3D_SCALE);
+    if (events)
+        atom_add(tot + PPB_MC3D_T_EVENTS, events);
 }
