@@ -70,6 +70,11 @@ int ppb_mesh_read_obj(const char *path, ppb_mesh *m, ppb_err *err)
     int vcap = 0, tcap = 0, lineno = 0;
     while (fgets(line, sizeof line, f)) {
         lineno++;
+        if (!strchr(line, '\n') && !feof(f)) {
+            fclose(f), ppb_mesh_free(m);
+            return ppb_fail(err, "%s:%d: a line longer than %zu characters", path, lineno,
+                            sizeof line - 2);
+        }
         char *save = NULL, *tok = strtok_r(line, " \t\r\n", &save);
         if (!tok)
             continue;
@@ -89,8 +94,13 @@ int ppb_mesh_read_obj(const char *path, ppb_mesh *m, ppb_err *err)
             memcpy(m->v + 3 * m->nv++, x, sizeof x);
         } else if (strcmp(tok, "f") == 0) {
             int idx[64], n = 0;
-            for (char *s; (s = strtok_r(NULL, " \t\r\n", &save)) && n < 64; n++)
-                if ((idx[n] = obj_index(s, m->nv)) < 0) {
+            for (char *s; (s = strtok_r(NULL, " \t\r\n", &save)); n++)
+                if (n == 64 || (idx[n] = obj_index(s, m->nv)) < 0) {
+                    if (n == 64) {
+                        fclose(f), ppb_mesh_free(m);
+                        return ppb_fail(err, "%s:%d: a face of more than 64 vertices", path,
+                                        lineno);
+                    }
                     fclose(f), ppb_mesh_free(m);
                     return ppb_fail(err, "%s:%d: face vertex '%.32s' names no vertex read so far",
                                     path, lineno, s);
