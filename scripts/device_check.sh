@@ -22,16 +22,8 @@ finish() { cp "$work/summary.txt" "$out/"; tar -C "$work/.." --exclude=device_ch
 trap finish EXIT
 
 bin=./ppbench tests=build/tests
-if [ -x .devlibs/bin/ppbench ]; then
-  bin=.devlibs/bin/ppbench tests=.devlibs/bin
-  export LD_LIBRARY_PATH=$PWD/.devlibs/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-  export PPBENCH_SOURCE=$PWD
-  lib=$(find /usr/local/nvidia /usr/lib/x86_64-linux-gnu /usr/lib64 /usr/lib -maxdepth 3 \
-          -name 'libnvidia-opencl.so*' 2>/dev/null | head -1)
-  if [ -n "$lib" ]; then
-    mkdir -p "$work/vendors" && echo "$lib" > "$work/vendors/nvidia.icd"
-    export OCL_ICD_VENDORS=$work/vendors
-  fi
+. scripts/device_env.sh
+if device_env "$work"; then
   say "prebuilt binaries (.devlibs), NVIDIA OpenCL driver: ${lib:-not found}"
 elif ! make -j"$(nproc)" ppbench build/tests/test_ocl build/tests/test_mc > "$work/build.log" 2>&1; then
   say "build failed (build.log)"; exit 1
@@ -39,7 +31,7 @@ fi
 { nvidia-smi || true; } > "$work/hardware.txt" 2>&1
 $bin devices > "$work/devices.txt" 2>&1
 # $PPB_CHECK_DEVICE (a selector) stands in for the GPU in a dry run on any machine.
-gpu=${PPB_CHECK_DEVICE:-$(grep -i -m1 -E 'nvidia|cuda|amd|gpu' "$work/devices.txt" | sed 's/^ *\([0-9]*\).*/\1/')}
+gpu=$(device_gpu "$work/devices.txt")
 say "devices: gpu=${gpu:-none} ($(tr '\n' ';' < "$work/devices.txt"))"
 [ -n "$gpu" ] || { say "no GPU OpenCL device"; exit 1; }
 export PPBENCH_DEVICE=$gpu PPBENCH_CACHE=

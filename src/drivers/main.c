@@ -18,6 +18,7 @@
 #include "base/progress.h"
 #include "drivers/experiment.h"
 #include "drivers/mc_shard.h"
+#include "drivers/object.h"
 #include "drivers/perf.h"
 #include "drivers/report.h"
 #include "drivers/score.h"
@@ -26,6 +27,7 @@
 #include "drivers/slurm.h"
 #include "drivers/sweep.h"
 #include "io/scene_json.h"
+#include "methods/object_registry.h"
 #include "methods/registry.h"
 #include "physics/ppsolver.h"
 #include "model/config.h"
@@ -370,7 +372,7 @@ static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_grid
 static int needs_blas(const command *cmd)
 {
     return !strcmp(cmd->name, "run") || !strcmp(cmd->name, "sweep") || !strcmp(cmd->name, "perf") ||
-           !strcmp(cmd->name, "mc-shard");
+           !strcmp(cmd->name, "mc-shard") || !strcmp(cmd->name, "object");
 }
 
 /* A config or option the user must fix: printed once, exit code 2. */
@@ -808,6 +810,34 @@ static int cmd_scene(const cli *c)
     return EXIT_OK;
 }
 
+/* `ppbench object CONFIG --out DIR` (drivers/object.h; docs/reference.md, Objects). The
+ * config's methods are object methods (methods/object_registry.h), checked there. */
+static int cmd_object(const cli *c)
+{
+    if (c->nargs != 1) {
+        fprintf(stderr, "ppbench object: usage: ppbench object --out DIR CONFIG\n");
+        return EXIT_USAGE;
+    }
+    ppb_config cfg;
+    ppb_err err = {{0}};
+    if (ppb_config_load_sets(&cfg, NULL, c->args[0], c->sets, c->nsets, &err))
+        return usage_error(&err);
+    if (c->out)
+        snprintf(cfg.out_dir, sizeof cfg.out_dir, "%s", c->out);
+    int code = check_config_out(c, &cfg);
+    if (code)
+        return code;
+    if (ppb_study_guard(cfg.out_dir, &err))
+        return usage_error(&err);
+    code = check_device(c);
+    if (code)
+        return code;
+    code = ppb_object_command(&cfg, c->device, c->quiet ? 2 : 0, PPB_VERSION, &err);
+    if (code)
+        fprintf(stderr, "ppbench object: %s\n", err.msg);
+    return code == 2 ? EXIT_USAGE : code ? EXIT_RUN : EXIT_OK;
+}
+
 /* `ppbench score RADIANCE.csv --ref DIR [--out DIR2]` (drivers/score.h). */
 static int cmd_score(const cli *c)
 {
@@ -876,6 +906,12 @@ static const command commands[] = {
      "write --out DIR/scene.json: what an external method\nreads (docs/external.md)",
      "ppbench scene --out /tmp/scene configs/uniform_g0_normal.ini", OPT_OUT | OPT_SET, 1,
      cmd_scene},
+    {"object", "CONFIG", 0,
+     "render a three-dimensional object ([object]) with the\nobject methods, scored against the "
+     "Monte Carlo "
+     "per patch and pixel\n(docs/reference.md, Objects)",
+     "ppbench object --out /tmp/sphere configs/objects/sphere.ini",
+     OPT_DEVICE | OPT_OUT | OPT_SET | OPT_QUIET, 1, cmd_object},
     {"score", "RADIANCE.csv", OPT_REF,
      "score a radiance.csv against the finished experiment\n--ref DIR: its summary, rms and "
      "totals rows into --out\n(default DIR-score, -score-2, ...; DIR is never written)",
@@ -952,6 +988,9 @@ static void usage(FILE *out)
                  "methods:\n");
     for (int i = 0; i < ppb_method_count(); i++)
         fprintf(out, "  %-8s %s\n", ppb_method_at(i)->id, ppb_method_at(i)->summary);
+    fprintf(out, "\nobject methods (`ppbench object`):\n");
+    for (int i = 0; i < ppb_object_method_count(); i++)
+        fprintf(out, "  %-8s %s\n", ppb_object_method_at(i)->id, ppb_object_method_at(i)->summary);
     fprintf(out,
             "\n"
             "examples:\n"

@@ -57,6 +57,9 @@ static const enum_name channel_names[] = {
 static const enum_name delta_m_names[] = {
     {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 static const enum_name on_off_names[] = {{0, "off"}, {1, "on"}, {0, NULL}};
+static const enum_name shape_names[] = {{PPB_OBJ_BOX, "box"},     {PPB_OBJ_SPHERE, "sphere"},
+                                        {PPB_OBJ_YOKAN, "yokan"}, {PPB_OBJ_MESH, "mesh"},
+                                        {PPB_OBJ_FILE, "file"},   {0, NULL}};
 
 /* An enum key is stored as an int (ppb_scene.geometry is a ppb_geometry). */
 _Static_assert(sizeof(ppb_geometry) == sizeof(int), "enum keys are stored as int");
@@ -189,6 +192,49 @@ static const key_def keys[] = {
     {"rte2d", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.delta_m), 0, 0, "on", on_off_names,
      "rte2d: delta-M scaling of the forward peak the direction cells cannot resolve, with the "
      "single-scattering correction of the exit radiance"},
+    /* [object]: `ppbench object` only (docs/reference.md, Objects); the tube's Monte Carlo
+     * never reads them, so none is part of its reference cache's key. */
+    {"object", "shape", K_ENUM, PPB_NOT_MC_KEY, F(object.shape), 0, 0, "box", shape_names,
+     "the object: box (the whole grid), sphere (the grid's inscribed ball), yokan (a box with a "
+     "ball inclusion of another material), mesh (a closed OBJ mesh), file (a voxel file)"},
+    {"object", "grid_x", K_INT, PPB_NOT_MC_KEY, F(object.nx), 1, 512, "32", NULL,
+     "grid voxels along x (mesh: the mesh's bounding box spans the grid)"},
+    {"object", "grid_y", K_INT, PPB_NOT_MC_KEY, F(object.ny), 1, 512, "32", NULL,
+     "grid voxels along y"},
+    {"object", "grid_z", K_INT, PPB_NOT_MC_KEY, F(object.nz), 1, 512, "32", NULL,
+     "grid voxels along z"},
+    {"object", "voxel", K_REAL, PPB_NOT_MC_KEY, F(object.voxel), 1e-4, 100, "0.25", NULL,
+     "voxel edge h, in the config's unit (mfp or mm)"},
+    {"object", "inclusion_radius", K_REAL, PPB_NOT_MC_KEY, F(object.inc_radius), 0, 0.5, "0.25",
+     NULL, "yokan: the inclusion ball's radius, a fraction of the grid's smallest edge"},
+    {"object", "inclusion_x", K_REAL, PPB_NOT_MC_KEY, F(object.inc_x), 0, 1, "0.5", NULL,
+     "yokan: the inclusion's centre along x, a fraction of the grid's x edge"},
+    {"object", "inclusion_y", K_REAL, PPB_NOT_MC_KEY, F(object.inc_y), 0, 1, "0.5", NULL,
+     "yokan: the inclusion's centre along y, a fraction of the grid's y edge"},
+    {"object", "inclusion_z", K_REAL, PPB_NOT_MC_KEY, F(object.inc_z), 0, 1, "0.5", NULL,
+     "yokan: the inclusion's centre along z, a fraction of the grid's z edge"},
+    {"object", "inclusion_sigma_t", K_REAL, PPB_NOT_MC_KEY, F(object.inc_sigma_t), 1e-3, 1000, "4",
+     NULL, "yokan: the inclusion's extinction, per unit length"},
+    {"object", "inclusion_albedo", K_REAL, PPB_NOT_MC_KEY, F(object.inc_albedo), 0, 1, "0.7", NULL,
+     "yokan: the inclusion's single-scattering albedo"},
+    {"object", "mesh", K_PATH, PPB_NOT_MC_KEY, F(object.mesh), 0, 0, "", NULL,
+     "shape = mesh: a closed triangle mesh (Wavefront OBJ), relative to the config's folder"},
+    {"object", "voxels", K_PATH, PPB_NOT_MC_KEY, F(object.voxels), 0, 0, "", NULL,
+     "shape = file: a voxel file (JSON header + raw bytes), relative to the config's folder"},
+    {"object", "light_theta", K_REAL, PPB_NOT_MC_KEY, F(object.light_theta), 0, 180, "0", NULL,
+     "direction toward the light: degrees from +y"},
+    {"object", "light_phi", K_REAL, PPB_NOT_MC_KEY, F(object.light_phi), -360, 360, "0", NULL,
+     "direction toward the light: degrees from +x toward +z"},
+    {"object", "camera_theta", K_REAL, PPB_NOT_MC_KEY, F(object.camera_theta), 0, 180, "45", NULL,
+     "direction toward the orthographic camera: degrees from +y"},
+    {"object", "camera_phi", K_REAL, PPB_NOT_MC_KEY, F(object.camera_phi), -360, 360, "30", NULL,
+     "direction toward the camera: degrees from +x toward +z"},
+    {"object", "image_width", K_INT, PPB_NOT_MC_KEY, F(object.image_w), 1, 4096, "64", NULL,
+     "camera pixels across"},
+    {"object", "image_height", K_INT, PPB_NOT_MC_KEY, F(object.image_h), 1, 4096, "64", NULL,
+     "camera pixels down"},
+    {"object", "patch", K_INT, PPB_NOT_MC_KEY, F(object.patch), 1, 512, "4", NULL,
+     "patch edge in boundary faces: a patch is patch x patch faces of one plane and orientation"},
     {"output", "dir", K_PATH, PPB_NOT_MC_KEY, F(out_dir), 0, 0, "", NULL,
      "output directory; default results/<name>"},
     {"run", "memory_limit", K_REAL, PPB_NOT_MC_KEY, F(memory_limit), 0, 1e6, "0", NULL,

@@ -37,7 +37,7 @@ typedef enum ppb_mc_key { PPB_MC_KEY = 1, PPB_NOT_MC_KEY = 2 } ppb_mc_key;
 typedef enum ppb_unit { PPB_UNIT_MFP = 0, PPB_UNIT_MM = 1 } ppb_unit;
 
 #define PPB_MAX_METHODS 16
-#define PPB_MAX_KEYS    64
+#define PPB_MAX_KEYS    96
 
 typedef struct ppb_mc_settings {
     long long photons;   /* photon budget */
@@ -91,6 +91,32 @@ typedef struct ppb_rte2d_settings {
     int delta_m;     /* 1: delta-M scaling with the single-scattering correction (TMS) */
 } ppb_rte2d_settings;
 
+/* A three-dimensional object's settings ([object]; docs/reference.md, Objects). Material 1 is
+ * [medium]'s sigma_t, albedo, g and n; material 2 the inclusion's (shape = yokan). The light and
+ * the camera are given as the direction toward them, theta from +y and phi from +x toward +z;
+ * model/object_build.h turns these into a ppb_object. The tube's methods ignore them. */
+typedef enum {
+    PPB_OBJ_BOX = 0,
+    PPB_OBJ_SPHERE = 1,
+    PPB_OBJ_YOKAN = 2,
+    PPB_OBJ_MESH = 3,
+    PPB_OBJ_FILE = 4
+} ppb_object_shape;
+typedef struct ppb_object_settings {
+    int shape;                       /* ppb_object_shape */
+    int nx, ny, nz;                  /* grid voxels */
+    double voxel;                    /* voxel edge, in the config's unit */
+    double inc_radius;               /* inclusion radius, a fraction of the smallest grid edge */
+    double inc_x, inc_y, inc_z;      /* inclusion centre, fractions of the grid's edges */
+    double inc_sigma_t, inc_albedo;  /* the inclusion's material */
+    char mesh[1024];                 /* shape = mesh: a closed triangle mesh (OBJ) */
+    char voxels[1024];               /* shape = file: a voxel file (docs/reference.md, Objects) */
+    double light_theta, light_phi;   /* toward the light, degrees */
+    double camera_theta, camera_phi; /* toward the camera, degrees */
+    int image_w, image_h;            /* camera pixels */
+    int patch;                       /* patch edge in boundary faces */
+} ppb_object_settings;
+
 /* A method defined by the config itself: a section [method.NAME] with `command` (a shell
  * command holding {scene} and {out}) and an optional `timeout` in seconds, or the same keys
  * given as --set method.NAME.command=... (which defines NAME, or overrides the file's key).
@@ -138,6 +164,7 @@ typedef struct ppb_config {
     ppb_pbd_settings pbd;
     ppb_dirpole_settings dirpole;
     ppb_rte2d_settings rte2d;
+    ppb_object_settings object;
     char out_dir[1024];
     double memory_limit; /* GB a method may allocate; 0 = half the machine's (base/memory.h) */
     ppb_key_origin origin[PPB_MAX_KEYS]; /* per key of the table */

@@ -25,8 +25,9 @@ int ppb_object_result_init(ppb_object_result *r, const char *method, int npatch,
 
 void ppb_object_result_free(ppb_object_result *r)
 {
-    free(r->patch_rad), free(r->patch_se), free(r->img), free(r->img_se);
+    free(r->patch_rad), free(r->patch_se), free(r->img), free(r->img_se), free(r->totals_csv);
     r->patch_rad = r->patch_se = r->img = r->img_se = NULL;
+    r->totals_csv = NULL;
 }
 
 /* Whether voxel (i, j, k), possibly beyond the grid, holds medium. */

@@ -84,6 +84,9 @@ typedef struct ppb_object_result {
     double *img, *img_se; /* [img_w * img_h]; pixels that see no medium hold 0 */
     double seconds;
     long long photons; /* Monte Carlo photons traced; 0 otherwise */
+    /* A method's own totals, or NULL: one CSV header line and one row (malloc'd; the Monte
+     * Carlo's photons and energy balance), which the driver writes as totals_<method>.csv. */
+    char *totals_csv;
 } ppb_object_result;
 
 int ppb_object_result_init(ppb_object_result *r, const char *method, int npatch, int nbins,
