@@ -655,8 +655,7 @@ static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
         return -1;
     ppb_figures fig = {.who = ex->cfg->name, .staged = ad->tmp, .final = ad->path};
     const ppb_result *ref = ppb_experiment_reference(ex);
-    const ppb_image_meta meta = {ex->cfg->name,       PPB_VERSION, ex->cfg->mc.seed,
-                                 ex->cfg->mc.photons, NULL,        NULL};
+    const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
     ppb_err why;
     if (ppb_images_write(dir, &ex->cfg->scene, &meta, ex->res, ex->n,
                          ref ? (int)(ref - ex->res) : -1, &why)) {
@@ -805,10 +804,10 @@ static int write_colour_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_er
             ref = n;
         n++;
     }
-    const ppb_image_meta meta = {ex->cfg->name,       PPB_VERSION,       ex->cfg->mc.seed,
-                                 ex->cfg->mc.photons, ex->cfg->material, "mm"};
+    const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
     ppb_err why;
-    if (ppb_images_write_colour(dir, &col->cfg[0].scene, &meta, rows, n, ref, &why)) {
+    if (ppb_images_write_colour(dir, &col->cfg[0].scene, &meta, ex->cfg->material,
+                                ex->cfg->unit == PPB_UNIT_MM ? "mm" : "mfp", rows, n, ref, &why)) {
         char path[PPB_PATH_MAX + 256];
         out_path(dir, "images", path, sizeof path);
         ppb_err ignored;

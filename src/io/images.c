@@ -435,7 +435,8 @@ static void tone_map_colour(const img_ctx *ch, int i, const double white[2], uns
 }
 
 int ppb_images_write_colour(const char *out_dir, const ppb_scene *sc, const ppb_image_meta *meta,
-                            const ppb_result *const res[3], int n, int ref, ppb_err *err)
+                            const char *material, const char *unit, const ppb_result *const res[3],
+                            int n, int ref, ppb_err *err)
 {
     if (sc->geometry != PPB_GEOM_TUBE || n <= 0)
         return 0;
@@ -488,10 +489,10 @@ int ppb_images_write_colour(const char *out_dir, const ppb_scene *sc, const ppb_
         const ppb_exr_attr attrs[] = {
             {"ppbench.method", res[0][i].method},
             {"ppbench.case", meta && meta->case_name ? meta->case_name : "unknown"},
-            {"ppbench.material", meta && meta->material ? meta->material : "unknown"},
+            {"ppbench.material", material ? material : "unknown"},
             {"ppbench.primaries", primaries},
             {"ppbench.luminance", luminance},
-            {"ppbench.units", meta && meta->unit ? meta->unit : "unknown"},
+            {"ppbench.units", unit ? unit : "unknown"},
             {"ppbench.exposure", exposure},
             {"ppbench.seed", seed},
             {"ppbench.photons", photons},
