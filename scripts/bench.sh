@@ -67,22 +67,10 @@ fi
 # and method, beside the noise floor), drawn from the cases' summary.csv before the report.
 bash scripts/summary_plot.sh "$out" "${cases[@]}"
 ./ppbench report "$out" "${cases[@]}"
-# The materials study (docs/reference.md: Colour; $out/materials/README.md): every case of
-# configs/materials.list, a measured material in colour (channel = rgb), into
-# $out/materials/<case>, its subsets r, g, b and y (the luminance) each a case of the
-# materials' own report (Table 2, ranking, figures per material and channel). Their Monte Carlo
-# references are shipped (references/material_*), so the study traces none.
-mapfile -t materials < configs/materials.list
-subsets=()
-for i in "${!materials[@]}"; do
-  c=${materials[$i]}
-  printf '[materials %d/%d] %s (%ds elapsed)\n' $((i + 1)) ${#materials[@]} "$c" $(( $(date +%s) - t0 )) >&2
-  PPB_BENCH_STUDY=1 ./ppbench run "${sets[@]}" --ref-cache "$cache" --out "$out/materials/$c" "configs/$c.ini"
-  for s in r g b y; do subsets+=("$c/$s"); done
-done
-[ $quick = 1 ] && cp "$out/notes.md" "$out/materials/notes.md"
-bash scripts/summary_plot.sh "$out/materials" "${subsets[@]}"
-./ppbench report "$out/materials" "${subsets[@]}"
+# The materials study (scripts/materials_study.sh; docs/reference.md: Colour): the colour cases
+# of configs/materials.list into $out/materials, with their own report.
+[ $quick = 1 ] && mkdir -p "$out/materials" && cp "$out/notes.md" "$out/materials/notes.md"
+bash scripts/materials_study.sh --out "$out/materials" --cache "$cache" "${sets[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2
 # The shipped references (references/<case>/, docs/reference.md: Keys) come from this study's
 # cache by `make references` (scripts/references.sh), run after a full bench.
