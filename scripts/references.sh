@@ -7,7 +7,8 @@
 # that every device is served: docs/reference.md, Keys), with OUT/<case>/provenance.txt saying what it is (photons, seed,
 # batches, version, commit, device, key). DIR defaults to results (what `make bench` wrote),
 # OUT to references. Refuses a case whose run was partial, traced no reference, or whose file
-# is gone; fails when the whole layer passes 30 MB. `make references` runs it.
+# is gone; fails when the whole layer passes 50 MB. `make references` runs it. Without CASEs:
+# the study's cases and each channel of the materials study's (materials/<case>/<r|g|b>).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 from=results out=references cases=()
