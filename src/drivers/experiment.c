@@ -271,6 +271,10 @@ static int compute_colour(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx
     y->ocl_versions = col->sub[0].ocl_versions;
     memcpy(ex->device, y->device, sizeof ex->device);
     ex->ocl_versions = y->ocl_versions;
+    /* The run's failures are every channel's, as y records them (`run` says them). */
+    ex->nfailed = y->nfailed;
+    memcpy(ex->failed, y->failed, sizeof ex->failed);
+    memcpy(ex->failed_why, y->failed_why, sizeof ex->failed_why);
     if (!any && col->sub[0].nfailed > 0)
         return ppb_fail(err, "%s", col->sub[0].failed_why[0]);
     return 0;
@@ -852,10 +856,8 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
     }
     if (ppb_adir_commit(&ad, err))
         return -1;
-    /* A colour set's failures are its luminance's: every channel's, named by channel. */
-    const ppb_experiment *f = ex->colour ? &ex->colour->sub[PPB_SUBSET_Y] : ex;
-    if (f->nfailed > 0)
+    if (ex->nfailed > 0) /* a colour run's: every channel's, named by channel */
         return ppb_fail(err, "%d method(s) failed, the others' outputs are written: %s: %s",
-                        f->nfailed, f->failed[0], f->failed_why[0]);
+                        ex->nfailed, ex->failed[0], ex->failed_why[0]);
     return 0;
 }
