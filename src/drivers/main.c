@@ -373,7 +373,7 @@ static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_grid
     return 0;
 }
 
-/* A colour config (channel = rgb) where only `ppbench run` takes one (sweep, perf, slurm,
+/* A colour config (channel = rgb) where only `ppbench run` takes one (sweep, slurm,
  * mc-shard, mc-merge: one channel's experiment each). */
 static int refuse_colour(const ppb_config *cfg, ppb_err *err)
 {
