@@ -4,9 +4,10 @@
  * own context); the luminance subset is the BT.709 weighted sum of those grey runs, and its
  * metrics are the metrics of that sum (computed here from the grey runs); no NaN; the Monte
  * Carlo conserves energy in every channel and in the luminance (R + T + sides + absorbed +
- * ballistic + specular = 1, every photon ends in one tally, to the tallies' fixed point). The written set: one grey set per
- * channel and y, summary.csv with its channel column, the colour pictures read back. The
- * refusals: a channel outside a key's range, rgb without a material, rgb in a sweep. */
+ * ballistic + specular = 1, every photon ends in one tally, to the tallies' fixed point). The
+ * written set: one grey set per channel and y, summary.csv with its channel column, the colour
+ * pictures read back. The refusals: a channel outside a key's range, rgb without a material, rgb in
+ * a sweep, a run into the committed materials study. */
 #include "testutil.h"
 
 #include <sys/stat.h>
@@ -288,6 +289,14 @@ static void test_refusals(void **state)
     assert_int_equal(tu_sh("%s", cmd), 2);
     snprintf(cmd, sizeof cmd, "%s/c.log", dir);
     assert_non_null(strstr(tu_read_text(cmd), "is `ppbench run`'s alone"));
+    /* The materials study's sets (results/materials/<case>) are make bench's alone
+     * (drivers/study_guard.h): the case's own config, without --out, is refused untouched. */
+    snprintf(cmd, sizeof cmd,
+             "cd %s && env -u PPB_BENCH_STUDY %s run configs/material_marble.ini > %s/d.log 2>&1",
+             PPB_SOURCE_DIR, tu_bin(), dir);
+    assert_int_equal(tu_sh("%s", cmd), 2);
+    snprintf(cmd, sizeof cmd, "%s/d.log", dir);
+    assert_non_null(strstr(tu_read_text(cmd), "is the committed study's"));
 }
 
 int main(void)
