@@ -67,6 +67,10 @@ fi
 # and method, beside the noise floor), drawn from the cases' summary.csv before the report.
 bash scripts/summary_plot.sh "$out" "${cases[@]}"
 ./ppbench report "$out" "${cases[@]}"
+# The materials study (scripts/materials_study.sh; docs/reference.md: Colour): the colour cases
+# of configs/materials.list into $out/materials, with their own report.
+[ $quick = 1 ] && mkdir -p "$out/materials" && cp "$out/notes.md" "$out/materials/notes.md"
+bash scripts/materials_study.sh --out "$out/materials" --cache "$cache" "${sets[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2
 # The shipped references (references/<case>/, docs/reference.md: Keys) come from this study's
 # cache by `make references` (scripts/references.sh), run after a full bench.

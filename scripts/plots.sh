@@ -23,6 +23,10 @@
 #                                Fig. 6-7); the light arrow is in the pictures (src/io/images.c)
 #   images/error_<m>.{png,pdf}   errmap_<m>.png titled "<m> vs mc", with a colour bar numbered
 #                                -50% .. +50%
+#   images/colour.{png,pdf}      (a colour set, docs/reference.md: Colour: CASE_DIR holds the
+#                                subsets r, g, b, y) every method's colour picture (sRGB,
+#                                images/<m>.png) in a row, the reference first, over its
+#                                luminance error map against the reference (y/images/errmap_<m>.png)
 set -euo pipefail
 dir=$1
 here=$(cd "$(dirname "$0")" && pwd)
@@ -281,3 +285,41 @@ if [ -d "$img" ] && has_rows "$dir/angular.csv"; then
     render "$img/error_$m" 560 640
   done
 fi
+
+# ---- a colour set: every method's colour picture over its luminance error map ----
+if [ -d "$dir/y/images" ] && has_rows "$dir/timings.csv"; then
+  mapfile -t all_methods < <(awk -F, '$1 == "y" {print $2}' "$dir/timings.csv" | awk '!seen[$0]++' | grep -E '^[A-Za-z0-9_.+-]+$')
+  present=()
+  [ -n "$ref" ] && [ -s "$img/$ref.png" ] && present+=("$ref")
+  for m in "${all_methods[@]}"; do
+    [ "$m" != "$ref" ] && [ -s "$img/$m.png" ] && [ -s "$dir/y/images/errmap_$m.png" ] && present+=("$m")
+  done
+  n=${#present[@]}
+  if [ "$n" -gt 1 ]; then
+    {
+      echo "set multiplot title NAME.\": every method's colour picture (sRGB; top: S1, S3 from above, bottom: S2, S3 from below)\\nover its luminance error against $ref, (Y_m - Y_$ref) / Y_$ref: blue -50% .. grey 0 .. red +50%\""
+      echo "unset border; unset tics; unset key; set size ratio -1; set margins 0.5, 0.5, 0.5, 2"
+      i=0
+      for m in "${present[@]}"; do
+        x=$(awk -v i=$i -v n="$n" 'BEGIN {print i / n}')
+        wd=$(awk -v n="$n" 'BEGIN {print 1 / n}')
+        echo "set origin $x, 0.46; set size $wd, 0.46"
+        echo "set title '$m' font ',14'"
+        echo "plot DIR.'/images/$m.png' binary filetype=png with rgbimage"
+        if [ "$m" != "$ref" ]; then
+          # the map alone (errmap's strip at the right holds its own bar, cut off here)
+          read -r wm hm < <(od -An -tu1 -j16 -N8 "$img/$m.png" | awk '{print $1 * 16777216 + $2 * 65536 + $3 * 256 + $4, $5 * 16777216 + $6 * 65536 + $7 * 256 + $8}')
+          echo "set origin $x, 0.0; set size $wd, 0.46"
+          echo "set title '$m vs $ref (Y)' font ',11'"
+          echo "set xrange [-0.5:$wm - 0.5]; set yrange [-0.5:$hm - 0.5]"
+          echo "plot DIR.'/y/images/errmap_$m.png' binary filetype=png with rgbimage"
+          echo "set autoscale xy"
+        fi
+        i=$((i + 1))
+      done
+      echo "unset multiplot"
+    } > "$tmp/body.gp"
+    render "$img/colour" $((n * 200 + 20)) 700
+  fi
+fi
+

@@ -632,6 +632,80 @@ static void test_unwritable_dir_fails(void **state)
     fake_free(f);
 }
 
+/* ---- colour (ppb_images_write_colour; docs/reference.md: Colour) ---- */
+
+/* A uniform colour field, R, G, B = 0.3, 0.2, 0.1 in every cell of both results: the EXR holds
+ * each channel's value on every surface pixel, bit for bit, with the colour attributes; the
+ * PNG's surface pixels are the stated tone curve's bytes, computed here from its definition:
+ * L_white = the reference's luminance (uniform: its 99th percentile is the value), Y = 0.2126 R
+ * + 0.7152 G + 0.0722 B (BT.709), x = L / L_white, so the luminance of x is 1, above the knee
+ * 0.75: every channel scaled by s(1) = 0.75 + 0.25 (1 - e^-1), then the sRGB OETF
+ * (IEC 61966-2-1: 12.92 x below 0.0031308, 1.055 x^(1/2.4) - 0.055 above). */
+static void test_colour_uniform(void **state)
+{
+    (void)state;
+    fake *ch[3];
+    const double L[3] = {0.3, 0.2, 0.1};
+    const ppb_result *res[3];
+    for (int c = 0; c < 3; c++) {
+        ch[c] = fake_new("colour_uniform", PPB_GEOM_TUBE);
+        fake_fill(ch[c], 0, L[c]);
+        fake_fill(ch[c], 1, L[c]);
+        res[c] = ch[c]->ex.res;
+    }
+    const ppb_image_meta meta = {"colour_case", "v9", 7, 1000};
+    ppb_err err;
+    if (ppb_images_write_colour(ch[0]->cfg.out_dir, &ch[0]->cfg.scene, &meta, "marble", "mm", res,
+                                2, 0, &err))
+        fail_msg("%s", err.msg);
+    int w, h, pw, ph;
+    float *exr = read_exr(ch[0], "pp.exr", &w, &h);
+    unsigned char *png = read_png(ch[0], "pp.png", &pw, &ph);
+    assert_int_equal(pw, w);
+    assert_int_equal(ph, h);
+    double y = 0.2126 * L[0] + 0.7152 * L[1] + 0.0722 * L[2];
+    double s = 0.75 + 0.25 * (1 - exp(-1.0));
+    unsigned char want[3];
+    for (int c = 0; c < 3; c++) {
+        double x = s * L[c] / y;
+        x = x > 1 ? 1 : x;
+        double e = x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1 / 2.4) - 0.055;
+        want[c] = (unsigned char)lround(255 * e);
+    }
+    long lit = 0;
+    for (long k = 0; k < (long)w * h; k++) {
+        if (exr[3 * k] == 0.0f && exr[3 * k + 1] == 0.0f && exr[3 * k + 2] == 0.0f)
+            continue;
+        for (int c = 0; c < 3; c++)
+            assert_true(exr[3 * k + c] == (float)L[c]);
+        if (is_arrow(png + 3 * k))
+            continue;
+        lit++;
+        for (int c = 0; c < 3; c++)
+            assert_int_equal(png[3 * k + c], want[c]);
+    }
+    assert_true(lit > (long)w * h / 5);
+    char path[1300], v[512];
+    image_file(ch[0], "mc.exr", path, sizeof path);
+    exr_string_attr(path, "ppbench.material", v, sizeof v);
+    assert_string_equal(v, "marble");
+    exr_string_attr(path, "ppbench.units", v, sizeof v);
+    assert_string_equal(v, "mm");
+    exr_string_attr(path, "ppbench.primaries", v, sizeof v);
+    assert_non_null(strstr(v, "Rec. 709"));
+    exr_string_attr(path, "ppbench.luminance", v, sizeof v);
+    assert_string_equal(v, "Y = 0.2126 R + 0.7152 G + 0.0722 B");
+    exr_string_attr(path, "ppbench.exposure", v, sizeof v);
+    char white[64];
+    snprintf(white, sizeof white, "L_white = %.6g (top view), %.6g (bottom view)", y, y);
+    if (!strstr(v, white))
+        fail_msg("exposure attribute '%s' lacks '%s'", v, white);
+    free(exr);
+    free(png);
+    for (int c = 0; c < 3; c++)
+        fake_free(ch[c]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -650,6 +724,7 @@ int main(void)
         cmocka_unit_test(test_slab_writes_nothing),
         cmocka_unit_test(test_image_exr_metadata),
         cmocka_unit_test(test_unwritable_dir_fails),
+        cmocka_unit_test(test_colour_uniform),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -329,7 +329,8 @@ static void test_errors(void **state)
         {"bad_material", "material = skimilk\n", "",
          ":4: [medium] material: unknown material 'skimilk' (did you mean skimmilk?"},
         {"bad_channel", "material = apple\nchannel = gren\n", "",
-         ":5: [medium] channel: 'gren' is not one of r|g|b|red|green|blue (did you mean green?)"},
+         ":5: [medium] channel: 'gren' is not one of r|g|b|rgb|red|green|blue (did you mean "
+         "green?)"},
         {"with_sigma_t", "material = apple\nsigma_t = 2\n", "",
          ":5: [medium] sigma_t: given together with material = apple (line 4)"},
         {"with_n_set", "material = apple\n", "--set medium.n=1.4",

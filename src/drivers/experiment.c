@@ -19,6 +19,7 @@
 #include "io/images.h"
 #include "io/plots.h"
 #include "methods/registry.h"
+#include "model/colour.h"
 #include "methods/work_estimate.h"
 #include "drivers/summary_table.h"
 #include "base/progress.h"
@@ -27,30 +28,33 @@
 #define PPB_VERSION "unknown"
 #endif
 
-/* Runs method m under the config's id for it (an external method's descriptor has none). */
-static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, ppb_run_ctx *ctx,
-                      ppb_err *err)
+/* Makes room for method m's results in ex (its result and companion, initialised with the
+ * scene's layout and their ids): *out and *nout. */
+static int begin_method(ppb_experiment *ex, const char *id, const ppb_method *m, ppb_result **out,
+                        int *nout, ppb_err *err)
 {
-    int nout = m->also ? 2 : 1;
-    if (ex->n + nout > PPB_MAX_RESULTS)
+    *nout = m->also ? 2 : 1;
+    if (ex->n + *nout > PPB_MAX_RESULTS)
         return ppb_fail(err, "too many results");
     ppb_layout lo = ppb_scene_layout(&ex->cfg->scene);
-    ppb_result *out = &ex->res[ex->n];
-    if (ppb_result_init(&out[0], id, &lo, err))
+    *out = &ex->res[ex->n];
+    if (ppb_result_init(&(*out)[0], id, &lo, err))
         return -1;
-    if (nout == 2 && ppb_result_init(&out[1], m->also, &lo, err)) {
-        ppb_result_free(&out[0]);
+    if (*nout == 2 && ppb_result_init(&(*out)[1], m->also, &lo, err)) {
+        ppb_result_free(&(*out)[0]);
         return -1;
     }
-    ex->n += nout;
-    if (!ctx->quiet)
-        fprintf(stderr, "%s: %s ...\n", ex->cfg->name, id);
-    double t0 = ppb_now();
-    ppb_err why = {{0}};
-    ctx->prior = ex->res; /* what ran before it, for a method that combines others */
-    ctx->nprior = ex->n - nout;
-    ctx->self = m;
-    if (m->run(ctx, out, &why)) {
+    ex->n += *nout;
+    return 0;
+}
+
+/* Records how method m's run into ex's last nout results went: failed = its run's status, why
+ * its reason, seconds its time. */
+static void end_method(ppb_experiment *ex, const char *id, const ppb_method *m, int nout,
+                       int failed, const ppb_err *why, double seconds, const ppb_run_ctx *ctx)
+{
+    ppb_result *out = &ex->res[ex->n - nout];
+    if (failed) {
         /* This method's failure is its own; the others run on. */
         for (int i = 0; i < nout; i++)
             ppb_result_free(&out[i]);
@@ -63,21 +67,17 @@ static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, p
                 snprintf(ex->incomplete[ex->nincomplete++], sizeof ex->incomplete[0], "%s", id);
             fprintf(stderr,
                     "%s: %s interrupted before it finished (%s): none of its rows written\n",
-                    ex->cfg->name, id, why.msg);
-            return 0;
+                    ex->cfg->name, id, why->msg);
+            return;
         }
         if (ex->nfailed < PPB_MAX_METHODS) {
             snprintf(ex->failed[ex->nfailed], sizeof ex->failed[0], "%s", id);
-            snprintf(ex->failed_why[ex->nfailed], sizeof ex->failed_why[0], "%s", why.msg);
+            snprintf(ex->failed_why[ex->nfailed], sizeof ex->failed_why[0], "%s", why->msg);
             ex->nfailed++;
         }
-        fprintf(stderr, "%s: %s failed: %s\n", ex->cfg->name, id, why.msg);
-        return 0;
+        fprintf(stderr, "%s: %s failed: %s\n", ex->cfg->name, id, why->msg);
+        return;
     }
-    /* timings.csv's seconds (reference: Outputs): the method's whole run, from its start to its
-     * result (setup, kernel builds, the reference cache, the work, reading back), the same
-     * number said here; the progress lines time the work loop alone (mc: the trace). */
-    double seconds = ppb_now() - t0;
     for (int i = 0; i < nout; i++) {
         ex->seconds[ex->n - nout + i] = seconds;
         ex->partial |= out[i].partial;
@@ -97,6 +97,186 @@ static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, p
         fprintf(stderr, "%s: %s interrupted before it finished: none of its rows written\n",
                 ex->cfg->name, id);
     }
+}
+
+/* Runs method m under the config's id for it (an external method's descriptor has none). */
+static int run_method(ppb_experiment *ex, const char *id, const ppb_method *m, ppb_run_ctx *ctx,
+                      ppb_err *err)
+{
+    int nout;
+    ppb_result *out;
+    if (begin_method(ex, id, m, &out, &nout, err))
+        return -1;
+    if (!ctx->quiet)
+        fprintf(stderr, "%s: %s ...\n", ex->cfg->name, id);
+    double t0 = ppb_now();
+    ppb_err why = {{0}};
+    ctx->cfg = ex->cfg;
+    ctx->prior = ex->res; /* what ran before it, for a method that combines others */
+    ctx->nprior = ex->n - nout;
+    ctx->self = m;
+    int rc = m->run(ctx, out, &why);
+    /* timings.csv's seconds (reference: Outputs): the method's whole run, from its start to its
+     * result (setup, kernel builds, the reference cache, the work, reading back), the same
+     * number said here; the progress lines time the work loop alone (mc: the trace). */
+    end_method(ex, id, m, nout, rc != 0, &why, ppb_now() - t0, ctx);
+    return 0;
+}
+
+const char *ppb_subset_name(int s)
+{
+    static const char *const names[PPB_NSUBSETS] = {"r", "g", "b", "y"};
+    return s >= 0 && s < PPB_NSUBSETS ? names[s] : "?";
+}
+
+/* A colour experiment's method m run once for every channel (its run_channels): each channel's
+ * results made in its own experiment, handed over as one array (method.h), and recorded in
+ * each with the joint run's time. */
+static int run_channels(ppb_colour *col, const char *id, const ppb_method *m, ppb_run_ctx *ctx,
+                        ppb_err *err)
+{
+    ppb_result all[6];
+    ppb_result *out[3];
+    int nout = 0;
+    memset(all, 0, sizeof all);
+    for (int c = 0; c < 3; c++) {
+        if (begin_method(&col->sub[c], id, m, &out[c], &nout, err)) {
+            for (int d = 0; d < c; d++) /* the ones begun before are given back */
+                end_method(&col->sub[d], id, m, nout, 1, &(ppb_err){"not run"}, 0, ctx);
+            return -1;
+        }
+        memcpy(&all[2 * c], out[c], (size_t)nout * sizeof *out[c]);
+    }
+    if (!ctx->quiet)
+        fprintf(stderr, "%s: %s (r, g, b at once) ...\n", col->sub[PPB_SUBSET_Y].cfg->name, id);
+    double t0 = ppb_now();
+    ppb_err why = {{0}};
+    ctx->cfg = &col->cfg[0];
+    ctx->prior = col->sub[0].res;
+    ctx->nprior = col->sub[0].n - nout;
+    ctx->self = m;
+    int rc = m->run_channels(ctx, col->cfg, 3, all, &why);
+    double seconds = ppb_now() - t0;
+    for (int c = 0; c < 3; c++) {
+        memcpy(out[c], &all[2 * c], (size_t)nout * sizeof *out[c]);
+        end_method(&col->sub[c], id, m, nout, rc != 0, &why, seconds, ctx);
+    }
+    return 0;
+}
+
+/* The luminance subset: for every result all three channels hold, their weighted sum
+ * (model/colour.h); a method that failed or is incomplete in any channel is so in y. */
+static int luminance(ppb_colour *col, ppb_err *err)
+{
+    ppb_experiment *y = &col->sub[PPB_SUBSET_Y];
+    for (int i = 0; i < col->sub[0].n; i++) {
+        const ppb_result *ch[3] = {&col->sub[0].res[i], NULL, NULL};
+        double seconds = col->sub[0].seconds[i];
+        for (int c = 1; c < 3; c++)
+            for (int j = 0; j < col->sub[c].n && !ch[c]; j++)
+                if (!strcmp(col->sub[c].res[j].method, ch[0]->method)) {
+                    ch[c] = &col->sub[c].res[j];
+                    seconds += col->sub[c].seconds[j];
+                }
+        if (!ch[1] || !ch[2])
+            continue;
+        if (y->n >= PPB_MAX_RESULTS)
+            return ppb_fail(err, "too many results");
+        if (ppb_result_luminance(ch, &y->res[y->n], err))
+            return -1;
+        y->seconds[y->n++] = seconds;
+    }
+    for (int c = 0; c < 3; c++) {
+        const ppb_experiment *s = &col->sub[c];
+        y->partial |= s->partial;
+        for (int i = 0; i < s->nfailed && y->nfailed < PPB_MAX_METHODS; i++) {
+            snprintf(y->failed[y->nfailed], sizeof y->failed[0], "%s", s->failed[i]);
+            snprintf(y->failed_why[y->nfailed++], sizeof y->failed_why[0], "%s: %s",
+                     ppb_subset_name(c), s->failed_why[i]);
+        }
+        for (int i = 0; i < s->nincomplete && y->nincomplete < PPB_MAX_METHODS; i++)
+            snprintf(y->incomplete[y->nincomplete++], sizeof y->incomplete[0], "%s",
+                     s->incomplete[i]);
+    }
+    return 0;
+}
+
+/* A colour experiment (experiment.h): each channel's config, every method per channel (or at
+ * once, run_channels), then the luminance. */
+static int compute_colour(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ctx *ctx, ppb_err *err)
+{
+    ppb_colour *col = calloc(1, sizeof *col);
+    if (!col)
+        return ppb_fail(err, "out of memory");
+    ex->colour = col;
+    for (int c = 0; c < 3; c++) {
+        if (ppb_config_channel(cfg, c, &col->cfg[c], err))
+            return -1;
+        col->sub[c].cfg = &col->cfg[c];
+    }
+    col->sub[PPB_SUBSET_Y].cfg = cfg;
+    /* Every channel's result arrays and the luminance's are held at once. */
+    double bytes = (double)PPB_NSUBSETS * ppb_work_results_bytes(cfg);
+    char detail[160];
+    snprintf(detail, sizeof detail,
+             "its result arrays: radiance and standard error of %zu cells, for r, g, b and y",
+             ppb_scene_layout(&cfg->scene).ncells);
+    if (ppb_memory_check(bytes, cfg->memory_limit, "the colour experiment", detail, err))
+        return -1;
+    for (int c = 0; c < 3 && !ctx->quiet; c++)
+        ppb_work_print(stderr, &col->cfg[c]);
+    int i = 0;
+    for (; i < cfg->nmethods && !ppb_interrupted(); i++) {
+        const ppb_method *m = ppb_method_find(cfg, cfg->methods[i]);
+        if (m->run_channels) {
+            if (run_channels(col, cfg->methods[i], m, ctx, err))
+                return -1;
+            continue;
+        }
+        for (int c = 0; c < 3 && !ppb_interrupted(); c++) {
+            ppb_experiment *s = &col->sub[c];
+            ctx->mc_reference[0] = ctx->mc_shipped_key[0] = '\0';
+            if (run_method(s, cfg->methods[i], m, ctx, err))
+                return -1;
+            if (m->reference == 1) { /* the channel's own reference file (provenance.txt) */
+                snprintf(s->mc_reference, sizeof s->mc_reference, "%s", ctx->mc_reference);
+                snprintf(s->mc_shipped_key, sizeof s->mc_shipped_key, "%s", ctx->mc_shipped_key);
+            }
+        }
+    }
+    ctx->prior = NULL;
+    ctx->nprior = 0;
+    ctx->cfg = cfg;
+    for (; i < cfg->nmethods; i++) {
+        ex->partial = 1;
+        fprintf(stderr, "%s: %s skipped: interrupted before it started\n", cfg->name,
+                cfg->methods[i]);
+    }
+    int any = 0;
+    for (int c = 0; c < 3; c++) {
+        ppb_experiment *s = &col->sub[c];
+        ex->partial |= s->partial;
+        s->partial |= ex->partial;
+        any |= s->n > 0;
+        if (ctx->ocl_open) {
+            snprintf(s->device, sizeof s->device, "%s", ctx->ocl.name);
+            ppb_ocl_versions_get(&ctx->ocl, &s->ocl_versions);
+        }
+    }
+    if (luminance(col, err))
+        return -1;
+    ppb_experiment *y = &col->sub[PPB_SUBSET_Y];
+    y->partial |= ex->partial;
+    memcpy(y->device, col->sub[0].device, sizeof y->device);
+    y->ocl_versions = col->sub[0].ocl_versions;
+    memcpy(ex->device, y->device, sizeof ex->device);
+    ex->ocl_versions = y->ocl_versions;
+    /* The run's failures are every channel's, as y records them (`run` says them). */
+    ex->nfailed = y->nfailed;
+    memcpy(ex->failed, y->failed, sizeof ex->failed);
+    memcpy(ex->failed_why, y->failed_why, sizeof ex->failed_why);
+    if (!any && col->sub[0].nfailed > 0)
+        return ppb_fail(err, "%s", col->sub[0].failed_why[0]);
     return 0;
 }
 
@@ -106,6 +286,8 @@ int ppb_experiment_compute(ppb_experiment *ex, const ppb_config *cfg, ppb_run_ct
     memset(ex, 0, sizeof *ex);
     ex->cfg = cfg;
     ctx->cfg = cfg;
+    if (cfg->channel == PPB_CHANNEL_RGB)
+        return compute_colour(ex, cfg, ctx, err);
     /* The result arrays are estimated and checked before any is allocated, and the
      * work is said before it starts (methods/work_estimate.h). */
     double bytes = ppb_work_results_bytes(cfg);
@@ -148,6 +330,12 @@ void ppb_experiment_free(ppb_experiment *ex)
     for (int i = 0; i < ex->n; i++)
         ppb_result_free(&ex->res[i]);
     ex->n = 0;
+    if (ex->colour) {
+        for (int s = 0; s < PPB_NSUBSETS; s++)
+            ppb_experiment_free(&ex->colour->sub[s]);
+        free(ex->colour);
+        ex->colour = NULL;
+    }
 }
 
 const ppb_result *ppb_experiment_reference(const ppb_experiment *ex)
@@ -499,8 +687,156 @@ static int write_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
     return 0;
 }
 
+/* The subsets' file `file` (summary.csv, timings.csv) as one table with a first column
+ * `channel` (r, g, b, y): the rows of each subset that has the file, in subset order. */
+static int write_channel_table(const char *dir, const char *file, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 256];
+    out_path(dir, file, path, sizeof path);
+    ppb_afile af;
+    int any = 0;
+    for (int s = 0; s < PPB_NSUBSETS; s++) {
+        char sub[PPB_PATH_MAX + 256];
+        snprintf(sub, sizeof sub, "%s/%s/%s", dir, ppb_subset_name(s), file);
+        size_t len;
+        char *text = ppb_read_file(sub, &len);
+        if (!text)
+            continue;
+        if (!any && ppb_afile_open(&af, path, err)) {
+            free(text);
+            return -1;
+        }
+        char *line = text, *next;
+        for (int row = 0; line && *line; row++, line = next) {
+            next = strchr(line, '\n');
+            if (next)
+                *next++ = '\0';
+            if (row == 0 && !any)
+                fprintf(af.f, "channel,%s\n", line);
+            else if (row > 0)
+                fprintf(af.f, "%s,%s\n", ppb_subset_name(s), line);
+        }
+        any = 1;
+        free(text);
+    }
+    return any ? ppb_afile_commit(&af, err) : 0;
+}
+
+/* The colour set's provenance.txt: what the subsets beside it are, each channel's reference
+ * (each subset's own provenance.txt says the rest); fig: the figures left out. */
+static int write_colour_provenance(const ppb_experiment *ex, const char *dir,
+                                   const ppb_figures *fig, ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 256], when[64];
+    out_path(dir, "provenance.txt", path, sizeof path);
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    time_t now = time(NULL);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
+    fprintf(af.f, "%s: what produced the files beside this one\n", provenance_mark);
+    fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
+            when);
+    fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
+            ex->partial);
+    ppb_provenance_write_build(af.f, ex->device[0] ? &ex->ocl_versions : NULL);
+    fprintf(af.f,
+            "colour.subsets = r g b y (an output set each: the channels' and the luminance's)\n"
+            "colour.primaries = Rec. 709 / sRGB, linear (the material's R, G, B channels)\n"
+            "colour.luminance = %.4f R + %.4f G + %.4f B\n",
+            ppb_luma[0], ppb_luma[1], ppb_luma[2]);
+    const ppb_colour *col = ex->colour;
+    for (int c = 0; c < 3; c++) {
+        const ppb_experiment *s = &col->sub[c];
+        if (s->mc_reference[0])
+            fprintf(af.f, "%s.mc.reference = %s\n", ppb_subset_name(c), s->mc_reference);
+        if (s->mc_shipped_key[0])
+            fprintf(af.f, "%s.mc.shipped_key = %s\n", ppb_subset_name(c), s->mc_shipped_key);
+    }
+    const ppb_experiment *y = &col->sub[PPB_SUBSET_Y];
+    for (int i = 0; i < y->nfailed; i++)
+        fprintf(af.f, "%s.failed = %s\n", y->failed[i], y->failed_why[i]);
+    if (fig)
+        fputs(fig->text, af.f);
+    ppb_config_write_readable(ex->cfg, af.f);
+    return ppb_afile_commit(&af, err);
+}
+
+/* A colour experiment's set (experiment.h): each subset written as a grey set into its own
+ * directory of the staging, then the colour files beside them. */
+static int write_colour_set(const ppb_experiment *ex, const ppb_adir *ad, ppb_err *err)
+{
+    const ppb_colour *col = ex->colour;
+    const char *dir = ad->tmp;
+    for (int s = 0; s < PPB_NSUBSETS; s++) {
+        ppb_adir sub = {0};
+        if ((size_t)snprintf(sub.path, sizeof sub.path, "%s/%s", ad->path, ppb_subset_name(s)) >=
+                sizeof sub.path ||
+            (size_t)snprintf(sub.tmp, sizeof sub.tmp, "%s/%s", ad->tmp, ppb_subset_name(s)) >=
+                sizeof sub.tmp)
+            return ppb_fail(err, "%s: path too long for its channel subsets", ad->path);
+        sub.made = 1;
+        if (ppb_mkdirs(sub.tmp, err) || write_set(&col->sub[s], &sub, err))
+            return -1;
+    }
+    if (write_channel_table(dir, "summary.csv", err) ||
+        write_channel_table(dir, "timings.csv", err) ||
+        write_colour_provenance(ex, dir, NULL, err) || write_config_ini(ex, dir, err))
+        return -1;
+    ppb_figures fig = {.who = ex->cfg->name, .staged = ad->tmp, .final = ad->path};
+    /* The pictures of the results every channel holds, index by index. */
+    static ppb_result res[3][PPB_MAX_RESULTS];
+    const ppb_result *rows[3] = {res[0], res[1], res[2]};
+    int n = 0, ref = -1;
+    const ppb_result *cref = ppb_experiment_reference(&col->sub[0]);
+    for (int i = 0; i < col->sub[0].n; i++) {
+        const char *id = col->sub[0].res[i].method;
+        int found = 1;
+        res[0][n] = col->sub[0].res[i];
+        for (int c = 1; c < 3; c++) {
+            int j = 0;
+            while (j < col->sub[c].n && strcmp(col->sub[c].res[j].method, id))
+                j++;
+            if (j == col->sub[c].n)
+                found = 0;
+            else
+                res[c][n] = col->sub[c].res[j];
+        }
+        if (!found)
+            continue;
+        if (cref && !strcmp(id, cref->method))
+            ref = n;
+        n++;
+    }
+    const ppb_image_meta meta = {ex->cfg->name, PPB_VERSION, ex->cfg->mc.seed, ex->cfg->mc.photons};
+    ppb_err why;
+    if (ppb_images_write_colour(dir, &col->cfg[0].scene, &meta, ex->cfg->material,
+                                ex->cfg->unit == PPB_UNIT_MM ? "mm" : "mfp", rows, n, ref, &why)) {
+        char path[PPB_PATH_MAX + 256];
+        out_path(dir, "images", path, sizeof path);
+        ppb_err ignored;
+        ppb_remove_tree(path, &ignored);
+        ppb_figures_fail(&fig, "images", why.msg);
+    }
+    ppb_plots_write(dir, cref ? cref->method : NULL, &fig);
+    void *ctx[2] = {(void *)ad, &fig};
+    if (ppb_dir_verify(dir, bad_file, ctx, err))
+        return -1;
+    if (fig.nfailed && write_colour_provenance(ex, dir, &fig, err))
+        return -1;
+    return 0;
+}
+
 void ppb_experiment_print_summary(const ppb_experiment *ex, FILE *f)
 {
+    for (int s = 0; ex->colour && s < PPB_NSUBSETS; s++) {
+        const ppb_experiment *sub = &ex->colour->sub[s];
+        const ppb_result *ref = ppb_experiment_reference(sub);
+        char name[192];
+        snprintf(name, sizeof name, "%s (%s)", ex->cfg->name, ppb_subset_name(s));
+        if (ref)
+            ppb_summary_table_print(f, name, sub->res, sub->n, ref, skip_for(ref));
+    }
     const ppb_result *ref = ppb_experiment_reference(ex);
     if (ref)
         ppb_summary_table_print(f, ex->cfg->name, ex->res, ex->n, ref, skip_for(ref));
@@ -514,13 +850,13 @@ int ppb_experiment_write(const ppb_experiment *ex, ppb_err *err)
     ppb_adir ad;
     if (claim_out(ex->cfg->out_dir, &ad, err) || ppb_adir_begin(&ad, err))
         return -1;
-    if (write_set(ex, &ad, err)) {
+    if (ex->colour ? write_colour_set(ex, &ad, err) : write_set(ex, &ad, err)) {
         ppb_adir_abort(&ad);
         return -1;
     }
     if (ppb_adir_commit(&ad, err))
         return -1;
-    if (ex->nfailed > 0)
+    if (ex->nfailed > 0) /* a colour run's: every channel's, named by channel */
         return ppb_fail(err, "%d method(s) failed, the others' outputs are written: %s: %s",
                         ex->nfailed, ex->failed[0], ex->failed_why[0]);
     return 0;

@@ -5,7 +5,14 @@
  * grid point. The Monte Carlo (`reference` in the method registry) is what rms.csv and
  * summary.csv measure against; the exact answers `mc1` (the tube's single scattering) and
  * `ppslab` (the slab) get their own summary_<id>.csv, the basis of CI's regression gate.
- * The output directory is the run's own: the set is written whole or not at all. */
+ * The output directory is the run's own: the set is written whole or not at all.
+ *
+ * A colour experiment (`[medium] channel = rgb`, docs/reference.md: Colour) runs every method
+ * for the R, G and B channels (a method with run_channels once for all three) and writes one
+ * grey output set per channel, <dir>/r, g, b, each exactly the set of the same config with
+ * channel = r, g or b, and <dir>/y, the luminance's (every result the BT.709 weighted sum of
+ * the channels', model/colour.h), beside the colour files: summary.csv and timings.csv with a
+ * channel column, the linear RGB OpenEXR and sRGB PNG pictures (io/images.h). */
 #ifndef PPB_EXPERIMENT_H
 #define PPB_EXPERIMENT_H
 
@@ -16,6 +23,10 @@
 #include "drivers/provenance.h"
 
 #define PPB_MAX_RESULTS (2 * PPB_MAX_METHODS)
+
+/* The channel subsets of a colour experiment: r, g, b, then the luminance y. */
+enum { PPB_NSUBSETS = 4, PPB_SUBSET_Y = 3 };
+struct ppb_colour;
 
 typedef struct ppb_experiment {
     const ppb_config *cfg;
@@ -35,7 +46,20 @@ typedef struct ppb_experiment {
     /* Deterministic methods interrupted midway: none of their rows are written. */
     int nincomplete;
     char incomplete[PPB_MAX_METHODS][32];
+    /* A colour experiment's channels (NULL: a grey one, whose results are the ones above; a
+     * colour one has none of its own). */
+    struct ppb_colour *colour;
 } ppb_experiment;
+
+/* A colour experiment's parts: each channel's config and experiment, and the luminance's
+ * (its cfg the colour config itself). */
+typedef struct ppb_colour {
+    ppb_config cfg[3];
+    ppb_experiment sub[PPB_NSUBSETS];
+} ppb_colour;
+
+/* The name of subset s ("r", "g", "b", "y"). */
+const char *ppb_subset_name(int s);
 
 /* Runs every method. A method that fails is recorded in ex->failed (and said on stderr) while
  * the others go on; fails only when no method produced a result (with the first reason). */

@@ -363,9 +363,27 @@ static int load_config(const cli *c, const char *path, ppb_config *cfg, ppb_grid
     if (ppb_config_load_sets(cfg, grid, path, c->sets, c->nsets, err) ||
         ppb_methods_check(cfg, err))
         return -1;
+    /* A colour run's methods are checked against every channel's medium (mp refuses albedo 1
+     * in any of them), before any work. */
+    for (int ch = 0; cfg->channel == PPB_CHANNEL_RGB && ch < 3; ch++) {
+        static ppb_config one; /* large: not on the stack */
+        if (ppb_config_channel(cfg, ch, &one, err) || ppb_methods_check(&one, err))
+            return -1;
+    }
     if (c->out)
         snprintf(cfg->out_dir, sizeof cfg->out_dir, "%s", c->out);
     return 0;
+}
+
+/* A colour config (channel = rgb) where only `ppbench run` takes one (sweep, slurm,
+ * mc-shard, mc-merge: one channel's experiment each). */
+static int refuse_colour(const ppb_config *cfg, ppb_err *err)
+{
+    if (cfg->channel != PPB_CHANNEL_RGB)
+        return 0;
+    return ppb_config_key_fail(cfg, "medium", "channel", err,
+                               "rgb (a colour run, docs/reference.md: Colour) is `ppbench run`'s "
+                               "alone: give one channel here, r, g or b");
 }
 
 /* Commands whose methods call OpenBLAS (the slab solver, the march tables, rte2d). */
@@ -626,6 +644,8 @@ static int load_grid_config(const cli *c, ppb_config *cfg, ppb_grid **grid)
     ppb_err err = {{0}};
     int code =
         load_config(c, c->args[0], cfg, *grid, &err) ? usage_error(&err) : check_config_out(c, cfg);
+    if (code == EXIT_OK && refuse_colour(cfg, &err))
+        code = usage_error(&err);
     if (code) {
         ppb_grid_free(*grid);
         *grid = NULL;
@@ -694,7 +714,7 @@ static int mc_shard_or_merge(const cli *c, int merge)
     /* One Monte Carlo run split by photons: a config holding lists is refused as by `run`. */
     ppb_config cfg;
     ppb_err err = {{0}};
-    if (load_config(c, c->args[0], &cfg, NULL, &err))
+    if (load_config(c, c->args[0], &cfg, NULL, &err) || refuse_colour(&cfg, &err))
         return usage_error(&err);
     int code = check_config_out(c, &cfg);
     if (code)

@@ -36,8 +36,8 @@ static int real_parent(const char *path, char *buf)
     return realpath(copy, buf) ? 0 : -1;
 }
 
-/* Whether the last component of path is a case of <source>/configs/study.list. */
-static int study_case(const char *path)
+/* Whether the last component of path is a case of <source>/configs/<list>. */
+static int study_case(const char *path, const char *list_name)
 {
     char name[256], list[PPB_PATH_MAX + 32], line[256];
     size_t n = strlen(path);
@@ -47,7 +47,7 @@ static int study_case(const char *path)
     while (b > 0 && path[b - 1] != '/')
         b--;
     snprintf(name, sizeof name, "%.*s", (int)(n - b), path + b);
-    snprintf(list, sizeof list, "%.4000s/configs/study.list", ppb_source_dir());
+    snprintf(list, sizeof list, "%.4000s/configs/%s", ppb_source_dir(), list_name);
     FILE *f = fopen(list, "r");
     int found = 0;
     while (f && !found && fgets(line, sizeof line, f)) {
@@ -68,9 +68,14 @@ int ppb_study_guard(const char *out_dir, ppb_err *err)
     snprintf(results, sizeof results, "%.4000s/results", ppb_source_dir());
     if (!realpath(results, real))
         return 0; /* no committed study here */
+    /* and the materials study's: results/materials/<case of configs/materials.list> */
+    char materials[PATH_MAX + 16];
+    snprintf(materials, sizeof materials, "%s/materials", real);
+    int has_parent = real_parent(out_dir, parent) == 0;
     int is_study =
         (realpath(out_dir, self) && strcmp(self, real) == 0) ||
-        (real_parent(out_dir, parent) == 0 && strcmp(parent, real) == 0 && study_case(out_dir));
+        (has_parent && strcmp(parent, real) == 0 && study_case(out_dir, "study.list")) ||
+        (has_parent && strcmp(parent, materials) == 0 && study_case(out_dir, "materials.list"));
     if (!is_study)
         return 0;
     return ppb_fail(err,

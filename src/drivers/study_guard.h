@@ -1,7 +1,8 @@
 /* study_guard.h: the committed study's output sets (results/<case>, docs/reference.md: Outputs,
  * "The committed study") are written by `make bench` alone: a run whose output directory is
- * one of them (results/<case>, case in configs/study.list), or results/ itself, is refused unless
- * scripts/bench.sh's marker is set (PPB_BENCH_STUDY=1 in the environment). */
+ * one of them (results/<case>, case in configs/study.list; results/materials/<case>, case in
+ * configs/materials.list), or results/ itself, is refused unless scripts/bench.sh's marker is
+ * set (PPB_BENCH_STUDY=1 in the environment). */
 #ifndef PPB_STUDY_GUARD_H
 #define PPB_STUDY_GUARD_H
 

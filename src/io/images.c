@@ -49,6 +49,7 @@
 #include "io/image_exr.h"
 #include "io/image_png.h"
 #include "io/render_tube.h"
+#include "model/colour.h"
 
 #define VIEW_NX      320
 #define VIEW_NY      240
@@ -135,15 +136,15 @@ static int cmp_float(const void *a, const void *b)
 }
 
 /* The percentile rather than the maximum, so that a few hot pixels (a bright bin, MC noise)
- * do not darken every picture. */
-static double white_level(const img_ctx *c, int from, int view)
+ * do not darken every picture: of the surface pixels of value[] in the view. */
+static double white_of(const img_ctx *c, const float *value, int view)
 {
     size_t half = PANEL_PIXELS / 2, k0 = (size_t)view * half;
     float *v = malloc(half * sizeof *v);
     size_t n = 0;
     for (size_t k = k0; v && k < k0 + half; k++)
-        if (c->kind[k] == PPB_PIX_SURFACE && isfinite(c->value[from][k]))
-            v[n++] = c->value[from][k];
+        if (c->kind[k] == PPB_PIX_SURFACE && isfinite(value[k]))
+            v[n++] = value[k];
     double white = 0.0;
     if (n > 0) {
         qsort(v, n, sizeof *v, cmp_float);
@@ -153,6 +154,11 @@ static double white_level(const img_ctx *c, int from, int view)
     }
     free(v);
     return white > 0 ? white : 1.0;
+}
+
+static double white_level(const img_ctx *c, int from, int view)
+{
+    return white_of(c, c->value[from], view);
 }
 
 static unsigned char srgb_byte(double linear)
@@ -399,5 +405,115 @@ int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_image_m
         rc = write_all(&c, err);
     }
     free_ctx(&c);
+    return rc;
+}
+
+/* What a colour EXR shows (ppb_images_write_colour). */
+static const char exr_shows_colour[] =
+    "radiance toward the camera, 1/sr per unit E_perp (scattered light only), R, G, B = the "
+    "material's channels; top half: view from above-left (S1 and S3), bottom half: view from "
+    "below-left (S2 and S3), tube clipped to |z| <= 0.4 W; 0 on the background and the cut caps";
+
+/* The colour picture of result i of the three channel contexts, as write_png's. */
+static void tone_map_colour(const img_ctx *ch, int i, const double white[2], unsigned char *rgb)
+{
+    for (size_t k = 0; k < PANEL_PIXELS; k++) {
+        unsigned char *px = rgb + 3 * k;
+        if (ch[0].kind[k] != PPB_PIX_SURFACE) {
+            put(px, ch[0].kind[k] == PPB_PIX_CAP ? cap_colour : background);
+            continue;
+        }
+        double x[3], y = 0;
+        for (int c = 0; c < 3; c++) {
+            x[c] = ch[c].value[i][k] / white[k >= PANEL_PIXELS / 2];
+            y += ppb_luma[c] * x[c];
+        }
+        double scale = y > KNEE ? shoulder(y) / y : 1;
+        for (int c = 0; c < 3; c++)
+            px[c] = srgb_byte(scale * x[c]);
+    }
+}
+
+int ppb_images_write_colour(const char *out_dir, const ppb_scene *sc, const ppb_image_meta *meta,
+                            const char *material, const char *unit, const ppb_result *const res[3],
+                            int n, int ref, ppb_err *err)
+{
+    if (sc->geometry != PPB_GEOM_TUBE || n <= 0)
+        return 0;
+    img_ctx ch[3];
+    float *lum = NULL, *rgbf = NULL;
+    unsigned char *rgb = NULL;
+    int rc = 0;
+    memset(ch, 0, sizeof ch);
+    for (int c = 0; c < 3 && rc == 0; c++) {
+        ch[c] = (img_ctx){.scene = sc, .meta = meta, .res = res[c], .n = n, .ref = ref};
+        snprintf(ch[c].dir, sizeof ch[c].dir, "%s/images", out_dir);
+        rc = render_panels(&ch[c], err);
+    }
+    if (rc == 0 && ppb_mkdirs(ch[0].dir, err))
+        rc = -1;
+    lum = malloc(PANEL_PIXELS * sizeof *lum);
+    rgbf = malloc(3 * PANEL_PIXELS * sizeof *rgbf);
+    rgb = malloc(3 * PANEL_PIXELS);
+    if (rc == 0 && (!lum || !rgbf || !rgb))
+        rc = ppb_fail(err, "images: out of memory");
+    double white[2] = {1, 1};
+    if (rc == 0) {
+        int from = ref >= 0 && ref < n ? ref : 0;
+        for (size_t k = 0; k < PANEL_PIXELS; k++)
+            lum[k] =
+                (float)(ppb_luma[0] * ch[0].value[from][k] + ppb_luma[1] * ch[1].value[from][k] +
+                        ppb_luma[2] * ch[2].value[from][k]);
+        for (int view = 0; view < 2; view++)
+            white[view] = white_of(&ch[0], lum, view);
+    }
+    char primaries[160], luminance[96], exposure[256], seed[32] = "unknown",
+                                                       photons[32] = "unknown";
+    snprintf(primaries, sizeof primaries,
+             "Rec. 709 / sRGB, linear (R, G, B: the material table's channels)");
+    snprintf(luminance, sizeof luminance, "Y = %.4f R + %.4f G + %.4f B", ppb_luma[0], ppb_luma[1],
+             ppb_luma[2]);
+    snprintf(exposure, sizeof exposure,
+             "PNG: each channel times 1 / L_white, L_white = %.6g (top view), %.6g (bottom view), "
+             "the 99th percentile of the reference's luminance; shoulder on the luminance above "
+             "0.75, clip to 1, sRGB OETF",
+             white[0], white[1]);
+    if (meta) {
+        snprintf(seed, sizeof seed, "%lld", meta->seed);
+        snprintf(photons, sizeof photons, "%lld", meta->photons);
+    }
+    for (int i = 0; i < n && rc == 0; i++) {
+        for (size_t k = 0; k < PANEL_PIXELS; k++)
+            for (int c = 0; c < 3; c++)
+                rgbf[3 * k + c] = ch[c].value[i][k];
+        const ppb_exr_attr attrs[] = {
+            {"ppbench.method", res[0][i].method},
+            {"ppbench.case", meta && meta->case_name ? meta->case_name : "unknown"},
+            {"ppbench.material", material ? material : "unknown"},
+            {"ppbench.primaries", primaries},
+            {"ppbench.luminance", luminance},
+            {"ppbench.units", unit ? unit : "unknown"},
+            {"ppbench.exposure", exposure},
+            {"ppbench.seed", seed},
+            {"ppbench.photons", photons},
+            {"ppbench.version", meta && meta->version ? meta->version : "unknown"},
+            {"ppbench.shows", exr_shows_colour},
+        };
+        char path[1300];
+        image_path(&ch[0], "", res[0][i].method, "exr", path, sizeof path);
+        rc = ppb_exr_write_rgb(path, VIEW_NX, PANEL_NY, rgbf, attrs,
+                               (int)(sizeof attrs / sizeof attrs[0]), err);
+        if (rc)
+            break;
+        tone_map_colour(ch, i, white, rgb);
+        draw_arrow(&ch[0], rgb, VIEW_NX);
+        image_path(&ch[0], "", res[0][i].method, "png", path, sizeof path);
+        rc = ppb_png_write_rgb(path, VIEW_NX, PANEL_NY, rgb, err);
+    }
+    free(lum);
+    free(rgbf);
+    free(rgb);
+    for (int c = 0; c < 3; c++)
+        free_ctx(&ch[c]);
     return rc;
 }

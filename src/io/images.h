@@ -26,4 +26,17 @@ typedef struct ppb_image_meta {
 int ppb_images_write(const char *out_dir, const ppb_scene *sc, const ppb_image_meta *meta,
                      const ppb_result *res, int n, int ref, ppb_err *err);
 
+/* A colour run's pictures (docs/reference.md: Colour) under <out_dir>/images/: for each of the
+ * n results, res[0][i], res[1][i], res[2][i] its R, G and B channels (one id, one scene but
+ * for the medium: sc is any channel's), <id>.exr with R, G, B the channels' radiance (linear
+ * Rec. 709 primaries; header: material, primaries, unit (the config's length unit), exposure) and
+ * <id>.png, sRGB: each channel times the exposure 1 / L_white (L_white per view: the 99th
+ * percentile of the reference's luminance, ref < 0: of res[*][0]), the shoulder of the grey
+ * pictures applied to the luminance (every channel scaled alike, so the hue stays), clipped to 1
+ * per channel, then the sRGB OETF. The per-channel error maps are the channel subsets'
+ * (images_write). */
+int ppb_images_write_colour(const char *out_dir, const ppb_scene *sc, const ppb_image_meta *meta,
+                            const char *material, const char *unit, const ppb_result *const res[3],
+                            int n, int ref, ppb_err *err);
+
 #endif

@@ -106,8 +106,11 @@ typedef struct ppb_method {
     /* Its benchmark in `ppbench perf` under the heading perf_title; NULL: none. */
     const char *perf_title;
     int (*perf)(ppb_run_ctx *ctx, FILE *out, ppb_err *err);
-    /* Runs every channel of a colour experiment at once: cfgs[c] is channel c's experiment, out[2 * c] and out[2 * c + 1] its result and companion (already initialised as for run). NULL: the runner runs the method once per channel. */
-    int (*run_channels)(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_result *out, ppb_err *err);
+    /* Runs every channel of a colour experiment at once: cfgs[c] is channel c's experiment, and
+     * out[2 * c], out[2 * c + 1] its result and companion (initialised as for run). NULL: the
+     * runner runs the method once per channel. */
+    int (*run_channels)(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_result *out,
+                        ppb_err *err);
 } ppb_method;
 
 /* A sum method's run and check (ppb_method.sum_of): the parts are found through the registry

@@ -52,8 +52,8 @@ static const enum_name table_names[] = {{PPB_TABLE_R, "R"}, {PPB_TABLE_S, "S"}, 
 static const enum_name unit_names[] = {{PPB_UNIT_MFP, "mfp"}, {PPB_UNIT_MM, "mm"}, {0, NULL}};
 /* The first name of a value is the one written; the others are accepted too. */
 static const enum_name channel_names[] = {
-    {PPB_CH_R, "r"},     {PPB_CH_G, "g"},    {PPB_CH_B, "b"}, {PPB_CH_R, "red"},
-    {PPB_CH_G, "green"}, {PPB_CH_B, "blue"}, {0, NULL}};
+    {PPB_CH_R, "r"},   {PPB_CH_G, "g"},     {PPB_CH_B, "b"},    {PPB_CHANNEL_RGB, "rgb"},
+    {PPB_CH_R, "red"}, {PPB_CH_G, "green"}, {PPB_CH_B, "blue"}, {0, NULL}};
 static const enum_name delta_m_names[] = {
     {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 static const enum_name on_off_names[] = {{0, "off"}, {1, "on"}, {0, NULL}};
@@ -102,7 +102,8 @@ static const key_def keys[] = {
     {"medium", "material", K_MATERIAL, PPB_MC_KEY, F(material), 0, 0, "none", NULL,
      "a measured medium (`ppbench materials`) that sets sigma_t, albedo, g and n, or none"},
     {"medium", "channel", K_ENUM, PPB_MC_KEY, F(channel), 0, 0, "g", channel_names,
-     "the material's colour channel"},
+     "the material's colour channel, or rgb: every method for each of the three (a colour run, "
+     "docs/reference.md: Colour)"},
     {"medium", "sigma_t", K_REAL, PPB_MC_KEY, F(scene.sigma_t), 1e-3, 1000, "1", NULL,
      "extinction, 1/mfp (left of the step)"},
     {"medium", "albedo", K_REAL, PPB_MC_KEY, F(scene.albedo), 0, 1, "0.95", NULL,
@@ -1149,7 +1150,23 @@ static int apply_material(ppb_config *cfg, ppb_err *err)
                                    origin_of(cfg, "experiment", "unit", where, sizeof where));
     ppb_scene *sc = &cfg->scene;
     double v[4], *dst[4] = {&sc->sigma_t, &sc->albedo, &sc->g, &sc->n};
-    ppb_material_medium(m, (ppb_channel)cfg->channel, &v[0], &v[1], &v[2], &v[3]);
+    /* A colour run (channel = rgb) checks every channel's medium here, before any work, and
+     * keeps the green one's in the config (PPB_CHANNEL_RGB); each channel's own config is
+     * ppb_config_channel's. */
+    int rgb = cfg->channel == PPB_CHANNEL_RGB;
+    for (int c = rgb ? PPB_CH_R : PPB_CH_B; rgb && c <= PPB_CH_B; c++) {
+        ppb_material_medium(m, (ppb_channel)c, &v[0], &v[1], &v[2], &v[3]);
+        for (int j = 0; j < 4; j++) {
+            const key_def *k = &keys[find_key("medium", material_keys[j])];
+            if (v[j] < k->min || v[j] > k->max)
+                return ppb_config_key_fail(
+                    cfg, "medium", "channel", err,
+                    "rgb runs every channel, and %s's %s channel has %s = %g, outside the range "
+                    "[%g, %g] the methods take",
+                    m->name, enum_value_name(channel_names, c), k->key, v[j], k->min, k->max);
+        }
+    }
+    ppb_material_medium(m, rgb ? PPB_CH_G : (ppb_channel)cfg->channel, &v[0], &v[1], &v[2], &v[3]);
     for (int j = 0; j < 4; j++) {
         const key_def *k = &keys[find_key("medium", material_keys[j])];
         /* A key given beside the material is refused unless it states the material's own value
@@ -1680,4 +1697,27 @@ const char *ppb_config_external_where(const ppb_config *cfg, const ppb_external_
         snprintf(buf, cap, "%s:%d: [method.%s]%s%s", cfg->path, line ? line : d->line, d->name,
                  key ? " " : "", key ? key : "");
     return buf;
+}
+
+const char *ppb_channel_name(int ch)
+{
+    return enum_value_name(channel_names, ch);
+}
+
+int ppb_config_channel(const ppb_config *cfg, int ch, ppb_config *out, ppb_err *err)
+{
+    const ppb_material *m = ppb_material_find(cfg->material);
+    if (cfg->channel != PPB_CHANNEL_RGB || !m || ch < PPB_CH_R || ch > PPB_CH_B)
+        return ppb_fail(err, "%s: not a colour config (channel = rgb) or no channel %d", cfg->path,
+                        ch);
+    *out = *cfg;
+    out->channel = ch;
+    /* The keys the material sets are given by it alone (apply_material refused any other
+     * value), so the channel's medium is the table's, as a config with channel = ch has it. */
+    ppb_scene *sc = &out->scene;
+    ppb_material_medium(m, (ppb_channel)ch, &sc->sigma_t, &sc->albedo, &sc->g, &sc->n);
+    if ((size_t)snprintf(out->out_dir, sizeof out->out_dir, "%s/%s", cfg->out_dir,
+                         ppb_channel_name(ch)) >= sizeof out->out_dir)
+        return ppb_fail(err, "%s: [output] dir too long for its channel subsets", cfg->path);
+    return validate(out, err);
 }

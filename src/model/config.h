@@ -145,6 +145,11 @@ typedef struct ppb_key_origin {
     int from_set; /* 1: last set by ppb_config_set (--set on the command line) */
 } ppb_key_origin;
 
+/* [medium] channel = rgb: a colour experiment (docs/reference.md, Colour): the runner runs
+ * every method for the R, G and B channels, each channel's config from ppb_config_channel;
+ * the config's own scene holds the green channel's medium. */
+enum { PPB_CHANNEL_RGB = 3 };
+
 typedef struct ppb_config {
     char path[1024];
     char name[128];
@@ -153,7 +158,7 @@ typedef struct ppb_config {
     ppb_scene scene;
     int unit;          /* ppb_unit */
     char material[32]; /* a row of model/materials.h by name, or "none" */
-    int channel;       /* ppb_channel: the material's colour channel */
+    int channel;       /* ppb_channel: the material's colour channel, or PPB_CHANNEL_RGB */
     int samples_dir;   /* directions per bin axis for deterministic methods (n x n per bin) */
     int samples_seg;   /* points per segment for deterministic methods */
     ppb_mc_settings mc;
@@ -199,6 +204,14 @@ int ppb_config_set(ppb_config *cfg, const char *section, const char *key, const 
 /* The config of grid point i (model/grid.h), validated; grid NULL has the one point 0. */
 int ppb_config_point(const ppb_config *cfg, const ppb_grid *grid, long long i, ppb_config *out,
                      ppb_err *err);
+
+/* Channel ch (PPB_CH_R, G or B) of a colour config (channel = rgb): *out is cfg with channel
+ * = ch and that channel's medium (ppb_material_medium), exactly the config of the same file
+ * with channel = r, g or b, and its output directory <out_dir>/<r|g|b>. */
+int ppb_config_channel(const ppb_config *cfg, int ch, ppb_config *out, ppb_err *err);
+
+/* The name a config writes for channel value ch ("r", "g", "b", "rgb"). */
+const char *ppb_channel_name(int ch);
 
 /* Fails with why (printf format) about a key, named where it was set: "file:line: [section]
  * key: why" (line 0 when the key kept its default), or "--set section.key: why". Returns -1. */
