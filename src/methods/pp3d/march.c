@@ -1,0 +1,316 @@
+/* march.c: the march of ss3d and pp3d along a ray through the voxels (pp3d.h; paper Eq. 13 and
+ * 15, Fig. 3's rendering process). Along the ray from the exit point p0 into the object, at
+ * distance l, q = p0 - l w:
+ *     L(p0, w) = integral exp(-d(l)) sigma_t alpha [ e^{-Dpre} R(tau; theta) + C(w) e^{-D} ] dl,
+ *     C(w) = p(w.w_L) + b(theta)/abar,   tau = D - Dpre clamped to the local slab,
+ * d the optical distance along the ray, theta the angle between w and -w_L (the local slab's
+ * normal). ss3d keeps C = p(w.w_L) alone (paper Eq. 5 with n = 1). Each voxel crossing has
+ * constant sigma_t and alpha; the direct beam's term is integrated in closed form on D linear
+ * between the points where D is read (exact on a crossing where D is linear: any light along an
+ * axis), the R term by the midpoint rule on steps of at most pp.step (the tube's R march). */
+#include "methods/pp3d/pp3d.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/progress.h"
+#include "kernels/ppb_conventions.h"
+#include "methods/pp3d/walk.h"
+
+/* What one ray reads from the tables: its angle node pair and its fixed phase. */
+typedef struct ray_dir {
+    double p; /* p(w.w_L) */
+    int j;    /* angle node below theta */
+    double f; /* weight of node j + 1 */
+} ray_dir;
+
+static ray_dir ray_dir_of(const ppb_object *o, const ppb_pp3d_tables *tab, const double w[3])
+{
+    ray_dir r = {0};
+    const double *wl = o->light_dir;
+    double c = w[0] * wl[0] + w[1] * wl[1] + w[2] * wl[2];
+    r.p = ppb_hg_phase(o->g, c);
+    if (tab) {
+        double th = acos(fmax(-1.0, fmin(1.0, -c))) / PPB_PI * (tab->nang - 1);
+        r.j = (int)floor(th);
+        r.j = r.j < 0 ? 0 : (r.j > tab->nang - 2 ? tab->nang - 2 : r.j);
+        r.f = th - r.j;
+    }
+    return r;
+}
+
+/* The albedo nodes' pair and weight at abar (paper Sec. 3.3, interpolated linearly). */
+static void albedo_nodes(const ppb_pp3d_tables *t, double abar, int *i, double *f)
+{
+    *i = 0, *f = 0.0;
+    if (t->nalb < 2)
+        return;
+    double x = (abar - t->alb0) / t->alb_h;
+    int k = (int)floor(x);
+    k = k < 0 ? 0 : (k > t->nalb - 2 ? t->nalb - 2 : k);
+    *i = k;
+    *f = fmin(1.0, fmax(0.0, x - k));
+}
+
+/* R of thickness node it at tau, bilinear in tau and theta, linear in the albedo nodes. */
+static double table_r(const ppb_pp3d_tables *t, int it, int ia, double fa, const ray_dir *rd,
+                      double tau)
+{
+    int ntau = t->ntau[it];
+    double x = tau / t->thick[it] * (ntau - 1);
+    int k = (int)floor(x);
+    k = k < 0 ? 0 : (k > ntau - 2 ? ntau - 2 : k);
+    double f = fmin(1.0, fmax(0.0, x - k)), v = 0.0;
+    for (int da = 0; da < (fa > 0.0 ? 2 : 1); da++) {
+        const double *r0 = t->R + t->off[it] + ((size_t)(ia + da) * t->nang + rd->j) * ntau + k;
+        const double *r1 = r0 + ntau;
+        double a0 = r0[0] + f * (r0[1] - r0[0]), a1 = r1[0] + f * (r1[1] - r1[0]);
+        double a = a0 + rd->f * (a1 - a0);
+        v += (da ? fa : 1.0 - fa) * a;
+    }
+    return v;
+}
+
+static double table_cb(const ppb_pp3d_tables *t, int it, int ia, double fa, const ray_dir *rd)
+{
+    double v = 0.0;
+    for (int da = 0; da < (fa > 0.0 ? 2 : 1); da++) {
+        const double *c = t->Cb + ((size_t)it * t->nalb + ia + da) * t->nang + rd->j;
+        v += (da ? fa : 1.0 - fa) * (c[0] + rd->f * (c[1] - c[0]));
+    }
+    return v;
+}
+
+/* C sigma_t h e^{e_a} phi(z), phi(z) = (e^z - 1)/z: the direct beam's first scattering over a
+ * step where both optical depths are linear; the scaled form below e_a = -700 (as
+ * kernels/ppb_beam_images.h: ppb_beam_step, which is OpenCL C only). */
+static double beam_step(double C, double sigma_t, double h, double e_a, double z)
+{
+    double phi = fabs(z) < 1e-300 ? 1.0 : expm1(z) / z;
+    if (e_a < -700.0 && z > 0.0)
+        return C * sigma_t * h * (exp(e_a + z) * (-expm1(-z) / z));
+    return C * exp(e_a) * sigma_t * h * phi;
+}
+
+/* One voxel crossing [la, lb] of voxel v; *d is the optical distance at la, advanced. */
+static double crossing(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+                       const ray_dir *rd, double step, const double p0[3], const double dir[3],
+                       size_t v, double la, double lb, double *d)
+{
+    double sigma = o->material[o->mat[v]].sigma_t;
+    double alpha = o->albedo_tex ? (double)o->albedo_tex[v] : o->material[o->mat[v]].albedo;
+    double len = lb - la, d0 = *d;
+    *d = d0 + sigma * len;
+    if (!(len > 0.0) || alpha <= 0.0)
+        return 0.0;
+    double xa[3], xb[3], xm[3];
+    for (int a = 0; a < 3; a++) {
+        xa[a] = p0[a] + la * dir[a];
+        xb[a] = p0[a] + lb * dir[a];
+        xm[a] = 0.5 * (xa[a] + xb[a]);
+    }
+    double Da = ppb_pp3d_map_depth(o, m, v, xa), Db = ppb_pp3d_map_depth(o, m, v, xb);
+    double Dm = ppb_pp3d_map_depth(o, m, v, xm);
+    int ia = 0, it = 0;
+    double fa = 0.0, C = rd->p;
+    if (tab) {
+        it = tab->vox_thick[v];
+        albedo_nodes(tab, m->abar[v], &ia, &fa);
+        C += table_cb(tab, it, ia, fa, rd);
+    }
+    /* Steps: one where D is linear over the crossing and no R term is marched, else pp.step. */
+    int linear = fabs(Dm - 0.5 * (Da + Db)) <= 1e-12 * (1.0 + Da + Db);
+    int n = (linear && !tab) ? 1 : (int)ceil(len / step);
+    n = n < 1 ? 1 : n;
+    double h = len / n, sum = 0.0, D1 = Da;
+    for (int i = 0; i < n; i++) {
+        double d1 = d0 + sigma * h * i;
+        if (d1 > PPB_PP3D_D_CAP)
+            break;
+        double D2 = Db, x[3];
+        if (i + 1 < n) {
+            for (int a = 0; a < 3; a++)
+                x[a] = xa[a] + (i + 1) * h * dir[a];
+            D2 = linear ? Da + (Db - Da) * (i + 1) / n : ppb_pp3d_map_depth(o, m, v, x);
+        }
+        sum += beam_step(C, sigma, h, -(d1 + D1), -(sigma * h + D2 - D1));
+        if (tab) {
+            double Dmid;
+            if (linear) {
+                Dmid = 0.5 * (D1 + D2);
+            } else {
+                for (int a = 0; a < 3; a++)
+                    x[a] = xa[a] + (i + 0.5) * h * dir[a];
+                Dmid = ppb_pp3d_map_depth(o, m, v, x);
+            }
+            double tau = Dmid - m->Dpre[v];
+            tau = tau < 0.0 ? 0.0 : (tau > tab->thick[it] ? tab->thick[it] : tau);
+            sum += sigma * h * exp(-(d1 + 0.5 * sigma * h) - m->Dpre[v]) *
+                   table_r(tab, it, ia, fa, rd, tau);
+        }
+        D1 = D2;
+    }
+    return alpha * sum;
+}
+
+double ppb_pp3d_ray(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+                    double step, const double p0[3], const double w_out[3], long start)
+{
+    double dir[3] = {-w_out[0], -w_out[1], -w_out[2]};
+    ray_dir rd = ray_dir_of(o, tab, w_out);
+    ppb_walk w;
+    if (!ppb_walk_init(&w, o, p0, dir, start))
+        return 0.0;
+    size_t v;
+    double ta, tb, d = 0.0, L = 0.0;
+    while (d <= PPB_PP3D_D_CAP && ppb_walk_next(&w, &v, &ta, &tb))
+        if (o->mat[v])
+            L += crossing(o, m, tab, &rd, step, p0, dir, v, ta, tb, &d);
+    return L;
+}
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+int ppb_pp3d_camera_init(const ppb_object *o, ppb_pp3d_camera *c, ppb_err *err)
+{
+    memset(c, 0, sizeof *c);
+    double n = sqrt(dot3(o->view_dir, o->view_dir));
+    if (!(n > 0.0) || o->img_w < 1 || o->img_h < 1)
+        return ppb_fail(err, "%s: the camera needs a view direction and at least one pixel",
+                        o->name);
+    for (int a = 0; a < 3; a++)
+        c->to_cam[a] = -o->view_dir[a] / n;
+    double yup[3] = {0.0, 1.0, 0.0}, zup[3] = {0.0, 0.0, 1.0};
+    cross3(fabs(c->to_cam[1]) > 0.999 ? zup : yup, c->to_cam, c->right);
+    double r = sqrt(dot3(c->right, c->right));
+    for (int a = 0; a < 3; a++)
+        c->right[a] /= r;
+    cross3(c->to_cam, c->right, c->up);
+    double ext[3] = {o->nx * o->voxel, o->ny * o->voxel, o->nz * o->voxel};
+    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
+    for (int k = 0; k < 3; k++)
+        c->centre[k] = 0.5 * ext[k];
+    for (int q = 0; q < 8; q++) {
+        double p[3] = {(q & 1) ? ext[0] : 0.0, (q & 2) ? ext[1] : 0.0, (q & 4) ? ext[2] : 0.0};
+        for (int k = 0; k < 3; k++)
+            p[k] -= c->centre[k];
+        umin = fmin(umin, dot3(p, c->right)), umax = fmax(umax, dot3(p, c->right));
+        vmin = fmin(vmin, dot3(p, c->up)), vmax = fmax(vmax, dot3(p, c->up));
+    }
+    c->u0 = umin, c->v1 = vmax;
+    c->du = (umax - umin) / o->img_w, c->dv = (vmax - vmin) / o->img_h;
+    return 0;
+}
+
+void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, int x, int y, double p[3])
+{
+    double u = c->u0 + (x + 0.5) * c->du, v = c->v1 - (y + 0.5) * c->dv;
+    for (int k = 0; k < 3; k++)
+        p[k] = c->centre[k] + u * c->right[k] + v * c->up[k];
+}
+
+/* Every boundary face's rays: face f = 2 axis + (side > 0) of voxel v, its centre, the bins of
+ * its patch's frame, nsamp x nsamp directions per bin uniform in (sin^2 theta, phi) (the tube's
+ * stratified samples, reference: Bins, with phi over [0, 2 pi)). A patch's bin is the mean over
+ * its faces and samples. */
+static int render_patches(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
+                          const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
+                          ppb_object_result *out, ppb_err *err)
+{
+    int nbins = o->ntheta * o->nphi;
+    size_t nvox = (size_t)o->nx * o->ny * o->nz;
+    double h = o->voxel;
+    ppb_progress pr;
+    ppb_progress_begin(&pr, out->method, "voxels", (double)nvox, quiet);
+    for (size_t v = 0; v < nvox; v++) {
+        if (ppb_interrupted()) {
+            ppb_progress_end(&pr, (double)v);
+            return ppb_fail(err, "%s: %s: interrupted", o->name, out->method);
+        }
+        if (!o->mat[v])
+            continue;
+        size_t s = v;
+        int idx[3];
+        idx[0] = (int)(s % (size_t)o->nx), s /= (size_t)o->nx;
+        idx[1] = (int)(s % (size_t)o->ny), idx[2] = (int)(s / (size_t)o->ny);
+        for (int f = 0; f < 6; f++) {
+            int q = p->face_patch[6 * v + f];
+            if (q < 0)
+                continue;
+            const ppb_object_patch *pa = &p->patch[q];
+            int axis = f / 2, side = (f & 1) ? 1 : -1;
+            double c[3], nrm[3] = {0.0, 0.0, 0.0}, b[3];
+            for (int a = 0; a < 3; a++)
+                c[a] = (idx[a] + 0.5) * h;
+            c[axis] = (idx[axis] + (side > 0 ? 1.0 : 0.0)) * h;
+            nrm[axis] = side;
+            cross3(nrm, pa->t, b);
+            double wgt = h * h / pa->area / (nsamp * nsamp);
+            for (int bin = 0; bin < nbins; bin++) {
+                int ith = bin / o->nphi, iph = bin % o->nphi;
+                double acc = 0.0;
+                for (int sa = 0; sa < nsamp; sa++)
+                    for (int sb = 0; sb < nsamp; sb++) {
+                        double s2 = (ith + (sa + 0.5) / nsamp) / o->ntheta;
+                        double st = sqrt(s2), ct = sqrt(1.0 - s2);
+                        double phi = (iph + (sb + 0.5) / nsamp) * 2.0 * PPB_PI / o->nphi;
+                        double w[3];
+                        for (int a = 0; a < 3; a++)
+                            w[a] = ct * nrm[a] + st * (cos(phi) * pa->t[a] + sin(phi) * b[a]);
+                        acc += ppb_pp3d_ray(o, m, tab, step, c, w, (long)v);
+                    }
+                out->patch_rad[(size_t)q * nbins + bin] += wgt * acc;
+            }
+        }
+        ppb_progress_update(&pr, (double)v + 1);
+    }
+    ppb_progress_end(&pr, (double)nvox);
+    return 0;
+}
+
+int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+                   double step, double *img, ppb_err *err)
+{
+    ppb_pp3d_camera cam;
+    if (ppb_pp3d_camera_init(o, &cam, err))
+        return -1;
+    for (int y = 0; y < o->img_h; y++)
+        for (int x = 0; x < o->img_w; x++) {
+            double pix[3], p0[3];
+            ppb_pp3d_camera_pixel(&cam, x, y, pix);
+            /* The ray starts beyond the grid box on the camera's side. */
+            double back = o->voxel * (o->nx + o->ny + o->nz);
+            for (int a = 0; a < 3; a++)
+                p0[a] = pix[a] + back * cam.to_cam[a];
+            img[(size_t)y * o->img_w + x] = ppb_pp3d_ray(o, m, tab, step, p0, cam.to_cam, -1);
+        }
+    return 0;
+}
+
+int ppb_pp3d_render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
+                    const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
+                    ppb_object_result *out, ppb_err *err)
+{
+    if (ppb_pp3d_image(o, m, tab, step, out->img, err) ||
+        render_patches(o, p, m, tab, nsamp, step, quiet, out, err))
+        return -1;
+    size_t n = (size_t)out->npatch * out->nbins, npix = (size_t)o->img_w * o->img_h;
+    for (size_t i = 0; i < n + npix; i++) {
+        double v = i < n ? out->patch_rad[i] : out->img[i - n];
+        if (!isfinite(v) || v < 0.0)
+            return ppb_fail(err, "%s: %s: radiance %g at %s %zu (not finite or negative)", o->name,
+                            out->method, v, i < n ? "patch cell" : "pixel", i < n ? i : i - n);
+    }
+    return 0;
+}

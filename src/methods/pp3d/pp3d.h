@@ -1,0 +1,103 @@
+/* pp3d.h: the paper's methods on a voxel object (paper Sec. 3.4-3.5, Fig. 3 and 9; docs/methods.md,
+ * "pp and ss in three dimensions"): `ss3d`, single scattering marched exactly voxel crossing by
+ * voxel crossing, and `pp3d`, the plane-parallel ray marcher, whose source at a march point is
+ * the slab solution (physics/ppsolver.h) of the local slab along the light.
+ *
+ * Owns the light's optical-depth map of an object (the paper's optical density map, average
+ * albedo map and, per voxel, the local slab that its furthest-point buffer locates), the
+ * direction-by-cosine integral tables of the local slabs, the voxel walk of a ray and the march
+ * of the patches' and the camera's rays. Host code; n = 1 only (the paper's Fig. 9 setting). */
+#ifndef PPB_PP3D_H
+#define PPB_PP3D_H
+
+#include "methods/object_method.h"
+#include "model/config.h"
+
+extern const ppb_object_method ppb_object_method_ss3d, ppb_object_method_pp3d;
+
+/* The optical-depth map of one light (paper Sec. 3.4, pre-process steps 2-3 and 5), per medium
+ * voxel v of the object (outside voxels hold zeros):
+ * - Dc[8 v + c]: D, the optical depth from the surface to corner c (c = cx + 2 cy + 4 cz) along
+ *   -w_L, as the limit from inside v (exact: traced through the voxels); inside v, D is their
+ *   trilinear interpolation, exact wherever D is linear in v (any light along an axis);
+ * - Dpre[v]: the part of D in front of v's local slab (0 unless the light line left the medium
+ *   and came back before v: a shadowing part of a non-convex object);
+ * - tau0[v]: the local slab's optical thickness: the contiguous medium chord along the light line
+ *   through v's centre (from where the light last entered to where it next leaves);
+ * - abar[v]: the albedo averaged over length along the light from that entry to v's centre
+ *   (paper Sec. 3.3);
+ * - depth[v]: the geometric distance from that entry to v's centre (the furthest-point buffer's
+ *   depth seen from the light). */
+typedef struct ppb_pp3d_map {
+    int nx, ny, nz;
+    double *Dc, *Dpre, *tau0, *abar, *depth;
+} ppb_pp3d_map;
+
+int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err);
+void ppb_pp3d_map_free(ppb_pp3d_map *m);
+/* D at point x inside voxel v (trilinear from its inside-limit corners). */
+double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3]);
+
+/* The local slabs' tables (paper Eq. 14-15): the slab is lit at normal incidence (its normal is
+ * -w_L, mu0 = 1), so a direction enters only by theta, its angle to -w_L. For every thickness
+ * node t, albedo node a, angle node j (theta_j = pi j / (nang - 1)) and tau node i:
+ *     R[t][a][j][i] = sum_k A_k(theta_j) e_k(tau_i) + a_lin tau_i,  Cb[t][a][j] = b(theta_j),
+ * both per unit albedo of the slab (the march multiplies by the local sigma_s). */
+typedef struct ppb_pp3d_tables {
+    int nthick, nalb, nang;
+    double alb0, alb_h;
+    double *thick;  /* [nthick] slab optical thicknesses */
+    int *ntau;      /* [nthick] tau nodes, uniform on [0, thick] */
+    size_t *off;    /* [nthick] where thickness node t's R block starts */
+    double *R, *Cb; /* R as above; Cb [nthick][nalb][nang] */
+    int *vox_thick; /* [nvox] the thickness node of each medium voxel */
+    int modes, modes_kept;
+} ppb_pp3d_tables;
+
+/* Relative spacing of the thickness nodes: the voxels' local slab thicknesses are grouped into
+ * runs spanning at most this ratio, each run one node at its geometric middle (a single
+ * thickness, as in a box lit along an axis, is its own node, exactly). */
+#define PPB_PP3D_THICK_RATIO 1.2
+/* Angle nodes over [0, pi]: linear interpolation in theta is 2e-5 relative at g = 0.9. */
+#define PPB_PP3D_NANG 257
+/* Tau nodes per unit optical depth, as the tube's tables (methods/pp/march.h). */
+#define PPB_PP3D_TAU_PER_MFP 64
+/* The optical distance where a march stops, as the tube's (march.c: d_cap). */
+#define PPB_PP3D_D_CAP 40.0
+
+int ppb_pp3d_tables_build(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp_settings *pp,
+                          int quiet, ppb_pp3d_tables *t, ppb_err *err);
+void ppb_pp3d_tables_free(ppb_pp3d_tables *t);
+
+/* The march of one object: every (patch face, bin, direction sample) ray and every pixel's ray.
+ * tab NULL: ss3d (the direct beam's first scattering only). nsamp: direction samples per bin
+ * axis (cfg samples_dir); step: the R march's step (pp.step). */
+int ppb_pp3d_render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
+                    const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
+                    ppb_object_result *out, ppb_err *err);
+
+/* The camera's image alone (a frame: what the paper times), img [img_w * img_h]. */
+int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+                   double step, double *img, ppb_err *err);
+
+/* The radiance leaving the object at point p0 along w_out (unit), per unit E_perp, marched from
+ * p0 along -w_out starting in voxel `start` (or, start < 0, from where the line enters the grid
+ * box). The single ray of ppb_pp3d_render, for tests. */
+double ppb_pp3d_ray(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+                    double step, const double p0[3], const double w_out[3], long start);
+
+/* The orthographic camera (docs/methods.md, "pp and ss in three dimensions"): to_cam =
+ * -view_dir; right = normalise(y x to_cam) (z x to_cam when the view is along y); up =
+ * to_cam x right. The image spans the projection of the grid box: u in [u0, u0 + img_w du] along
+ * right, v in [v1 - img_h dv, v1] along up, pixel (x, y) row-major from the top left, its ray
+ * through its centre. */
+typedef struct ppb_pp3d_camera {
+    double to_cam[3], right[3], up[3], centre[3];
+    double u0, v1, du, dv;
+} ppb_pp3d_camera;
+
+int ppb_pp3d_camera_init(const ppb_object *o, ppb_pp3d_camera *c, ppb_err *err);
+/* The centre of pixel (x, y) on the plane through the grid box's centre normal to the view. */
+void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, int x, int y, double p[3]);
+
+#endif
