@@ -32,7 +32,7 @@ static ray_dir ray_dir_of(const ppb_object *o, const ppb_pp3d_tables *tab, const
     double c = w[0] * wl[0] + w[1] * wl[1] + w[2] * wl[2];
     r.p = ppb_hg_phase(o->g, c);
     if (tab) {
-        double th = acos(fmax(-1.0, fmin(1.0, -c))) / PPB_PI * (tab->nang - 1);
+        double th = ppb_pp3d_angle_pos(c, tab->nang);
         r.j = (int)floor(th);
         r.j = r.j < 0 ? 0 : (r.j > tab->nang - 2 ? tab->nang - 2 : r.j);
         r.f = th - r.j;

@@ -13,6 +13,8 @@
 #include "methods/object_method.h"
 #include "model/config.h"
 
+#include <math.h>
+
 extern const ppb_object_method ppb_object_method_ss3d, ppb_object_method_pp3d;
 
 /* The optical-depth map of one light (paper Sec. 3.4, pre-process steps 2-3 and 5), per medium
@@ -39,8 +41,8 @@ void ppb_pp3d_map_free(ppb_pp3d_map *m);
 double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3]);
 
 /* The local slabs' tables (paper Eq. 14-15): the slab is lit at normal incidence (its normal is
- * -w_L, mu0 = 1), so a direction enters only by theta, its angle to -w_L. For every thickness
- * node t, albedo node a, angle node j (theta_j = pi j / (nang - 1)) and tau node i:
+ * -w_L, mu0 = 1), so a direction enters only by its angle to the light. For every thickness
+ * node t, albedo node a, angle node j (ppb_pp3d_angle_node) and tau node i:
  *     R[t][a][j][i] = sum_k A_k(theta_j) e_k(tau_i) + a_lin tau_i,  Cb[t][a][j] = b(theta_j),
  * both per unit albedo of the slab (the march multiplies by the local sigma_s). */
 typedef struct ppb_pp3d_tables {
@@ -58,8 +60,23 @@ typedef struct ppb_pp3d_tables {
  * runs spanning at most this ratio, each run one node at its geometric middle (a single
  * thickness, as in a box lit along an axis, is its own node, exactly). */
 #define PPB_PP3D_THICK_RATIO 1.2
-/* Angle nodes over [0, pi]: linear interpolation in theta is 2e-5 relative at g = 0.9. */
-#define PPB_PP3D_NANG 257
+/* Angle nodes: psi, the angle between w and the light's travel w_L (theta = pi - psi), at
+ * psi_j = pi (j / (nang - 1))^2, dense toward the forward direction where HG's peak lies
+ * (width about 1 - g); linear interpolation in the node coordinate (ppb_pp3d_angle_pos). */
+#define PPB_PP3D_NANG 513
+
+static inline double ppb_pp3d_angle_node(int j, int nang)
+{
+    double v = (double)j / (nang - 1);
+    return 3.14159265358979323846 * v * v;
+}
+
+/* The node coordinate, in [0, nang - 1], of a direction whose cosine with w_L is c. */
+static inline double ppb_pp3d_angle_pos(double c, int nang)
+{
+    double psi = acos(c < -1.0 ? -1.0 : (c > 1.0 ? 1.0 : c));
+    return sqrt(psi / 3.14159265358979323846) * (nang - 1);
+}
 /* Tau nodes per unit optical depth, as the tube's tables (methods/pp/march.h). */
 #define PPB_PP3D_TAU_PER_MFP 64
 /* The optical distance where a march stops, as the tube's (march.c: d_cap). */

@@ -142,9 +142,9 @@ static int build_block(const ppb_object *o, const ppb_pp_settings *pp, ppb_pp3d_
             E[(size_t)i * ne + k] = exp(lambda[k] * (i * dtau - tref[k]));
     /* The slab's J carries its albedo; the march multiplies by the local sigma_s. */
     for (int j = 0; j < nang; j++) {
-        double th = PPB_PI * j / (nang - 1);
+        double psi = ppb_pp3d_angle_node(j, nang);
         /* The slab's frame: y is its outward normal, -w_L (ppsolver.h); w's azimuth is free. */
-        double w[3] = {sin(th), cos(th), 0.0}, b;
+        double w[3] = {sin(psi), -cos(psi), 0.0}, b;
         pp_source_coeffs(sol, w, a, &b);
         Cb[j] = b / alb;
         for (int k = 0; k < ne; k++)
