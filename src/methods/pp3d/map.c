@@ -13,22 +13,7 @@ static double voxel_albedo(const ppb_object *o, size_t v)
     return o->albedo_tex ? (double)o->albedo_tex[v] : o->material[o->mat[v]].albedo;
 }
 
-/* D from q, a point of voxel v0, to the surface along d = -w_L: the medium's optical depth along
- * the whole line. */
-static double trace_depth(const ppb_object *o, size_t v0, const double q[3], const double d[3])
-{
-    ppb_walk w;
-    size_t v;
-    double ta, tb, D = 0.0;
-    if (!ppb_walk_init(&w, o, q, d, (long)v0))
-        return 0.0;
-    while (ppb_walk_next(&w, &v, &ta, &tb))
-        if (o->mat[v])
-            D += o->material[o->mat[v]].sigma_t * (tb - ta);
-    return D;
-}
-
-/* From voxel v's centre q along d: the contiguous medium run from q (optical depth *run,
+/* From q, a point of voxel v0, along d: the contiguous medium run from q (optical depth *run,
  * albedo integral *alb, length *len) and what lies beyond it (*beyond, optical depth). */
 static void trace_run(const ppb_object *o, size_t v0, const double q[3], const double d[3],
                       double *run, double *alb, double *len, double *beyond)
@@ -62,11 +47,11 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
     m->nx = o->nx, m->ny = o->ny, m->nz = o->nz;
     size_t nvox = (size_t)o->nx * o->ny * o->nz;
     m->Dc = calloc(8 * nvox, sizeof *m->Dc);
-    m->Dpre = calloc(nvox, sizeof *m->Dpre);
+    m->Pc = calloc(8 * nvox, sizeof *m->Pc);
     m->tau0 = calloc(nvox, sizeof *m->tau0);
     m->abar = calloc(nvox, sizeof *m->abar);
     m->depth = calloc(nvox, sizeof *m->depth);
-    if (!m->Dc || !m->Dpre || !m->tau0 || !m->abar || !m->depth) {
+    if (!m->Dc || !m->Pc || !m->tau0 || !m->abar || !m->depth) {
         ppb_pp3d_map_free(m);
         return ppb_fail(err, "%s: out of memory for the light map of %zu voxels", o->name, nvox);
     }
@@ -86,13 +71,15 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
                     double q[3] = {(i + ((c & 1) ? 1.0 - e : e)) * h,
                                    (j + ((c & 2) ? 1.0 - e : e)) * h,
                                    (k + ((c & 4) ? 1.0 - e : e)) * h};
-                    m->Dc[8 * v + c] = trace_depth(o, v, q, back);
+                    double run, alb, len, pre;
+                    trace_run(o, v, q, back, &run, &alb, &len, &pre);
+                    m->Dc[8 * v + c] = run + pre;
+                    m->Pc[8 * v + c] = pre;
                 }
                 double q[3] = {(i + 0.5) * h, (j + 0.5) * h, (k + 0.5) * h};
                 double run_b, alb_b, len_b, pre, run_f, alb_f, len_f, after;
                 trace_run(o, v, q, back, &run_b, &alb_b, &len_b, &pre);
                 trace_run(o, v, q, fwd, &run_f, &alb_f, &len_f, &after);
-                m->Dpre[v] = pre;
                 m->tau0[v] = run_b + run_f;
                 m->abar[v] = len_b > 0.0 ? alb_b / len_b : voxel_albedo(o, v);
                 m->depth[v] = len_b;
@@ -102,11 +89,20 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
 
 void ppb_pp3d_map_free(ppb_pp3d_map *m)
 {
-    free(m->Dc), free(m->Dpre), free(m->tau0), free(m->abar), free(m->depth);
+    free(m->Dc), free(m->Pc), free(m->tau0), free(m->abar), free(m->depth);
     memset(m, 0, sizeof *m);
 }
 
-double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3])
+static double trilinear(const double *c, const double f[3])
+{
+    double x00 = c[0] + f[0] * (c[1] - c[0]), x10 = c[2] + f[0] * (c[3] - c[2]);
+    double x01 = c[4] + f[0] * (c[5] - c[4]), x11 = c[6] + f[0] * (c[7] - c[6]);
+    double y0 = x00 + f[1] * (x10 - x00), y1 = x01 + f[1] * (x11 - x01);
+    return y0 + f[2] * (y1 - y0);
+}
+
+double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3],
+                          double *pre)
 {
     size_t s = v;
     int idx[3];
@@ -117,9 +113,7 @@ double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, 
         double t = x[a] / o->voxel - idx[a];
         f[a] = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     }
-    const double *c = m->Dc + 8 * v;
-    double x00 = c[0] + f[0] * (c[1] - c[0]), x10 = c[2] + f[0] * (c[3] - c[2]);
-    double x01 = c[4] + f[0] * (c[5] - c[4]), x11 = c[6] + f[0] * (c[7] - c[6]);
-    double y0 = x00 + f[1] * (x10 - x00), y1 = x01 + f[1] * (x11 - x01);
-    return y0 + f[2] * (y1 - y0);
+    if (pre)
+        *pre = trilinear(m->Pc + 8 * v, f);
+    return trilinear(m->Dc + 8 * v, f);
 }

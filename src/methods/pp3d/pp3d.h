@@ -22,8 +22,10 @@ extern const ppb_object_method ppb_object_method_ss3d, ppb_object_method_pp3d;
  * - Dc[8 v + c]: D, the optical depth from the surface to corner c (c = cx + 2 cy + 4 cz) along
  *   -w_L, as the limit from inside v (exact: traced through the voxels); inside v, D is their
  *   trilinear interpolation, exact wherever D is linear in v (any light along an axis);
- * - Dpre[v]: the part of D in front of v's local slab (0 unless the light line left the medium
- *   and came back before v: a shadowing part of a non-convex object);
+ * - Pc[8 v + c]: the part of Dc in front of the corner's local slab (0 unless the light line
+ *   left the medium and came back before it: a shadowing part of a non-convex object), also
+ *   interpolated trilinearly, so that D - Dpre, the depth in the local slab, is the
+ *   interpolation of the corners' own depths;
  * - tau0[v]: the local slab's optical thickness: the contiguous medium chord along the light line
  *   through v's centre (from where the light last entered to where it next leaves);
  * - abar[v]: the albedo averaged over length along the light from that entry to v's centre
@@ -32,13 +34,15 @@ extern const ppb_object_method ppb_object_method_ss3d, ppb_object_method_pp3d;
  *   depth seen from the light). */
 typedef struct ppb_pp3d_map {
     int nx, ny, nz;
-    double *Dc, *Dpre, *tau0, *abar, *depth;
+    double *Dc, *Pc, *tau0, *abar, *depth;
 } ppb_pp3d_map;
 
 int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err);
 void ppb_pp3d_map_free(ppb_pp3d_map *m);
-/* D at point x inside voxel v (trilinear from its inside-limit corners). */
-double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3]);
+/* D and Dpre at point x inside voxel v (trilinear from its inside-limit corners); pre may be
+ * NULL. Returns D. */
+double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3],
+                          double *pre);
 
 /* The local slabs' tables (paper Eq. 14-15): the slab is lit at normal incidence (its normal is
  * -w_L, mu0 = 1), so a direction enters only by its angle to the light. For every thickness
