@@ -93,7 +93,7 @@ void ppb_pp3d_map_free(ppb_pp3d_map *m)
     memset(m, 0, sizeof *m);
 }
 
-static double trilinear(const double *c, const double f[3])
+double ppb_pp3d_trilinear(const double c[8], const double f[3])
 {
     double x00 = c[0] + f[0] * (c[1] - c[0]), x10 = c[2] + f[0] * (c[3] - c[2]);
     double x01 = c[4] + f[0] * (c[5] - c[4]), x11 = c[6] + f[0] * (c[7] - c[6]);
@@ -114,6 +114,6 @@ double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, 
         f[a] = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     }
     if (pre)
-        *pre = trilinear(m->Pc + 8 * v, f);
-    return trilinear(m->Dc + 8 * v, f);
+        *pre = ppb_pp3d_trilinear(m->Pc + 8 * v, f);
+    return ppb_pp3d_trilinear(m->Dc + 8 * v, f);
 }

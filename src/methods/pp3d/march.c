@@ -97,10 +97,9 @@ static double beam_step(double C, double sigma_t, double h, double e_a, double z
 /* The map at distance l of a crossing: D and Dpre, by lookup or, on a crossing where both are
  * linear, from its ends. */
 typedef struct cross_map {
-    const ppb_object *o;
-    const ppb_pp3d_map *m;
-    size_t v;
-    double xa[3], dir[3], la, len;
+    const double *Dc, *Pc; /* the voxel's corners */
+    double fa[3], fd[3];   /* the crossing's start in the voxel's unit cube, and dir / h */
+    double la, len;
     double Da, Db, Pa, Pb;
     int linear;
 } cross_map;
@@ -112,10 +111,13 @@ static double cross_depth(const cross_map *c, double l, double *pre)
         *pre = c->Pa + f * (c->Pb - c->Pa);
         return c->Da + f * (c->Db - c->Da);
     }
-    double x[3];
-    for (int a = 0; a < 3; a++)
-        x[a] = c->xa[a] + (l - c->la) * c->dir[a];
-    return ppb_pp3d_map_depth(c->o, c->m, c->v, x, pre);
+    double f[3];
+    for (int a = 0; a < 3; a++) {
+        double t = c->fa[a] + (l - c->la) * c->fd[a];
+        f[a] = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    }
+    *pre = ppb_pp3d_trilinear(c->Pc, f);
+    return ppb_pp3d_trilinear(c->Dc, f);
 }
 
 /* One voxel crossing [la, lb] of voxel v; *d is the optical distance at la, advanced. Per step:
@@ -135,17 +137,18 @@ static double crossing(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3
     *d = d0 + sigma * len;
     if (!(len > 0.0) || alpha <= 0.0)
         return 0.0;
-    cross_map c = {.o = o, .m = m, .v = v, .la = la, .len = len};
-    double xb[3], xm[3], Pm;
+    cross_map c = {.Dc = m->Dc + 8 * v, .Pc = m->Pc + 8 * v, .la = la, .len = len};
+    size_t s = v;
+    int idx[3];
+    idx[0] = (int)(s % (size_t)o->nx), s /= (size_t)o->nx;
+    idx[1] = (int)(s % (size_t)o->ny), idx[2] = (int)(s / (size_t)o->ny);
     for (int a = 0; a < 3; a++) {
-        c.dir[a] = dir[a];
-        c.xa[a] = p0[a] + la * dir[a];
-        xb[a] = p0[a] + lb * dir[a];
-        xm[a] = 0.5 * (c.xa[a] + xb[a]);
+        c.fa[a] = (p0[a] + la * dir[a]) / o->voxel - idx[a];
+        c.fd[a] = dir[a] / o->voxel;
     }
-    c.Da = ppb_pp3d_map_depth(o, m, v, c.xa, &c.Pa);
-    c.Db = ppb_pp3d_map_depth(o, m, v, xb, &c.Pb);
-    double Dm = ppb_pp3d_map_depth(o, m, v, xm, &Pm);
+    double Pm, Dm = cross_depth(&c, la + 0.5 * len, &Pm);
+    c.Da = cross_depth(&c, la, &c.Pa);
+    c.Db = cross_depth(&c, lb, &c.Pb);
     double tol = 1e-12 * (1.0 + c.Da + c.Db);
     c.linear = fabs(Dm - 0.5 * (c.Da + c.Db)) <= tol && fabs(Pm - 0.5 * (c.Pa + c.Pb)) <= tol;
     int ia = 0, it = 0;

@@ -39,6 +39,8 @@ typedef struct ppb_pp3d_map {
 
 int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err);
 void ppb_pp3d_map_free(ppb_pp3d_map *m);
+/* The trilinear interpolation of corner values c (c[cx + 2 cy + 4 cz]) at f in the unit cube. */
+double ppb_pp3d_trilinear(const double c[8], const double f[3]);
 /* D and Dpre at point x inside voxel v (trilinear from its inside-limit corners); pre may be
  * NULL. Returns D. */
 double ppb_pp3d_map_depth(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double x[3],
