@@ -7,6 +7,7 @@
 #include "testutil.h"
 
 #include <math.h>
+#include <time.h>
 
 #include "base/clock.h"
 #include "kernels/march_params.h"
@@ -407,12 +408,14 @@ static void test_pp3d_ball_frame(void **state)
         fail_msg("%s", err.msg);
     double t2 = ppb_now();
     double *img = calloc(256 * 256, sizeof *img);
+    clock_t c0 = clock();
     if (ppb_pp3d_image(&o, &m, &t, cfg.pp.step, img, &err))
         fail_msg("%s", err.msg);
-    double t3 = ppb_now();
+    double t3 = ppb_now(), cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
     printf("pp3d, 64^3 ball, %d directions, %d thickness x %d albedo nodes: map %.2f s, tables "
-           "%.2f s, frame (256 x 256 rays, step %g) %.3f s\n",
-           cfg.pp.directions, t.nthick, t.nalb, t1 - t0, t2 - t1, cfg.pp.step, t3 - t2);
+           "%.2f s, frame (256 x 256 rays, step %g) %.3f s wall, %.3f s CPU (%ld CPUs online)\n",
+           cfg.pp.directions, t.nthick, t.nalb, t1 - t0, t2 - t1, cfg.pp.step, t3 - t2, cpu,
+           sysconf(_SC_NPROCESSORS_ONLN));
     double worst = 0.0, top = 0.0, bottom = 0.0;
     for (int y = 0; y < 256; y++)
         for (int x = 0; x < 128; x++) {

@@ -11,7 +11,10 @@
 #include "methods/pp3d/pp3d.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
+#include <unistd.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -250,90 +253,198 @@ void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, int x, int y, double p[3])
         p[k] = c->centre[k] + u * c->right[k] + v * c->up[k];
 }
 
-/* Every boundary face's rays: face f = 2 axis + (side > 0) of voxel v, its centre, the bins of
- * its patch's frame, nsamp x nsamp directions per bin uniform in (sin^2 theta, phi) (the tube's
- * stratified samples, reference: Bins, with phi over [0, 2 pi)). A patch's bin is the mean over
- * its faces and samples. */
-static int render_patches(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
-                          const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
-                          ppb_object_result *out, ppb_err *err)
+/* One boundary face's rays, added into its patch's bins (row of nbins): face f = 2 axis +
+ * (side > 0) of voxel v, from its centre, nsamp x nsamp directions per bin uniform in
+ * (sin^2 theta, phi) (the tube's stratified samples, reference: Bins, with phi over [0, 2 pi)
+ * in the patch's frame). A patch's bin is the mean over its faces and samples. */
+static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb_pp3d_map *m,
+                      const ppb_pp3d_tables *tab, int nsamp, double step, size_t v, int f,
+                      double *row)
 {
-    int nbins = o->ntheta * o->nphi;
-    size_t nvox = (size_t)o->nx * o->ny * o->nz;
     double h = o->voxel;
-    ppb_progress pr;
-    ppb_progress_begin(&pr, out->method, "voxels", (double)nvox, quiet);
-    for (size_t v = 0; v < nvox; v++) {
-        if (ppb_interrupted()) {
-            ppb_progress_end(&pr, (double)v);
-            return ppb_fail(err, "%s: %s: interrupted", o->name, out->method);
-        }
-        if (!o->mat[v])
-            continue;
-        size_t s = v;
-        int idx[3];
-        idx[0] = (int)(s % (size_t)o->nx), s /= (size_t)o->nx;
-        idx[1] = (int)(s % (size_t)o->ny), idx[2] = (int)(s / (size_t)o->ny);
-        for (int f = 0; f < 6; f++) {
-            int q = p->face_patch[6 * v + f];
-            if (q < 0)
-                continue;
-            const ppb_object_patch *pa = &p->patch[q];
-            int axis = f / 2, side = (f & 1) ? 1 : -1;
-            double c[3], nrm[3] = {0.0, 0.0, 0.0}, b[3];
-            for (int a = 0; a < 3; a++)
-                c[a] = (idx[a] + 0.5) * h;
-            c[axis] = (idx[axis] + (side > 0 ? 1.0 : 0.0)) * h;
-            nrm[axis] = side;
-            cross3(nrm, pa->t, b);
-            double wgt = h * h / pa->area / (nsamp * nsamp);
-            for (int bin = 0; bin < nbins; bin++) {
-                int ith = bin / o->nphi, iph = bin % o->nphi;
-                double acc = 0.0;
-                for (int sa = 0; sa < nsamp; sa++)
-                    for (int sb = 0; sb < nsamp; sb++) {
-                        double s2 = (ith + (sa + 0.5) / nsamp) / o->ntheta;
-                        double st = sqrt(s2), ct = sqrt(1.0 - s2);
-                        double phi = (iph + (sb + 0.5) / nsamp) * 2.0 * PPB_PI / o->nphi;
-                        double w[3];
-                        for (int a = 0; a < 3; a++)
-                            w[a] = ct * nrm[a] + st * (cos(phi) * pa->t[a] + sin(phi) * b[a]);
-                        acc += ppb_pp3d_ray(o, m, tab, step, c, w, (long)v);
-                    }
-                out->patch_rad[(size_t)q * nbins + bin] += wgt * acc;
+    size_t s = v;
+    int idx[3];
+    idx[0] = (int)(s % (size_t)o->nx), s /= (size_t)o->nx;
+    idx[1] = (int)(s % (size_t)o->ny), idx[2] = (int)(s / (size_t)o->ny);
+    int axis = f / 2, side = (f & 1) ? 1 : -1;
+    double c[3], nrm[3] = {0.0, 0.0, 0.0}, b[3];
+    for (int a = 0; a < 3; a++)
+        c[a] = (idx[a] + 0.5) * h;
+    c[axis] = (idx[axis] + (side > 0 ? 1.0 : 0.0)) * h;
+    nrm[axis] = side;
+    cross3(nrm, pa->t, b);
+    double wgt = h * h / pa->area / (nsamp * nsamp);
+    for (int bin = 0; bin < o->ntheta * o->nphi; bin++) {
+        int ith = bin / o->nphi, iph = bin % o->nphi;
+        double acc = 0.0;
+        for (int sa = 0; sa < nsamp; sa++)
+            for (int sb = 0; sb < nsamp; sb++) {
+                double s2 = (ith + (sa + 0.5) / nsamp) / o->ntheta;
+                double st = sqrt(s2), ct = sqrt(1.0 - s2);
+                double phi = (iph + (sb + 0.5) / nsamp) * 2.0 * PPB_PI / o->nphi;
+                double w[3];
+                for (int a = 0; a < 3; a++)
+                    w[a] = ct * nrm[a] + st * (cos(phi) * pa->t[a] + sin(phi) * b[a]);
+                acc += ppb_pp3d_ray(o, m, tab, step, c, w, (long)v);
             }
-        }
-        ppb_progress_update(&pr, (double)v + 1);
+        row[bin] += wgt * acc;
     }
-    ppb_progress_end(&pr, (double)nvox);
+}
+
+/* The start of pixel (x, y)'s ray: beyond the grid box on the camera's side. */
+static void pixel_ray(const ppb_object *o, const ppb_pp3d_camera *cam, int x, int y, double p0[3])
+{
+    double pix[3];
+    ppb_pp3d_camera_pixel(cam, x, y, pix);
+    double back = o->voxel * (o->nx + o->ny + o->nz);
+    for (int a = 0; a < 3; a++)
+        p0[a] = pix[a] + back * cam->to_cam[a];
+}
+
+/* The work of one run, shared by its threads: items [0, npatch) are the patches (each one's
+ * faces in voxel order, so a patch's sums do not depend on the threads), then the image's
+ * rows. Each item is taken once, through the atomic counter. */
+typedef struct render_job {
+    const ppb_object *o;
+    const ppb_object_patches *p;
+    const ppb_pp3d_map *m;
+    const ppb_pp3d_tables *tab;
+    int nsamp, with_patches;
+    double step;
+    const size_t *face_off, *faces; /* patch q's faces: faces[face_off[q] .. face_off[q + 1]) */
+    ppb_pp3d_camera cam;
+    double *patch_rad, *img;
+    int nitems;
+    atomic_int next, done;
+} render_job;
+
+static void render_item(render_job *j, int item)
+{
+    const ppb_object *o = j->o;
+    int nbins = o->ntheta * o->nphi, np = j->with_patches ? j->p->npatch : 0;
+    if (item < np) {
+        for (size_t k = j->face_off[item]; k < j->face_off[item + 1]; k++)
+            face_rays(o, &j->p->patch[item], j->m, j->tab, j->nsamp, j->step, j->faces[k] / 6,
+                      (int)(j->faces[k] % 6), j->patch_rad + (size_t)item * nbins);
+        return;
+    }
+    int y = item - np;
+    for (int x = 0; x < o->img_w; x++) {
+        double p0[3];
+        pixel_ray(o, &j->cam, x, y, p0);
+        j->img[(size_t)y * o->img_w + x] =
+            ppb_pp3d_ray(o, j->m, j->tab, j->step, p0, j->cam.to_cam, -1);
+    }
+}
+
+static void *render_worker(void *arg)
+{
+    render_job *j = arg;
+    int item;
+    while (!ppb_interrupted() && (item = atomic_fetch_add(&j->next, 1)) < j->nitems) {
+        render_item(j, item);
+        atomic_fetch_add(&j->done, 1);
+    }
+    return NULL;
+}
+
+/* The threads: the CPUs online, at most PPB_PP3D_MAX_THREADS. */
+static int render_threads(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : (n > PPB_PP3D_MAX_THREADS ? PPB_PP3D_MAX_THREADS : (int)n);
+}
+
+/* Runs the job on the threads, the calling one among them, with progress lines from it. */
+static int render_run(render_job *j, const char *label, int quiet, ppb_err *err)
+{
+    int nt = render_threads();
+    pthread_t th[PPB_PP3D_MAX_THREADS];
+    int started = 0;
+    for (int i = 1; i < nt; i++, started++)
+        if (pthread_create(&th[i], NULL, render_worker, j))
+            break;
+    ppb_progress pr;
+    ppb_progress_begin(&pr, label, "items", j->nitems, quiet);
+    int item;
+    while (!ppb_interrupted() && (item = atomic_fetch_add(&j->next, 1)) < j->nitems) {
+        render_item(j, item);
+        atomic_fetch_add(&j->done, 1);
+        ppb_progress_update(&pr, atomic_load(&j->done));
+    }
+    for (int i = 1; i <= started; i++)
+        pthread_join(th[i], NULL);
+    ppb_progress_end(&pr, atomic_load(&j->done));
+    if (atomic_load(&j->done) < j->nitems)
+        return ppb_fail(err, "%s: %s: interrupted", j->o->name, label);
     return 0;
+}
+
+/* Each patch's faces, in voxel order. */
+static int patch_faces(const ppb_object *o, const ppb_object_patches *p, size_t **off,
+                       size_t **faces, ppb_err *err)
+{
+    size_t nvox = (size_t)o->nx * o->ny * o->nz, nf = 0;
+    *off = calloc((size_t)p->npatch + 1, sizeof **off);
+    if (!*off)
+        return ppb_fail(err, "%s: out of memory for the patches' faces", o->name);
+    for (size_t i = 0; i < 6 * nvox; i++)
+        if (p->face_patch[i] >= 0)
+            (*off)[p->face_patch[i] + 1]++, nf++;
+    for (int q = 0; q < p->npatch; q++)
+        (*off)[q + 1] += (*off)[q];
+    *faces = malloc((nf ? nf : 1) * sizeof **faces);
+    size_t *fill = calloc((size_t)p->npatch + 1, sizeof *fill);
+    if (!*faces || !fill) {
+        free(fill), free(*off), free(*faces);
+        *off = *faces = NULL;
+        return ppb_fail(err, "%s: out of memory for the patches' faces", o->name);
+    }
+    for (size_t i = 0; i < 6 * nvox; i++) {
+        int q = p->face_patch[i];
+        if (q >= 0)
+            (*faces)[(*off)[q] + fill[q]++] = i;
+    }
+    free(fill);
+    return 0;
+}
+
+static int render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
+                  const ppb_pp3d_tables *tab, int nsamp, double step, int quiet, const char *label,
+                  double *patch_rad, double *img, ppb_err *err)
+{
+    render_job j = {.o = o,
+                    .p = p,
+                    .m = m,
+                    .tab = tab,
+                    .nsamp = nsamp,
+                    .step = step,
+                    .with_patches = p != NULL,
+                    .patch_rad = patch_rad,
+                    .img = img};
+    size_t *off = NULL, *faces = NULL;
+    if (ppb_pp3d_camera_init(o, &j.cam, err) || (p && patch_faces(o, p, &off, &faces, err)))
+        return -1;
+    j.face_off = off, j.faces = faces;
+    j.nitems = (p ? p->npatch : 0) + o->img_h;
+    atomic_init(&j.next, 0);
+    atomic_init(&j.done, 0);
+    int rc = render_run(&j, label, quiet, err);
+    free(off), free(faces);
+    return rc;
 }
 
 int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
                    double step, double *img, ppb_err *err)
 {
-    ppb_pp3d_camera cam;
-    if (ppb_pp3d_camera_init(o, &cam, err))
-        return -1;
-    for (int y = 0; y < o->img_h; y++)
-        for (int x = 0; x < o->img_w; x++) {
-            double pix[3], p0[3];
-            ppb_pp3d_camera_pixel(&cam, x, y, pix);
-            /* The ray starts beyond the grid box on the camera's side. */
-            double back = o->voxel * (o->nx + o->ny + o->nz);
-            for (int a = 0; a < 3; a++)
-                p0[a] = pix[a] + back * cam.to_cam[a];
-            img[(size_t)y * o->img_w + x] = ppb_pp3d_ray(o, m, tab, step, p0, cam.to_cam, -1);
-        }
-    return 0;
+    return render(o, NULL, m, tab, 1, step, 1, "image", NULL, img, err);
 }
 
 int ppb_pp3d_render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
                     const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
                     ppb_object_result *out, ppb_err *err)
 {
-    if (ppb_pp3d_image(o, m, tab, step, out->img, err) ||
-        render_patches(o, p, m, tab, nsamp, step, quiet, out, err))
+    if (render(o, p, m, tab, nsamp, step, quiet, out->method, out->patch_rad, out->img, err))
         return -1;
     size_t n = (size_t)out->npatch * out->nbins, npix = (size_t)o->img_w * o->img_h, nneg = 0;
     double worst = 0.0;

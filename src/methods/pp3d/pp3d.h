@@ -85,6 +85,8 @@ static inline double ppb_pp3d_angle_pos(double c, int nang)
 }
 /* Tau nodes per unit optical depth, as the tube's tables (methods/pp/march.h). */
 #define PPB_PP3D_TAU_PER_MFP 64
+/* The march's threads at most (it takes the CPUs online up to this). */
+#define PPB_PP3D_MAX_THREADS 64
 /* The optical distance where a march stops, as the tube's (march.c: d_cap). */
 #define PPB_PP3D_D_CAP 40.0
 
@@ -99,7 +101,9 @@ int ppb_pp3d_render(const ppb_object *o, const ppb_object_patches *p, const ppb_
                     const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
                     ppb_object_result *out, ppb_err *err);
 
-/* The camera's image alone (a frame: what the paper times), img [img_w * img_h]. */
+/* The camera's image alone (a frame: what the paper times), img [img_w * img_h]. The march
+ * runs on the CPUs online (at most PPB_PP3D_MAX_THREADS threads), patches and image rows
+ * shared out one at a time; every sum is one thread's, so results do not depend on them. */
 int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
                    double step, double *img, ppb_err *err);
 
