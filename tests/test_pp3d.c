@@ -404,7 +404,7 @@ static void test_pp3d_ball_frame(void **state)
     if (ppb_pp3d_map_build(&o, &m, &err))
         fail_msg("%s", err.msg);
     double t1 = ppb_now();
-    if (ppb_pp3d_tables_build(&o, &m, &cfg.pp, 1, &t, &err))
+    if (ppb_pp3d_tables_build(&o, &m, &cfg.pp, cfg.memory_limit, 0.0, 1, &t, &err))
         fail_msg("%s", err.msg);
     double t2 = ppb_now();
     double *img = calloc(256 * 256, sizeof *img);
@@ -435,12 +435,53 @@ static void test_pp3d_ball_frame(void **state)
     free(o.mat);
 }
 
+/* What both refuse before any work, each with a message naming the object, the method and
+ * the value. */
+static void test_refusals(void **state)
+{
+    (void)state;
+    ppb_config cfg;
+    ppb_err err;
+    if (ppb_config_defaults(&cfg, &err))
+        fail_msg("%s", err.msg);
+    const ppb_object_method *ms[2] = {&ppb_object_method_ss3d, &ppb_object_method_pp3d};
+    for (int mi = 0; mi < 2; mi++)
+        for (int c = 0; c < 3; c++) {
+            ppb_object o = box(4, 4, 4, 0.5, 1.0, 0.9, 0.0);
+            float tex[64];
+            const char *want = "n = 1.4";
+            if (c == 0)
+                o.n = 1.4;
+            if (c == 1)
+                o.light_dir[1] = -2.0, want = "not a unit vector";
+            if (c == 2) {
+                for (int i = 0; i < 64; i++)
+                    tex[i] = 0.5f;
+                tex[21] = 1.5f;
+                o.albedo_tex = tex, want = "albedo texture holds 1.5 at voxel 21";
+            }
+            ppb_object_patches p;
+            ppb_object_result r;
+            if (ppb_object_patches_build(&o, &p, &err) ||
+                ppb_object_result_init(&r, ms[mi]->id, p.npatch, 32, 4, 4, &err))
+                fail_msg("%s", err.msg);
+            ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
+            if (ms[mi]->run(&ctx, &o, &p, &r, &err) != -1)
+                fail_msg("%s ran where it should refuse (want '%s')", ms[mi]->id, want);
+            if (!strstr(err.msg, want) || !strstr(err.msg, ms[mi]->id))
+                fail_msg("message '%s' lacks '%s'", err.msg, want);
+            ppb_object_result_free(&r);
+            ppb_object_patches_free(&p);
+            free(o.mat);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_map_ball_columns),    cmocka_unit_test(test_ss3d_slab_closed_form),
-        cmocka_unit_test(test_box_reproduces_tube), cmocka_unit_test(test_shadowed_slab),
-        cmocka_unit_test(test_pp3d_ball_frame),
+        cmocka_unit_test(test_map_ball_columns),      cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_ss3d_slab_closed_form), cmocka_unit_test(test_box_reproduces_tube),
+        cmocka_unit_test(test_shadowed_slab),         cmocka_unit_test(test_pp3d_ball_frame),
     };
     return cmocka_run_group_tests(tests, open_device, close_device);
 }

@@ -41,6 +41,12 @@ static void trace_run(const ppb_object *o, size_t v0, const double q[3], const d
     }
 }
 
+double ppb_pp3d_map_bytes(const ppb_object *o)
+{
+    /* Dc and Pc (8 doubles each), tau0, abar, depth per voxel */
+    return (double)o->nx * o->ny * o->nz * 19.0 * sizeof(double);
+}
+
 int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
 {
     memset(m, 0, sizeof *m);

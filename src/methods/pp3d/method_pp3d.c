@@ -5,9 +5,11 @@
 #include <math.h>
 
 #include "base/clock.h"
+#include "base/memory.h"
 
 /* What both refuse before any work: a refractive boundary (the paper's Fig. 9 and this march
- * are n = 1), a light or view that is no direction, a voxel or material out of range. */
+ * are n = 1), a light that is no unit vector, an empty grid, a material or a texture albedo
+ * out of range. */
 static int pp3d_check(const char *id, const ppb_object *o, ppb_err *err)
 {
     double nl = sqrt(o->light_dir[0] * o->light_dir[0] + o->light_dir[1] * o->light_dir[1] +
@@ -25,6 +27,11 @@ static int pp3d_check(const char *id, const ppb_object *o, ppb_err *err)
             !(o->material[k].albedo <= 1.0))
             return ppb_fail(err, "%s: %s: material %d: sigma_t %g, albedo %g out of range", o->name,
                             id, k, o->material[k].sigma_t, o->material[k].albedo);
+    size_t nvox = (size_t)o->nx * o->ny * o->nz;
+    for (size_t v = 0; o->albedo_tex && v < nvox; v++)
+        if (o->mat[v] && !(o->albedo_tex[v] >= 0.0f && o->albedo_tex[v] <= 1.0f))
+            return ppb_fail(err, "%s: %s: the albedo texture holds %g at voxel %zu (not in [0, 1])",
+                            o->name, id, (double)o->albedo_tex[v], v);
     return 0;
 }
 
@@ -37,9 +44,12 @@ static int run(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *
         return -1;
     ppb_pp3d_map map;
     ppb_pp3d_tables tab;
-    if (ppb_pp3d_map_build(o, &map, err))
+    double map_bytes = ppb_pp3d_map_bytes(o);
+    if (ppb_memory_check(map_bytes, cfg->memory_limit, out->method, "the light map", err) ||
+        ppb_pp3d_map_build(o, &map, err))
         return -1;
-    if (with_tables && ppb_pp3d_tables_build(o, &map, &cfg->pp, ctx->quiet, &tab, err)) {
+    if (with_tables && ppb_pp3d_tables_build(o, &map, &cfg->pp, cfg->memory_limit, map_bytes,
+                                             ctx->quiet, &tab, err)) {
         ppb_pp3d_map_free(&map);
         return -1;
     }

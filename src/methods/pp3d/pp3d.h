@@ -37,6 +37,8 @@ typedef struct ppb_pp3d_map {
     double *Dc, *Pc, *tau0, *abar, *depth;
 } ppb_pp3d_map;
 
+/* Bytes the map takes (estimated before it is built). */
+double ppb_pp3d_map_bytes(const ppb_object *o);
 int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err);
 void ppb_pp3d_map_free(ppb_pp3d_map *m);
 /* The trilinear interpolation of corner values c (c[cx + 2 cy + 4 cz]) at f in the unit cube. */
@@ -90,8 +92,12 @@ static inline double ppb_pp3d_angle_pos(double c, int nang)
 /* The optical distance where a march stops, as the tube's (march.c: d_cap). */
 #define PPB_PP3D_D_CAP 40.0
 
+/* Builds the tables; their size, known once the thickness nodes are planned, is checked
+ * against memory_limit ([run] memory_limit, GB; base/memory.h) with `held` bytes already
+ * held (the map) before they are allocated. */
 int ppb_pp3d_tables_build(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp_settings *pp,
-                          int quiet, ppb_pp3d_tables *t, ppb_err *err);
+                          double memory_limit, double held, int quiet, ppb_pp3d_tables *t,
+                          ppb_err *err);
 void ppb_pp3d_tables_free(ppb_pp3d_tables *t);
 
 /* The march of one object: every (patch face, bin, direction sample) ray and every pixel's ray.

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/memory.h"
 #include "base/progress.h"
 #include "kernels/ppb_conventions.h"
 
@@ -169,7 +170,8 @@ done:
 }
 
 int ppb_pp3d_tables_build(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp_settings *pp,
-                          int quiet, ppb_pp3d_tables *t, ppb_err *err)
+                          double memory_limit, double held, int quiet, ppb_pp3d_tables *t,
+                          ppb_err *err)
 {
     memset(t, 0, sizeof *t);
     t->nang = PPB_PP3D_NANG;
@@ -190,6 +192,21 @@ int ppb_pp3d_tables_build(const ppb_object *o, const ppb_pp3d_map *m, const ppb_
         t->ntau[it] = (nint < 1 ? 1 : nint) + 1;
         t->off[it] = total;
         total += (size_t)t->nalb * t->nang * t->ntau[it];
+    }
+    /* The tables, and a block's build: its slab solution (about 24 of M/2 x M/2 doubles,
+     * march_tables.h) and the A and E matrices. */
+    double n = pp->directions, ntmax = 0.0;
+    for (int it = 0; it < t->nthick; it++)
+        ntmax = t->ntau[it] > ntmax ? t->ntau[it] : ntmax;
+    double bytes = ((double)total + (double)t->nthick * t->nalb * t->nang + 24.0 * n * n +
+                    2.0 * n * (t->nang + ntmax)) *
+                   sizeof(double);
+    char detail[160];
+    snprintf(detail, sizeof detail, "%d thickness x %d albedo nodes x %d angles, the map %.3g GB",
+             t->nthick, t->nalb, t->nang, held / 1e9);
+    if (ppb_memory_check(bytes + held, memory_limit, "pp3d's tables", detail, err)) {
+        ppb_pp3d_tables_free(t);
+        return -1;
     }
     t->R = calloc(total ? total : 1, sizeof *t->R);
     t->Cb = calloc((size_t)(t->nthick ? t->nthick : 1) * t->nalb * t->nang, sizeof *t->Cb);
