@@ -409,7 +409,7 @@ static void test_pp3d_ball_frame(void **state)
     double t2 = ppb_now();
     double *img = calloc(256 * 256, sizeof *img);
     clock_t c0 = clock();
-    if (ppb_pp3d_image(&o, &m, &t, cfg.pp.step, img, &err))
+    if (ppb_pp3d_image(&o, &m, &t, 1, cfg.pp.step, img, &err))
         fail_msg("%s", err.msg);
     double t3 = ppb_now(), cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
     printf("pp3d, 64^3 ball, %d directions, %d thickness x %d albedo nodes: map %.2f s, tables "

@@ -241,14 +241,16 @@ int ppb_pp3d_camera_init(const ppb_object *o, ppb_pp3d_camera *c, ppb_err *err)
         umin = fmin(umin, dot3(p, c->right)), umax = fmax(umax, dot3(p, c->right));
         vmin = fmin(vmin, dot3(p, c->up)), vmax = fmax(vmax, dot3(p, c->up));
     }
-    c->u0 = umin, c->v1 = vmax;
-    c->du = (umax - umin) / o->img_w, c->dv = (vmax - vmin) / o->img_h;
+    /* Square pixels, the larger extent over its pixel count, the image centred. */
+    c->pixel = fmax((umax - umin) / o->img_w, (vmax - vmin) / o->img_h);
+    c->u0 = 0.5 * (umin + umax) - 0.5 * o->img_w * c->pixel;
+    c->v1 = 0.5 * (vmin + vmax) + 0.5 * o->img_h * c->pixel;
     return 0;
 }
 
-void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, int x, int y, double p[3])
+void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, double x, double y, double p[3])
 {
-    double u = c->u0 + (x + 0.5) * c->du, v = c->v1 - (y + 0.5) * c->dv;
+    double u = c->u0 + x * c->pixel, v = c->v1 - y * c->pixel;
     for (int k = 0; k < 3; k++)
         p[k] = c->centre[k] + u * c->right[k] + v * c->up[k];
 }
@@ -291,8 +293,10 @@ static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb
     }
 }
 
-/* The start of pixel (x, y)'s ray: beyond the grid box on the camera's side. */
-static void pixel_ray(const ppb_object *o, const ppb_pp3d_camera *cam, int x, int y, double p0[3])
+/* The start of the ray through image point (x, y) (pixel units from the top-left corner):
+ * beyond the grid box on the camera's side. */
+static void pixel_ray(const ppb_object *o, const ppb_pp3d_camera *cam, double x, double y,
+                      double p0[3])
 {
     double pix[3];
     ppb_pp3d_camera_pixel(cam, x, y, pix);
@@ -309,7 +313,7 @@ typedef struct render_job {
     const ppb_object_patches *p;
     const ppb_pp3d_map *m;
     const ppb_pp3d_tables *tab;
-    int nsamp, with_patches;
+    int nsamp, nsub, with_patches;
     double step;
     const size_t *face_off, *faces; /* patch q's faces: faces[face_off[q] .. face_off[q + 1]) */
     ppb_pp3d_camera cam;
@@ -328,12 +332,18 @@ static void render_item(render_job *j, int item)
                       (int)(j->faces[k] % 6), j->patch_rad + (size_t)item * nbins);
         return;
     }
-    int y = item - np;
+    /* A pixel: the mean of nsub x nsub rays at the centres of its sub-squares (the radiance
+     * averaged over the pixel's area, docs/methods.md). */
+    int y = item - np, ns = j->nsub;
     for (int x = 0; x < o->img_w; x++) {
-        double p0[3];
-        pixel_ray(o, &j->cam, x, y, p0);
-        j->img[(size_t)y * o->img_w + x] =
-            ppb_pp3d_ray(o, j->m, j->tab, j->step, p0, j->cam.to_cam, -1);
+        double acc = 0.0;
+        for (int a = 0; a < ns; a++)
+            for (int b = 0; b < ns; b++) {
+                double p0[3];
+                pixel_ray(o, &j->cam, x + (b + 0.5) / ns, y + (a + 0.5) / ns, p0);
+                acc += ppb_pp3d_ray(o, j->m, j->tab, j->step, p0, j->cam.to_cam, -1);
+            }
+        j->img[(size_t)y * o->img_w + x] = acc / (ns * ns);
     }
 }
 
@@ -410,14 +420,15 @@ static int patch_faces(const ppb_object *o, const ppb_object_patches *p, size_t 
 }
 
 static int render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
-                  const ppb_pp3d_tables *tab, int nsamp, double step, int quiet, const char *label,
-                  double *patch_rad, double *img, ppb_err *err)
+                  const ppb_pp3d_tables *tab, int nsamp, int nsub, double step, int quiet,
+                  const char *label, double *patch_rad, double *img, ppb_err *err)
 {
     render_job j = {.o = o,
                     .p = p,
                     .m = m,
                     .tab = tab,
                     .nsamp = nsamp,
+                    .nsub = nsub < 1 ? 1 : nsub,
                     .step = step,
                     .with_patches = p != NULL,
                     .patch_rad = patch_rad,
@@ -434,17 +445,17 @@ static int render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp
     return rc;
 }
 
-int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab, int nsub,
                    double step, double *img, ppb_err *err)
 {
-    return render(o, NULL, m, tab, 1, step, 1, "image", NULL, img, err);
+    return render(o, NULL, m, tab, 1, nsub, step, 1, "image", NULL, img, err);
 }
 
 int ppb_pp3d_render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
-                    const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
+                    const ppb_pp3d_tables *tab, int nsamp, int nsub, double step, int quiet,
                     ppb_object_result *out, ppb_err *err)
 {
-    if (render(o, p, m, tab, nsamp, step, quiet, out->method, out->patch_rad, out->img, err))
+    if (render(o, p, m, tab, nsamp, nsub, step, quiet, out->method, out->patch_rad, out->img, err))
         return -1;
     size_t n = (size_t)out->npatch * out->nbins, npix = (size_t)o->img_w * o->img_h, nneg = 0;
     double worst = 0.0;

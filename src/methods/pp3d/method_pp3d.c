@@ -53,8 +53,8 @@ static int run(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *
         ppb_pp3d_map_free(&map);
         return -1;
     }
-    int rc = ppb_pp3d_render(o, p, &map, with_tables ? &tab : NULL, cfg->samples_dir, cfg->pp.step,
-                             ctx->quiet, out, err);
+    int rc = ppb_pp3d_render(o, p, &map, with_tables ? &tab : NULL, cfg->samples_dir,
+                             cfg->samples_seg, cfg->pp.step, ctx->quiet, out, err);
     if (with_tables)
         ppb_pp3d_tables_free(&tab);
     ppb_pp3d_map_free(&map);

@@ -102,15 +102,16 @@ void ppb_pp3d_tables_free(ppb_pp3d_tables *t);
 
 /* The march of one object: every (patch face, bin, direction sample) ray and every pixel's ray.
  * tab NULL: ss3d (the direct beam's first scattering only). nsamp: direction samples per bin
- * axis (cfg samples_dir); step: the R march's step (pp.step). */
+ * axis (cfg samples_dir); nsub: rays per pixel axis (cfg samples_seg: a pixel is the mean over
+ * its area); step: the R march's step (pp.step). */
 int ppb_pp3d_render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp3d_map *m,
-                    const ppb_pp3d_tables *tab, int nsamp, double step, int quiet,
+                    const ppb_pp3d_tables *tab, int nsamp, int nsub, double step, int quiet,
                     ppb_object_result *out, ppb_err *err);
 
 /* The camera's image alone (a frame: what the paper times), img [img_w * img_h]. The march
  * runs on the CPUs online (at most PPB_PP3D_MAX_THREADS threads), patches and image rows
  * shared out one at a time; every sum is one thread's, so results do not depend on them. */
-int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
+int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab, int nsub,
                    double step, double *img, ppb_err *err);
 
 /* The radiance leaving the object at point p0 along w_out (unit), per unit E_perp, marched from
@@ -119,18 +120,19 @@ int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_ta
 double ppb_pp3d_ray(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
                     double step, const double p0[3], const double w_out[3], long start);
 
-/* The orthographic camera (docs/methods.md, "pp and ss in three dimensions"): to_cam =
- * -view_dir; right = normalise(y x to_cam) (z x to_cam when the view is along y); up =
- * to_cam x right. The image spans the projection of the grid box: u in [u0, u0 + img_w du] along
- * right, v in [v1 - img_h dv, v1] along up, pixel (x, y) row-major from the top left, its ray
- * through its centre. */
+/* The orthographic camera (docs/reference.md, Objects; kernels/ppb_object.h's on the object
+ * branch, the same numbers): to_cam = -view_dir; right = normalise(y x to_cam) (z x to_cam
+ * when |to_cam.y| > 0.999); up = to_cam x right. Square pixels of edge `pixel`, the larger of
+ * the grid box's extents along right and up over img_w and img_h, the image centred on the box's
+ * projection: its top-left corner at (u0, v1) along (right, up) from the box's centre. */
 typedef struct ppb_pp3d_camera {
     double to_cam[3], right[3], up[3], centre[3];
-    double u0, v1, du, dv;
+    double u0, v1, pixel;
 } ppb_pp3d_camera;
 
 int ppb_pp3d_camera_init(const ppb_object *o, ppb_pp3d_camera *c, ppb_err *err);
-/* The centre of pixel (x, y) on the plane through the grid box's centre normal to the view. */
-void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, int x, int y, double p[3]);
+/* Image point (x, y), in pixels from the top-left corner (a pixel's centre at + 0.5), on the
+ * plane through the grid box's centre across the view. */
+void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, double x, double y, double p[3]);
 
 #endif
