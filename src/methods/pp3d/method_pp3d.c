@@ -62,14 +62,14 @@ static int run(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *
     return rc;
 }
 
-static int run_ss3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
-                    ppb_object_result *out, ppb_err *err)
+int ppb_pp3d_run_ss3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
+                      ppb_object_result *out, ppb_err *err)
 {
     return run(ctx, o, p, out, 0, err);
 }
 
-static int run_pp3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
-                    ppb_object_result *out, ppb_err *err)
+int ppb_pp3d_run_pp3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
+                      ppb_object_result *out, ppb_err *err)
 {
     return run(ctx, o, p, out, 1, err);
 }
@@ -77,11 +77,11 @@ static int run_pp3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patc
 const ppb_object_method ppb_object_method_ss3d = {
     .id = "ss3d",
     .summary = "single scattering marched through the voxels, exact per crossing (paper Eq. 5)",
-    .run = run_ss3d,
+    .run = ppb_pp3d_run_ss3d,
 };
 
 const ppb_object_method ppb_object_method_pp3d = {
     .id = "pp3d",
     .summary = "the paper's plane-parallel ray marcher on the object (Sec. 3.4, Eq. 13-15)",
-    .run = run_pp3d,
+    .run = ppb_pp3d_run_pp3d,
 };

@@ -15,7 +15,13 @@
 
 #include <math.h>
 
+/* The two methods as registry entries, and their run functions for a registry that lists
+ * entries by value (methods/object_method.h's ppb_object_method_fn). */
 extern const ppb_object_method ppb_object_method_ss3d, ppb_object_method_pp3d;
+int ppb_pp3d_run_ss3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
+                      ppb_object_result *out, ppb_err *err);
+int ppb_pp3d_run_pp3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_patches *p,
+                      ppb_object_result *out, ppb_err *err);
 
 /* The optical-depth map of one light (paper Sec. 3.4, pre-process steps 2-3 and 5), per medium
  * voxel v of the object (outside voxels hold zeros):
