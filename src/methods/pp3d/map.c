@@ -3,6 +3,7 @@
  * sums the same segments in the light's order. */
 #include "methods/pp3d/pp3d.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -43,8 +44,31 @@ static void trace_run(const ppb_object *o, size_t v0, const double q[3], const d
 
 double ppb_pp3d_map_bytes(const ppb_object *o)
 {
-    /* Dc and Pc (8 doubles each), tau0, abar, depth per voxel */
-    return (double)o->nx * o->ny * o->nz * 19.0 * sizeof(double);
+    /* Dc and Pc (8 doubles each), tau0, abar, depth and a flag per voxel */
+    return (double)o->nx * o->ny * o->nz * (19.0 * sizeof(double) + 1.0);
+}
+
+/* Whether eight corner values are those of one linear function (the trilinear form's cross
+ * terms vanish): then the voxel's light paths enter through one plane, as far as its corners
+ * tell, and D is linear inside. */
+static int corners_linear(const double c[8])
+{
+    double big = 0.0;
+    for (int k = 0; k < 8; k++)
+        big = fmax(big, fabs(c[k]));
+    double tol = 1e-9 * (1.0 + big);
+    double cxy = c[3] - c[2] - c[1] + c[0], cxz = c[5] - c[4] - c[1] + c[0];
+    double cyz = c[6] - c[4] - c[2] + c[0];
+    double cxyz = c[7] - c[6] - c[5] + c[4] - c[3] + c[2] + c[1] - c[0];
+    return fabs(cxy) <= tol && fabs(cxz) <= tol && fabs(cyz) <= tol && fabs(cxyz) <= tol;
+}
+
+double ppb_pp3d_trace(const ppb_object *o, size_t v, const double x[3], double *pre)
+{
+    double back[3] = {-o->light_dir[0], -o->light_dir[1], -o->light_dir[2]};
+    double run, alb, len;
+    trace_run(o, v, x, back, &run, &alb, &len, pre);
+    return run + *pre;
 }
 
 int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
@@ -57,7 +81,8 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
     m->tau0 = calloc(nvox, sizeof *m->tau0);
     m->abar = calloc(nvox, sizeof *m->abar);
     m->depth = calloc(nvox, sizeof *m->depth);
-    if (!m->Dc || !m->Pc || !m->tau0 || !m->abar || !m->depth) {
+    m->kinked = calloc(nvox, sizeof *m->kinked);
+    if (!m->Dc || !m->Pc || !m->tau0 || !m->abar || !m->depth || !m->kinked) {
         ppb_pp3d_map_free(m);
         return ppb_fail(err, "%s: out of memory for the light map of %zu voxels", o->name, nvox);
     }
@@ -82,6 +107,7 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
                     m->Dc[8 * v + c] = run + pre;
                     m->Pc[8 * v + c] = pre;
                 }
+                m->kinked[v] = !corners_linear(m->Dc + 8 * v) || !corners_linear(m->Pc + 8 * v);
                 double q[3] = {(i + 0.5) * h, (j + 0.5) * h, (k + 0.5) * h};
                 double run_b, alb_b, len_b, pre, run_f, alb_f, len_f, after;
                 trace_run(o, v, q, back, &run_b, &alb_b, &len_b, &pre);
@@ -95,7 +121,7 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
 
 void ppb_pp3d_map_free(ppb_pp3d_map *m)
 {
-    free(m->Dc), free(m->Pc), free(m->tau0), free(m->abar), free(m->depth);
+    free(m->kinked), free(m->Dc), free(m->Pc), free(m->tau0), free(m->abar), free(m->depth);
     memset(m, 0, sizeof *m);
 }
 

@@ -100,6 +100,10 @@ static double beam_step(double C, double sigma_t, double h, double e_a, double z
 /* The map at distance l of a crossing: D and Dpre, by lookup or, on a crossing where both are
  * linear, from its ends. */
 typedef struct cross_map {
+    const ppb_object *o;
+    size_t v;
+    int exact;             /* a kinked voxel: D traced at every point */
+    double xa[3];          /* the crossing's start */
     const double *Dc, *Pc; /* the voxel's corners */
     double fa[3], fd[3];   /* the crossing's start in the voxel's unit cube, and dir / h */
     double la, len;
@@ -113,6 +117,12 @@ static double cross_depth(const cross_map *c, double l, double *pre)
         double f = (l - c->la) / c->len;
         *pre = c->Pa + f * (c->Pb - c->Pa);
         return c->Da + f * (c->Db - c->Da);
+    }
+    if (c->exact) {
+        double x[3];
+        for (int a = 0; a < 3; a++)
+            x[a] = c->xa[a] + (l - c->la) * c->fd[a] * c->o->voxel;
+        return ppb_pp3d_trace(c->o, c->v, x, pre);
     }
     double f[3];
     for (int a = 0; a < 3; a++) {
@@ -140,20 +150,28 @@ static double crossing(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3
     *d = d0 + sigma * len;
     if (!(len > 0.0) || alpha <= 0.0)
         return 0.0;
-    cross_map c = {.Dc = m->Dc + 8 * v, .Pc = m->Pc + 8 * v, .la = la, .len = len};
+    cross_map c = {.o = o,
+                   .v = v,
+                   .exact = m->kinked[v],
+                   .Dc = m->Dc + 8 * v,
+                   .Pc = m->Pc + 8 * v,
+                   .la = la,
+                   .len = len};
     size_t s = v;
     int idx[3];
     idx[0] = (int)(s % (size_t)o->nx), s /= (size_t)o->nx;
     idx[1] = (int)(s % (size_t)o->ny), idx[2] = (int)(s / (size_t)o->ny);
     for (int a = 0; a < 3; a++) {
-        c.fa[a] = (p0[a] + la * dir[a]) / o->voxel - idx[a];
+        c.xa[a] = p0[a] + la * dir[a];
+        c.fa[a] = c.xa[a] / o->voxel - idx[a];
         c.fd[a] = dir[a] / o->voxel;
     }
     double Pm, Dm = cross_depth(&c, la + 0.5 * len, &Pm);
     c.Da = cross_depth(&c, la, &c.Pa);
     c.Db = cross_depth(&c, lb, &c.Pb);
     double tol = 1e-12 * (1.0 + c.Da + c.Db);
-    c.linear = fabs(Dm - 0.5 * (c.Da + c.Db)) <= tol && fabs(Pm - 0.5 * (c.Pa + c.Pb)) <= tol;
+    c.linear =
+        !c.exact && fabs(Dm - 0.5 * (c.Da + c.Db)) <= tol && fabs(Pm - 0.5 * (c.Pa + c.Pb)) <= tol;
     int ia = 0, it = 0;
     double fa = 0.0, cb = 0.0, tau0 = 0.0;
     if (tab) {
@@ -256,9 +274,10 @@ void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, double x, double y, double 
 }
 
 /* One boundary face's rays, added into its patch's bins (row of nbins): face f = 2 axis +
- * (side > 0) of voxel v, from its centre, nsamp x nsamp directions per bin uniform in
- * (sin^2 theta, phi) (the tube's stratified samples, reference: Bins, with phi over [0, 2 pi)
- * in the patch's frame). A patch's bin is the mean over its faces and samples. */
+ * (side > 0) of voxel v, nsamp x nsamp directions per bin uniform in (sin^2 theta, phi) (the
+ * tube's stratified samples, reference: Bins, with phi over [0, 2 pi) in the patch's frame),
+ * each from its own point of the face. A patch's bin is the mean over its faces and samples:
+ * the radiance averaged over the patch's area and the bin (docs/reference.md, Objects). */
 static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb_pp3d_map *m,
                       const ppb_pp3d_tables *tab, int nsamp, double step, size_t v, int f,
                       double *row)
@@ -287,7 +306,12 @@ static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb
                 double w[3];
                 for (int a = 0; a < 3; a++)
                     w[a] = ct * nrm[a] + st * (cos(phi) * pa->t[a] + sin(phi) * b[a]);
-                acc += ppb_pp3d_ray(o, m, tab, step, c, w, (long)v);
+                /* Sample (sa, sb) at sub-square (sa, (sa + sb) mod n) of the face's n x n
+                 * grid (a Latin square): the face's area is sampled at no extra rays. */
+                double q[3] = {c[0], c[1], c[2]};
+                q[(axis + 1) % 3] += ((sa + 0.5) / nsamp - 0.5) * h;
+                q[(axis + 2) % 3] += (((sa + sb) % nsamp + 0.5) / nsamp - 0.5) * h;
+                acc += ppb_pp3d_ray(o, m, tab, step, q, w, (long)v);
             }
         row[bin] += wgt * acc;
     }

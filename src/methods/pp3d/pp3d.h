@@ -37,16 +37,22 @@ int ppb_pp3d_run_pp3d(ppb_run_ctx *ctx, const ppb_object *o, const ppb_object_pa
  * - abar[v]: the albedo averaged over length along the light from that entry to v's centre
  *   (paper Sec. 3.3);
  * - depth[v]: the geometric distance from that entry to v's centre (the furthest-point buffer's
- *   depth seen from the light). */
+ *   depth seen from the light);
+ * - kinked[v]: 1 when its corners' D or Dpre are not one linear function: light paths through
+ *   v enter through different planes (a staircase edge or a shadow edge crosses v), where the
+ *   interpolation would smooth a kink; the march traces D exactly there (ppb_pp3d_trace). */
 typedef struct ppb_pp3d_map {
     int nx, ny, nz;
     double *Dc, *Pc, *tau0, *abar, *depth;
+    unsigned char *kinked;
 } ppb_pp3d_map;
 
 /* Bytes the map takes (estimated before it is built). */
 double ppb_pp3d_map_bytes(const ppb_object *o);
 int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err);
 void ppb_pp3d_map_free(ppb_pp3d_map *m);
+/* D (returned) and Dpre at point x of voxel v, traced exactly through the voxels. */
+double ppb_pp3d_trace(const ppb_object *o, size_t v, const double x[3], double *pre);
 /* The trilinear interpolation of corner values c (c[cx + 2 cy + 4 cz]) at f in the unit cube. */
 double ppb_pp3d_trilinear(const double c[8], const double f[3]);
 /* D and Dpre at point x inside voxel v (trilinear from its inside-limit corners); pre may be

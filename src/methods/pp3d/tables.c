@@ -95,7 +95,8 @@ static void plan_albedo(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp
     for (size_t v = 0; v < nvox; v++)
         if (o->mat[v])
             lo = fmin(lo, m->abar[v]), hi = fmax(hi, m->abar[v]);
-    if (!(hi > lo)) {
+    /* One albedo: abar = (sum alpha l) / (sum l) is that albedo to rounding, one node. */
+    if (!(hi - lo > 1e-12 * fabs(hi))) {
         t->nalb = 1, t->alb0 = isfinite(lo) ? lo : 0.0, t->alb_h = 1.0;
         return;
     }
