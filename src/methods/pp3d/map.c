@@ -63,6 +63,34 @@ static int corners_linear(const double c[8])
     return fabs(cxy) <= tol && fabs(cxz) <= tol && fabs(cyz) <= tol && fabs(cxyz) <= tol;
 }
 
+/* Whether D and Dpre traced at the 19 other points of the voxel's 3 x 3 x 3 lattice (edge and
+ * face midpoints, centre; nudged inside as the corners) equal the corners' interpolation: a
+ * staircase edge whose light paths cross the voxel between its corners shows there. */
+static int lattice_linear(const ppb_object *o, const ppb_pp3d_map *m, size_t v, const double *back)
+{
+    size_t s = v;
+    int idx[3];
+    idx[0] = (int)(s % (size_t)o->nx), s /= (size_t)o->nx;
+    idx[1] = (int)(s % (size_t)o->ny), idx[2] = (int)(s / (size_t)o->ny);
+    const double e = 1e-9, fr[3] = {e, 0.5, 1.0 - e};
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            for (int c = 0; c < 3; c++) {
+                if (a != 1 && b != 1 && c != 1)
+                    continue; /* a corner */
+                double f[3] = {fr[a], fr[b], fr[c]}, q[3], run, alb, len, pre;
+                for (int k = 0; k < 3; k++)
+                    q[k] = (idx[k] + f[k]) * o->voxel;
+                trace_run(o, v, q, back, &run, &alb, &len, &pre);
+                double D = ppb_pp3d_trilinear(m->Dc + 8 * v, f);
+                double P = ppb_pp3d_trilinear(m->Pc + 8 * v, f);
+                double tol = 1e-9 * (1.0 + fabs(D));
+                if (fabs(run + pre - D) > tol || fabs(pre - P) > tol)
+                    return 0;
+            }
+    return 1;
+}
+
 double ppb_pp3d_trace(const ppb_object *o, size_t v, const double x[3], double *pre)
 {
     double back[3] = {-o->light_dir[0], -o->light_dir[1], -o->light_dir[2]};
@@ -107,7 +135,8 @@ int ppb_pp3d_map_build(const ppb_object *o, ppb_pp3d_map *m, ppb_err *err)
                     m->Dc[8 * v + c] = run + pre;
                     m->Pc[8 * v + c] = pre;
                 }
-                m->kinked[v] = !corners_linear(m->Dc + 8 * v) || !corners_linear(m->Pc + 8 * v);
+                m->kinked[v] = !corners_linear(m->Dc + 8 * v) || !corners_linear(m->Pc + 8 * v) ||
+                               !lattice_linear(o, m, v, back);
                 double q[3] = {(i + 0.5) * h, (j + 0.5) * h, (k + 0.5) * h};
                 double run_b, alb_b, len_b, pre, run_f, alb_f, len_f, after;
                 trace_run(o, v, q, back, &run_b, &alb_b, &len_b, &pre);
