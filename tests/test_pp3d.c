@@ -150,6 +150,40 @@ static double ss_slab(double t0, double alpha, double g, const double wl[3], con
     return alpha * p * mu0 / (mu0 - mu) * (exp(-t0 / mu0) - exp(-t0 / mu));
 }
 
+/* The bin average over o's direction samples (object.h's bins, uniform in sin^2 theta and phi)
+ * of f at patch pa's frame. */
+static double bin_average(const ppb_object *o, const ppb_object_patch *pa, int bin, int ns,
+                          double (*f)(const double w[3], void *arg), void *arg)
+{
+    double b[3] = {pa->n[1] * pa->t[2] - pa->n[2] * pa->t[1],
+                   pa->n[2] * pa->t[0] - pa->n[0] * pa->t[2],
+                   pa->n[0] * pa->t[1] - pa->n[1] * pa->t[0]};
+    double sum = 0.0;
+    for (int sa = 0; sa < ns; sa++)
+        for (int sb = 0; sb < ns; sb++) {
+            double s2 = (bin / o->nphi + (sa + 0.5) / ns) / o->ntheta;
+            double phi = (bin % o->nphi + (sb + 0.5) / ns) * 2.0 * PPB_PI / o->nphi;
+            double w[3];
+            for (int k = 0; k < 3; k++)
+                w[k] =
+                    sqrt(1.0 - s2) * pa->n[k] + sqrt(s2) * (cos(phi) * pa->t[k] + sin(phi) * b[k]);
+            sum += f(w, arg) / (ns * ns);
+        }
+    return sum;
+}
+
+/* ss_slab of a 4 optical-depth slab of albedo 0.8 for the object's light and g. */
+typedef struct slab_arg {
+    const ppb_object *o;
+    int top;
+} slab_arg;
+
+static double slab_ss(const double w[3], void *arg)
+{
+    const slab_arg *a = arg;
+    return ss_slab(4.0, 0.8, a->o->g, a->o->light_dir, w, a->top);
+}
+
 /* ss3d in the middle of a 44 x 2 x 44 mfp box against the slab's closed form, averaged over the
  * bins' direction samples (uniform in sin^2 theta and phi over [0, 2 pi), object.h), at normal
  * and oblique light (in the x-y plane: D stays linear in every voxel the middle's rays cross, so
@@ -174,23 +208,10 @@ static void test_ss3d_slab_closed_form(void **state)
         for (int top = 0; top < 2; top++) {
             double c3[3] = {11.0, top ? 2.0 : 0.0, 11.0};
             int q = patch_at(&p, 1, top ? 1 : -1, c3);
-            const ppb_object_patch *pa = &p.patch[q];
-            double b[3] = {pa->n[1] * pa->t[2] - pa->n[2] * pa->t[1],
-                           pa->n[2] * pa->t[0] - pa->n[0] * pa->t[2],
-                           pa->n[0] * pa->t[1] - pa->n[1] * pa->t[0]};
+            slab_arg sarg = {.o = &o, .top = top};
             double worst = 0.0;
             for (int bin = 0; bin < o.ntheta * o.nphi; bin++) {
-                double ref = 0.0;
-                for (int sa = 0; sa < ns; sa++)
-                    for (int sb = 0; sb < ns; sb++) {
-                        double s2 = (bin / o.nphi + (sa + 0.5) / ns) / o.ntheta;
-                        double phi = (bin % o.nphi + (sb + 0.5) / ns) * 2.0 * PPB_PI / o.nphi;
-                        double w[3];
-                        for (int k = 0; k < 3; k++)
-                            w[k] = sqrt(1.0 - s2) * pa->n[k] +
-                                   sqrt(s2) * (cos(phi) * pa->t[k] + sin(phi) * b[k]);
-                        ref += ss_slab(4.0, 0.8, o.g, o.light_dir, w, top) / (ns * ns);
-                    }
+                double ref = bin_average(&o, &p.patch[q], bin, ns, slab_ss, &sarg);
                 double v = r.patch_rad[(size_t)q * o.ntheta * o.nphi + bin];
                 assert_rel(v, ref, 1e-8);
                 worst = fmax(worst, fabs(v - ref) / ref);
@@ -266,28 +287,6 @@ static void test_box_reproduces_tube(void **state)
     free(o.mat);
     for (int i = 0; i < 2; i++)
         ppb_result_free(&tube[i]);
-}
-
-/* The bin average over o's direction samples (object.h's bins, uniform in sin^2 theta and phi)
- * of f at patch pa's frame. */
-static double bin_average(const ppb_object *o, const ppb_object_patch *pa, int bin, int ns,
-                          double (*f)(const double w[3], void *arg), void *arg)
-{
-    double b[3] = {pa->n[1] * pa->t[2] - pa->n[2] * pa->t[1],
-                   pa->n[2] * pa->t[0] - pa->n[0] * pa->t[2],
-                   pa->n[0] * pa->t[1] - pa->n[1] * pa->t[0]};
-    double sum = 0.0;
-    for (int sa = 0; sa < ns; sa++)
-        for (int sb = 0; sb < ns; sb++) {
-            double s2 = (bin / o->nphi + (sa + 0.5) / ns) / o->ntheta;
-            double phi = (bin % o->nphi + (sb + 0.5) / ns) * 2.0 * PPB_PI / o->nphi;
-            double w[3];
-            for (int k = 0; k < 3; k++)
-                w[k] =
-                    sqrt(1.0 - s2) * pa->n[k] + sqrt(s2) * (cos(phi) * pa->t[k] + sin(phi) * b[k]);
-            sum += f(w, arg) / (ns * ns);
-        }
-    return sum;
 }
 
 /* Two slabs, 28 x 28 mfp, sigma_t 2, lit from the top: the upper one 0.5 mfp thick (1 optical),
