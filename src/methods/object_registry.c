@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "methods/mc3d/method_mc3d.h"
+#include "methods/pp3d/pp3d.h"
 
 static const ppb_object_method methods[] = {
     {.id = "mc3d",
@@ -13,7 +14,13 @@ static const ppb_object_method methods[] = {
      .summary = "photon Monte Carlo through the voxel grid (reference); mc3d1 its "
                 "once-scattered part",
      .run = ppb_object_method_mc3d},
-    /* The plane-parallel object methods (ss3d, pp3d) are added here at merge. */
+    {.id = "ss3d",
+     .summary = "single scattering by ray marching through the light's optical-depth map (exact)",
+     .run = ppb_pp3d_run_ss3d},
+    {.id = "pp3d",
+     .summary = "the paper's method on an object: the march with the local slabs' R tables "
+                "(Sec. 3.4-3.5)",
+     .run = ppb_pp3d_run_pp3d},
 };
 
 #define NMETHODS ((int)(sizeof methods / sizeof methods[0]))
