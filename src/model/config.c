@@ -189,6 +189,9 @@ static const key_def keys[] = {
     {"rte2d", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.delta_m), 0, 0, "on", on_off_names,
      "rte2d: delta-M scaling of the forward peak the direction cells cannot resolve, with the "
      "single-scattering correction of the exit radiance"},
+    {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
+     "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
+     "truncates nothing"},
     {"output", "dir", K_PATH, PPB_NOT_MC_KEY, F(out_dir), 0, 0, "", NULL,
      "output directory; default results/<name>"},
     {"run", "memory_limit", K_REAL, PPB_NOT_MC_KEY, F(memory_limit), 0, 1e6, "0", NULL,
