@@ -186,10 +186,10 @@ static int perf_case(ppb_run_ctx *ctx, const ppb_method *mc, const char *name, l
         /* The reference's noise falls as 1/sqrt(photons): to e in tmc (noise / e)^2. */
         double tmc_e = mc ? tmc * (noise / e) * (noise / e) : NAN;
         fprintf(out,
-                "%-31s %5d x %3d %6.2f %7.3f%% %7.3f%% %7.3f%%  %6.1f %6.1f  %8.3g %6.2f%% "
-                "%10.4g %8.3g\n",
-                name, st.nodes, st.cells, t0, 100 * e, 100 * ex, 100 * ew, tx, tw,
-                mc ? (double)photons / tmc : NAN, 100 * noise, tmc_e, tmc_e / t0);
+                "%-31s %5d x %3d %6.2f %3d %5.2f %5.2f %7.3f%% %7.3f%% %7.3f%%  %6.1f %6.1f  "
+                "%8.3g %6.2f%% %10.4g %8.3g\n",
+                name, st.nodes, st.cells, t0, st.sweeps, st.t_sweeps, st.t_exit, 100 * e, 100 * ex,
+                100 * ew, tx, tw, mc ? (double)photons / tmc : NAN, 100 * noise, tmc_e, tmc_e / t0);
     }
     if (ok0)
         ppb_result_free(&r0);
@@ -244,15 +244,16 @@ int ppb_perf_rte2d(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
         photons = atoll(env);
     const ppb_method *mc = reference_method();
     fprintf(out,
-            "Per study case: rte2d converged at the case's settings (nodes x cells, seconds); "
-            "its estimated\ndistance to its own limit e (the worst summary cell's rms_rel) = "
-            "e_grid + e_dir, each 2 x\nthe change when the grid and track spacing are halved "
-            "(t_grid: that run's seconds) or the\ndirection cells doubled (t_dir) (Richardson, "
-            "first order); the Monte Carlo's rate at %lld\nphotons on the same case, its noise "
-            "(the worst cell) and its time to noise e: t (noise / e)^2.\n",
+            "Per study case: rte2d converged at the case's settings (nodes x cells, seconds, its "
+            "sweeps and\ntheir seconds, the exit march's seconds); its estimated distance to "
+            "its own limit e (the\nworst summary cell's rms_rel) = e_grid + e_dir, each 2 x the "
+            "change when the grid and track\nspacing are halved (t_grid: that run's seconds) or "
+            "the direction cells doubled (t_dir)\n(Richardson, first order); the Monte Carlo's "
+            "rate at %lld photons on the same case, its\nnoise (the worst cell) and its time to "
+            "noise e: t (noise / e)^2.\n",
             photons);
-    fprintf(out, "%-31s %11s %6s %8s %8s %8s  %6s %6s  %8s %7s %10s %8s\n", "case", "nodes x cel",
-            "s", "e", "e_grid", "e_dir", "t_grid", "t_dir", "mc ph/s", "noise", "mc s to e",
-            "mc/rte2d");
+    fprintf(out, "%-31s %11s %6s %3s %5s %5s %8s %8s %8s  %6s %6s  %8s %7s %10s %8s\n", "case",
+            "nodes x cel", "s", "swp", "t_swp", "t_ext", "e", "e_grid", "e_dir", "t_grid", "t_dir",
+            "mc ph/s", "noise", "mc s to e", "mc/rte2d");
     return each_case(ctx, mc, photons, out, err);
 }
