@@ -15,8 +15,10 @@
 #   above 1e-3 of the surface's largest), no chi2 (se 0).
 BEGIN {
     FS = ",";
-    if (m == "") m = "rte2d";
-    if (ref == "") ref = "mc";
+    if (m == "" || ref == "") {
+        print "chi2_radiance: give the method and the reference: -v m=ID -v ref=ID" > "/dev/stderr";
+        exit 2;
+    }
 }
 FNR == 1 { nfile++; next }
 {

@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "base/clock.h"
-#include "methods/registry.h"
 #include "methods/rte2d/method_rte2d.h"
 
 /* Photons of the reference's timed run per case: its noise at 4e6 is 7-30 % per summary cell,
@@ -80,15 +79,6 @@ static double worst_noise(const ppb_result *r)
     }
     free(pts);
     return worst;
-}
-
-/* The registry's Monte Carlo (ppb_method.reference == 1), found without naming it. */
-static const ppb_method *reference_method(void)
-{
-    for (int i = 0; i < ppb_method_count(); i++)
-        if (ppb_method_at(i)->reference == 1)
-            return ppb_method_at(i);
-    return NULL;
 }
 
 /* The reference on cfg's scene with photons traced (no cache: ctx->ref_cache off for the run), wall
@@ -242,7 +232,7 @@ int ppb_perf_rte2d(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
     const char *env = getenv("PPBENCH_PERF_MC_PHOTONS");
     if (env && atoll(env) > 0)
         photons = atoll(env);
-    const ppb_method *mc = reference_method();
+    const ppb_method *mc = ctx->reference; /* set by `ppbench perf` */
     fprintf(out,
             "Per study case: rte2d converged at the case's settings (nodes x cells, seconds, its "
             "sweeps and\ntheir seconds, the exit march's seconds); its estimated distance to "
