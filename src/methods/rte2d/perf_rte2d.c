@@ -8,9 +8,9 @@
 #include "base/clock.h"
 #include "methods/rte2d/method_rte2d.h"
 
-/* Photons of the reference's timed run per case: its noise at 4e6 is 7-30 % per summary cell,
- * far above any accuracy it is scaled to, so its 1/sqrt(photons) law is what is extrapolated
- * (independent batches: reference: Metrics); $PPBENCH_PERF_MC_PHOTONS overrides it. */
+/* Photons of the reference's timed run per case: its noise there (8-14 % at the worst summary
+ * cell) is far above any accuracy it is scaled to, so what is extrapolated is its 1/sqrt(photons)
+ * law (independent batches: reference: Metrics); $PPBENCH_PERF_MC_PHOTONS overrides it. */
 #define PERF_RTE_MC_PHOTONS 4000000LL
 
 /* The tree configs/ is in: $PPBENCH_SOURCE, else the build's source directory. */
