@@ -192,6 +192,9 @@ static const key_def keys[] = {
     {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
      "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
      "truncates nothing"},
+    {"rte2d", "graded_bins", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.graded), 0, 0, "on", on_off_names,
+     "rte2d: the bins next to the face's tangent plane averaged on samples graded toward it "
+     "(Gauss points), off: the midpoints every marcher uses"},
     {"output", "dir", K_PATH, PPB_NOT_MC_KEY, F(out_dir), 0, 0, "", NULL,
      "output directory; default results/<name>"},
     {"run", "memory_limit", K_REAL, PPB_NOT_MC_KEY, F(memory_limit), 0, 1e6, "0", NULL,
