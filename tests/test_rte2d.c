@@ -263,7 +263,8 @@ static void test_slab_matches_ppslab_n14(void **state)
  * n = 1.4 (g = 0, normal light, 48 cells), against ppslab's eigen solution (the independent
  * solver; the same discrete ordinates) on 64 x 64 midpoints per bin (that error down to about
  * 1.5e-4), the graded 4 x 4 samples must match that row to the 1e-3 slab_matches_ppslab holds
- * every bin to, and the midpoint 4 x 4 must not (the error this is for; measured below). */
+ * every bin to, and the midpoint 4 x 4 must not (the error this is for; measured: midpoints
+ * 1.43e-2, graded 7.6e-4, the latter the cells' own difference to ppslab elsewhere). */
 static void test_graded_last_row(void **state)
 {
     (void)state;
