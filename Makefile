@@ -120,6 +120,12 @@ test-newcomer:
 	@mkdir -p $(BUILD)/tmp
 	@PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp timeout 900 bash tests/test_newcomer.sh
 
+# scripts/chi2_radiance.awk (a method's bins against mc's, chi-square per bin) on hand-worked files.
+.PHONY: test-chi2
+test: test-chi2
+test-chi2:
+	@bash tests/test_chi2_radiance.sh
+
 # The layer order is src/LAYERS; tests/test_layers.sh plants one violation of each rule.
 layers:
 	@bash scripts/check_layers.sh

@@ -24,6 +24,10 @@ int ppb_perf_all(ppb_run_ctx *ctx, FILE *out, ppb_err *err)
         ctx->cfg = &defaults;
     }
     setvbuf(out, NULL, _IOLBF, 0);
+    /* The reference method, for benchmarks that put a method's cost beside its. */
+    for (int i = 0; i < ppb_method_count(); i++)
+        if (ppb_method_at(i)->reference == 1)
+            ctx->reference = ppb_method_at(i);
     /* $PPBENCH_PERF_ONLY=ID runs method ID's benchmark alone (paired timing runs of two
      * builds). */
     const char *only = getenv("PPBENCH_PERF_ONLY");

@@ -45,7 +45,11 @@ typedef struct ppb_run_ctx {
     const ppb_result *prior;
     int nprior;
     const struct ppb_method *self; /* the method running, set by the runner */
-    const char *ref_cache;         /* --ref-cache DIR: mc's tallies reused from there */
+    /* The Monte Carlo (the registry's method with reference == 1), set by `ppbench perf` for
+     * the benchmarks that time a method against it (a slice cannot reach the registry); NULL
+     * elsewhere. */
+    const struct ppb_method *reference;
+    const char *ref_cache; /* --ref-cache DIR: mc's tallies reused from there */
     /* The reference's file in the cache or the shipped layer (mc_cache.h), set by mc: the one
      * it was loaded from or stored into; "" when none (provenance.txt's mc.reference). */
     char mc_reference[4096 + 160];

@@ -193,6 +193,12 @@ static const key_def keys[] = {
     {"rte2d", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.delta_m), 0, 0, "on", on_off_names,
      "rte2d: delta-M scaling of the forward peak the direction cells cannot resolve, with the "
      "single-scattering correction of the exit radiance"},
+    {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
+     "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
+     "truncates nothing"},
+    {"rte2d", "graded_bins", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.graded), 0, 0, "on", on_off_names,
+     "rte2d: the bins next to the face's tangent plane averaged on samples graded toward it "
+     "(Gauss points), off: the midpoints every marcher uses"},
     /* [object]: `ppbench object` only (docs/reference.md, Objects); the tube's Monte Carlo
      * never reads them, so none is part of its reference cache's key. */
     {"object", "shape", K_ENUM, PPB_NOT_MC_KEY, F(object.shape), 0, 0, "box", shape_names,

@@ -3,7 +3,8 @@
  * One refinement of Eq. 5, I_n = K I_(n-1) + I_0, is a sweep of every direction cell's tracks
  * through the flat-source regions (ppb_rte_moc, below: conservative by construction). The exit
  * radiance is a march from every segment point in every direction sample of every bin
- * (ppb_rte_exit), as `pp` averages its bins (reference: Bins), along q = p - l w:
+ * (ppb_rte_exit), as `pp` averages its bins (reference: Bins; the samples and their weights the
+ * host's, the last theta row graded toward the tangent plane), along q = p - l w:
  *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
  * where J is the converged scattered-light source per unit scattering coefficient (bilinear in
  * the nodes, each node its dual region's average, rte2d_params.h) and C E the direct beam's
@@ -203,7 +204,6 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
                            __global const double *src, __global double *out,
                            __global const double *rad, __global const double *bnd)
 {
-    (void)dirs;
     int nbins = ppb_bin_count(P.ntheta, P.nphi), seg, bin;
     int surf = ppb_exit_cell((int)get_global_id(0), P.row0, nbins, P.offset, P.nseg, &seg, &bin);
     if (surf < 0)
@@ -215,6 +215,10 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
         double px, py, v[3];
         int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
                                   P.nphi, k, &px, &py, v);
+        /* The host's sample of that index and its weight (method_rte2d.c, rte_bin_sample: the
+         * last theta row graded toward the tangent plane). */
+        v[0] = dirs[4 * dir], v[1] = dirs[4 * dir + 1], v[2] = dirs[4 * dir + 2];
+        double wk = dirs[4 * dir + 3];
         if (P.med.n > 1.0) {
             /* Air-side sample w = v: inside along Snell's direction, (1 - F) / n^2 times the
              * inside radiance (the n^2 law, reference: Medium). */
@@ -224,13 +228,13 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
             ppb_beam_phases(P.ss_g, P.sin_theta_l, P.cos_theta_l, v[0], v[1], cb);
             for (int c = 0; c < 4; c++)
                 cb[c] *= P.ss_w;
-            sum +=
-                wt * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py, v[0], v[1]);
+            sum += wk * wt *
+                   rte_ray(&P, src + (long)dir * nn, cb, rad, bnd + 4 * dir, px, py, v[0], v[1]);
             continue;
         }
         double cb[4] = {P.ss_w * ppb_hg_phase(P.ss_g, v[0] * P.sin_theta_l - v[1] * P.cos_theta_l),
                         0.0, 0.0, 0.0};
-        sum += rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, v[0], v[1]);
+        sum += wk * rte_ray(&P, src + (long)dir * nn, cb, rad, bnd, px, py, v[0], v[1]);
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
 }

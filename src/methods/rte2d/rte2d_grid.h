@@ -32,15 +32,16 @@
 typedef struct ppb_rte_grid {
     ppb_rte_params P; /* the grid and medium fields (launch fields left to the caller) */
     int nnodes;
-    pp_dirs dirs; /* the solver's partition: antipodal for g < 0, as ppsolver.c builds it */
-    int nc;       /* transported cells */
-    int *rep;     /* [nc]: the cell of dirs each transported cell is */
-    int *slot;    /* [2N]: transported index of every cell (its mirror's where not itself) */
-    double *mult; /* [nc]: 1 or 2, cells the transported one stands for */
-    double *dir4; /* [nc][4]: transport direction (the centre; in the tube x scaled so the
-                     cells integrate w_x^2 exactly) and the cell average of p(w.w_L) */
-    double *Pf;   /* [nc][nc] row-major: folded phase matrix */
-    double *bnd;  /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
+    pp_dirs dirs;    /* the solver's partition: antipodal for g < 0, as ppsolver.c builds it */
+    int nc;          /* transported cells */
+    int *rep;        /* [nc]: the cell of dirs each transported cell is */
+    int *slot;       /* [2N]: transported index of every cell (its mirror's where not itself) */
+    double *mult;    /* [nc]: 1 or 2, cells the transported one stands for */
+    double *dir4;    /* [nc][4]: transport direction (the centre; in the tube x scaled so the
+                        cells integrate w_x^2 exactly) and the cell average of p(w.w_L) */
+    double *Pf;      /* [nc][nc] row-major: folded phase matrix */
+    double moment_b; /* the first-moment correction's mix b (0: none; ppb_rte_moment_fix) */
+    double *bnd;     /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
     /* The flat-source regions (FSRs) of the conservative sweep: the nodes' dual cells, the
      * column of the node on the step split in two at step_x (so sigma_t and alpha are constant
      * in each); slab: one column of unit width. */
@@ -80,7 +81,7 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x);
 
 /* Builds the grid with node spacing about `spacing` mfp (each part of the x range, and y, get
  * ceil(length / spacing) cells), `directions` cells per hemisphere and march step hstep mfp. */
-int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep,
+int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep, int moment,
                       ppb_rte_grid *G, ppb_err *err);
 void ppb_rte_grid_free(ppb_rte_grid *G);
 
@@ -93,6 +94,14 @@ void ppb_rte_grid_free(ppb_rte_grid *G);
  * delta part counted as unscattered). Returns f; 0 with *out = sc where the scaled media cannot
  * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. */
 double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out);
+
+/* The first-moment correction of the full 2N x 2N cell phase matrix P (pp_phase_matrix's, of
+ * HG g, on d; for g < 0 d must be the antipodal partition): P <- (1 - b) P + b A, A the identity
+ * (g > 0) or the antipodal permutation (g < 0), b chosen so that the mean over the columns of
+ * sum_i P_ij c_i . c_j (c the cells' centres) is g; rows and columns keep summing to 1 and S
+ * stays symmetric. Returns b; 0 (P untouched) at g = 0 or where the matrix already reaches g.
+ * `[rte2d] moment` (reference: Methods, `rte2d`). */
+double ppb_rte_moment_fix(const pp_dirs *d, double g, double *P);
 
 /* Nodes of the grid ppb_rte_grid_make builds at `spacing` (G->nnodes), before building. */
 double ppb_rte_nodes(const ppb_scene *sc, double spacing);
