@@ -2,7 +2,7 @@
  * single and multiple scattering (docs/methods.md, "Slab solver: error budget against
  * adding-doubling"; `make build/slab_budget`).
  *
- * usage: slab_budget DIRS MODE [G] [--sfi K] [--diffuse] [--ref FILE] [--collars C]
+ * usage: slab_budget DIRS MODE [G] [--sfi K] [--diffuse [--nodes K]] [--ref FILE] [--collars C]
  *   DIRS cells per hemisphere, MODE the delta-M mode (0 off, 1 on, 2 auto), G only the cases of
  *   that g. Reads tests/data/adding_doubling_ref.csv (iadpython, tests/data/
  *   gen_adding_doubling_ref.py) from the repository root, or --ref FILE with the same first
@@ -23,8 +23,8 @@
  *   plus that.
  *   --collars C: the partition with C collars per hemisphere ([pp] collars; 0, the default, the
  *   near-square cells).
- *   --diffuse: URU and UTU (diffuse incidence, 2 int UR1(mu) mu dmu in air) by 12-node
- *   Gauss-Legendre in mu, one solve per node; printed beside adding-doubling's.
+ *   --diffuse: URU and UTU (diffuse incidence, 2 int UR1(mu) mu dmu in air) by Gauss-Legendre
+ *   in mu (--nodes K, default 12), one solve per node; printed beside adding-doubling's.
  * Last line: the worst |difference| of each column. */
 #include <math.h>
 #include <stdio.h>
@@ -188,12 +188,12 @@ static void worst(double *w, int k, double v)
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(
-            stderr,
-            "usage: slab_budget DIRS MODE [G] [--sfi K] [--diffuse] [--ref FILE] [--collars C]\n");
+        fprintf(stderr,
+                "usage: slab_budget DIRS MODE [G] [--sfi K] [--diffuse [--nodes K]] [--ref FILE] "
+                "[--collars C]\n");
         return 2;
     }
-    int N = atoi(argv[1]), mode = atoi(argv[2]), sfi = 0, diffuse = 0;
+    int N = atoi(argv[1]), mode = atoi(argv[2]), sfi = 0, diffuse = 0, nodes = 12;
     double gf = -1;
     const char *ref = "tests/data/adding_doubling_ref.csv";
     for (int i = 3; i < argc; i++) {
@@ -204,7 +204,9 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
             ref = argv[++i];
         else if (strcmp(argv[i], "--diffuse") == 0)
-            diffuse = 1;
+            diffuse = 12;
+        else if (strcmp(argv[i], "--nodes") == 0 && i + 1 < argc)
+            nodes = atoi(argv[++i]);
         else
             gf = atof(argv[i]);
     }
@@ -246,9 +248,10 @@ int main(int argc, char **argv)
         worst(w, 0, dr), worst(w, 1, dt), worst(w, 2, drs), worst(w, 3, dts);
         worst(w, 4, drm), worst(w, 5, dtm);
         if (diffuse) {
-            double x[12], wq[12], uru = 0, utu = 0;
-            ppb_gauss_legendre(12, x, wq);
-            for (int j = 0; j < 12; j++) {
+            double x[64], wq[64], uru = 0, utu = 0;
+            nodes = nodes < 1 ? 1 : (nodes > 64 ? 64 : nodes);
+            ppb_gauss_legendre(nodes, x, wq);
+            for (int j = 0; j < nodes; j++) {
                 double mu = 0.5 + 0.5 * x[j];
                 if (totals_at(&c, N, mode, mu, &ur, &ut, NULL) != 0)
                     return 1;
