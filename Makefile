@@ -77,6 +77,10 @@ $(BIN): $(BUILD)/obj/drivers/main.o $(LIB)
 $(BUILD)/burley_fit: scripts/burley_fit.c $(LIB) | $(BUILD)/deps.mk
 	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
+# The slab solver's error budget against adding-doubling (docs/methods.md; scripts/slab_budget.c).
+$(BUILD)/slab_budget: scripts/slab_budget.c $(LIB) | $(BUILD)/deps.mk
+	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS)
+
 $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS) \

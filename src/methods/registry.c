@@ -17,12 +17,20 @@
 #include "methods/ppslab/method_ppslab.h"
 #include "methods/rte2d/method_rte2d.h"
 #include "methods/rte2d/perf_rte2d.h"
+#include "physics/ppsolver.h"
 
 static const ppb_method *builtin(const char *id);
 
 /* mp+ss and any other sum of methods (method.h: ppb_method_sum): parts found among the
  * built-in methods. */
 static int run_sum(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err);
+
+/* ppslab reads [pp] (the slab solver's section, named here where every method may be named):
+ * its collars against its directions, before any work. */
+static int ppslab_check(const ppb_config *cfg, ppb_err *err)
+{
+    return pp_collars_check(cfg, "pp", err);
+}
 
 /* The registry: the order here is the order of outputs; adding a method is one line here
  * (docs/reference.md: Methods, "Adding a method"). */
@@ -99,7 +107,8 @@ static const ppb_method methods[] = {
      .slab_only = 1,
      .reference = 2,
      .summary = "plane-parallel solution at the slab faces (slab mode only)",
-     .run = ppb_method_ppslab},
+     .run = ppb_method_ppslab,
+     .check = ppslab_check},
     {.id = "rte2d",
      .reference = 2, /* noise-free in the tube: summary_rte2d.csv */
      .summary = "the tube's transfer solved: the paper's refinement iterated",

@@ -57,6 +57,7 @@ typedef struct ppb_pp_settings {
     int albedos;    /* albedo nodes of the tables (Sec. 3.3) */
     int map_res;    /* cells per mfp of the D(x) and average-albedo maps */
     int delta_m;    /* PPB_DELTA_M_*: the slab solver's delta-M (ppslab and the march) */
+    int collars;    /* the direction cells' collars per hemisphere, 0 = near-square cells */
 } ppb_pp_settings;
 
 /* [pp] delta_m; the values of PP_DELTA_M_* (physics/ppsolver.h, which asserts it). */

@@ -48,13 +48,13 @@ static double fine_theta(int f, int collars, int r_snap, int split, double theta
     return a + (b - a) * ((piece - 1) % split + 1) / split;
 }
 
-static int ring_counts(int n, int pole, double theta_snap, int *count)
+static int ring_counts(int n, int pole, double theta_snap, int want, int *count)
 {
     count[0] = pole;
     if (n == pole)
         return 1;
     double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PPB_PI / n);
-    int collars = (int)lround((0.5 * PPB_PI - acos(1.0 - 1.0 / n)) / side);
+    int collars = want > 0 ? want : (int)lround((0.5 * PPB_PI - acos(1.0 - 1.0 / n)) / side);
     int base = n % 2, first_min = pole % 2 != base ? 1 : 2;
     if (collars < 1)
         collars = 1;
@@ -152,15 +152,24 @@ static void cell_geometry(pp_dirs *d, int i)
                      : fmax(0.5 * (t1 - t0), 0.5 * sin_max * (d->phi_hi[i] - d->phi_lo[i]));
 }
 
-static int make(int n, int antipodal, double theta_snap, pp_dirs *d, ppb_err *err)
+int pp_dirs_max_collars(int n)
+{
+    return n < 6 ? 0 : (n - 4) / 2; /* below every partition's own limit (ring_counts) */
+}
+
+static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d, ppb_err *err)
 {
     memset(d, 0, sizeof *d);
     if (n < 1 || n > PP_DIRS_MAX)
         return ppb_fail(err, "pp directions: %d cells per hemisphere, need 1..%d", n, PP_DIRS_MAX);
+    if (collars < 0 || collars > pp_dirs_max_collars(n))
+        return ppb_fail(err, "pp directions: %d collars, need 0..%d for %d cells per hemisphere",
+                        collars, pp_dirs_max_collars(n), n);
     int *count = calloc((size_t)n + 1, sizeof(int));
     if (!count)
         return ppb_fail(err, "pp directions: out of memory");
-    int nrings = ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, theta_snap, count);
+    int nrings =
+        ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, theta_snap, collars, count);
     d->n = n;
     d->nrings = nrings;
     d->solid = 2.0 * PPB_PI / n;
@@ -190,17 +199,24 @@ static int make(int n, int antipodal, double theta_snap, pp_dirs *d, ppb_err *er
 
 int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
 {
-    return make(n, 0, 0.0, d, err);
+    return make(n, 0, 0.0, 0, d, err);
 }
 
 int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err *err)
 {
-    return make(n, antipodal, acos(mu_snap), d, err);
+    return make(n, antipodal, acos(mu_snap), 0, d, err);
 }
 
 int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err)
 {
-    return make(n, 1, 0.0, d, err);
+    return make(n, 1, 0.0, 0, d, err);
+}
+
+int pp_dirs_make_collars(int n, int antipodal, double mu_snap, int collars, pp_dirs *d,
+                         ppb_err *err)
+{
+    return make(n, antipodal, mu_snap > 0.0 && mu_snap < 1.0 ? acos(mu_snap) : 0.0, collars, d,
+                err);
 }
 
 void pp_dirs_free(pp_dirs *d)

@@ -60,6 +60,14 @@ int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err);
  * (0, 1) up to the rounding of the cell counts (|mu error| <= 1/n): the solver's Fresnel
  * boundaries put it at the critical cosine, where the radiance is discontinuous (ppsolver.h). */
 int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err *err);
+/* The general form: collars > 0 sets the number of collars below the polar ring (before the
+ * snap's split), 0 the near-square cells above; mu_snap outside (0, 1) snaps nothing. More
+ * collars than square cells trade azimuthal for polar resolution, which is what a slab's totals
+ * depend on (ppsolver.h: [pp] collars). Fails beyond pp_dirs_max_collars(n). */
+int pp_dirs_make_collars(int n, int antipodal, double mu_snap, int collars, pp_dirs *d,
+                         ppb_err *err);
+/* The most collars n cells per hemisphere allow (two cells each at least): (n - 4) / 2. */
+int pp_dirs_max_collars(int n);
 void pp_dirs_free(pp_dirs *d);
 
 /* Cell in [0, 2N) holding direction w (unit vector); w.y = 0 counts as up. */

@@ -52,7 +52,7 @@ static double beam_phase(const ppb_scene *sc, const double w[3])
  * Zero-filled before it is set, so two keys compare with memcmp. */
 typedef struct table_key {
     int with_modes, geometry, ntheta, nphi, nsamp, tau_per_mfp;
-    int directions, modes, want_s, nalb, ncols, ntau[PPB_MARCH_MAX_COLS], delta_m;
+    int directions, modes, want_s, nalb, ncols, ntau[PPB_MARCH_MAX_COLS], delta_m, collars;
     double g, theta_deg, height, alb0, alb_h, sigma_t[PPB_MARCH_MAX_COLS], n;
 } table_key;
 
@@ -97,6 +97,7 @@ static table_key plan(const ppb_scene *sc, const ppb_pp_settings *pp, int nsamp,
     k.directions = pp->directions;
     k.modes = pp->modes;
     k.delta_m = pp_delta_m_wanted(pp->delta_m, sc->g); /* auto and on alike where it applies */
+    k.collars = pp->collars;
     k.want_s = pp->table == PPB_TABLE_S;
     double alo = sc->albedo, ahi = sc->albedo;
     if (sc->geometry == PPB_GEOM_TUBE && sc->step == PPB_STEP_ALBEDO) {
@@ -416,8 +417,8 @@ static int solve_block(pp_build *b, double tau0, double alb, pp_solution **sol, 
                      .directions = b->pp->directions};
     /* delta-M changes the diffuse field only (ppsolver.h): J stays the source of the true
      * medium, attenuated by the true sigma_t along the march, with the exact beam */
-    return pp_solve_delta_m(&prm, sc->n > 1.0 ? sc->n : 1.0, b->pp->delta_m, b->first, sol, NULL,
-                            err);
+    return pp_solve_collars(&prm, sc->n > 1.0 ? sc->n : 1.0, b->pp->delta_m, b->pp->collars,
+                            b->first, sol, NULL, err);
 }
 
 /* The (column c, albedo node) block: C, and the R and S rows (layout: march_params.h). */

@@ -48,6 +48,7 @@ struct pp_solution {
     double Fb;     /* F of the unscattered beam at either face, from inside */
     double specular, ballistic_top;
     int delta_m; /* PP_DELTA_M_* as asked */
+    int collars; /* the partition's collars per hemisphere, 0 = near-square cells */
     double fwd;  /* delta-M: the forward fraction F the cell matrix holds (0: off; ppsolver.h) */
 };
 
@@ -676,6 +677,17 @@ static double isotropic_diffusion(const pp_solution *s)
     return D;
 }
 
+int pp_collars_check(const ppb_config *cfg, const char *section, ppb_err *err)
+{
+    int most = pp_dirs_max_collars(cfg->pp.directions);
+    if (cfg->pp.collars > most)
+        return ppb_config_key_fail(cfg, section, "collars", err,
+                                   "%d is more than the %d that [pp] directions = %d allows (two "
+                                   "cells a collar at least)",
+                                   cfg->pp.collars, most, cfg->pp.directions);
+    return 0;
+}
+
 int pp_delta_m_wanted(int delta_m, double g)
 {
     return g > 0.0 &&
@@ -706,7 +718,7 @@ static int phase_stage(pp_solution *s, const pp_solution *share, ppb_err *err)
 {
     size_t nn = (size_t)s->n * s->n;
     /* the held blocks carry their delta-M: shared only between solves alike in it */
-    if (share && share->n == s->n && share->p.g == s->p.g &&
+    if (share && share->n == s->n && share->p.g == s->p.g && share->collars == s->collars &&
         pp_delta_m_wanted(share->delta_m, share->p.g) == pp_delta_m_wanted(s->delta_m, s->p.g)) {
         s->fwd = share->fwd;
         memcpy(s->Sa, share->Sa, nn * sizeof(double));
@@ -756,9 +768,18 @@ static int solve_stages(pp_solution *s, const pp_solution *share, pp_work *w, pp
 int pp_solve_delta_m(const pp_params *p, double nrel, int delta_m, const pp_solution *share,
                      pp_solution **out, pp_timing *t, ppb_err *err)
 {
+    return pp_solve_collars(p, nrel, delta_m, 0, share, out, t, err);
+}
+
+int pp_solve_collars(const pp_params *p, double nrel, int delta_m, int collars,
+                     const pp_solution *share, pp_solution **out, pp_timing *t, ppb_err *err)
+{
     *out = NULL;
     if (check_params(p, err) != 0)
         return -1;
+    if (collars < 0 || collars > pp_dirs_max_collars(p->directions))
+        return ppb_fail(err, "pp solver: collars = %d, need 0..%d at directions = %d", collars,
+                        pp_dirs_max_collars(p->directions), p->directions);
     if (!(nrel >= 1 && nrel <= 10))
         return ppb_fail(err, "pp solver: n = %g, need 1 <= n <= 10", nrel);
     pp_solution *s = calloc(1, sizeof *s);
@@ -766,6 +787,7 @@ int pp_solve_delta_m(const pp_params *p, double nrel, int delta_m, const pp_solu
         return ppb_fail(err, "pp solver: out of memory");
     s->p = *p;
     s->delta_m = delta_m;
+    s->collars = collars;
     s->n = p->directions, s->m = 2 * p->directions;
     s->conservative = 1.0 - p->albedo < CONSERVATIVE_EPS;
     if (nrel > 1.0) { /* the beam refracts; mu0 inside from here on */
@@ -778,12 +800,9 @@ int pp_solve_delta_m(const pp_params *p, double nrel, int delta_m, const pp_solu
     pp_work w;
     /* g < 0: the partition closed under w -> -w, where the backward matrix is the permuted
      * forward one (phase.h); the same partition as the default for odd N */
-    int rc =
-        p->g < 0 ? pp_dirs_make_antipodal(s->n, &s->dirs, err) : pp_dirs_make(s->n, &s->dirs, err);
-    if (rc == 0 && s->fresnel) { /* a collar edge at the critical cosine (ppsolver.h) */
-        pp_dirs_free(&s->dirs);
-        rc = pp_dirs_make_snap(s->n, p->g < 0, sqrt(1.0 - 1.0 / (nrel * nrel)), &s->dirs, err);
-    }
+    /* at n > 1 a collar edge at the critical cosine (ppsolver.h) */
+    double mu_snap = s->fresnel ? sqrt(1.0 - 1.0 / (nrel * nrel)) : 0.0;
+    int rc = pp_dirs_make_collars(s->n, p->g < 0, mu_snap, s->collars, &s->dirs, err);
     if (rc == 0)
         rc = solution_alloc(s, err);
     if (rc == 0 && work_alloc(&w, (size_t)s->n) != 0)

@@ -73,7 +73,10 @@
  *   (1 - f), f = g^M, made the thin slabs worse (HG(g') misplaces the higher moments, the
  *   scaled beam counts the cells' forward part twice) and did not help the thick ones. With it
  *   the 108 cases of g 0.7-0.95 are within 1.4e-3 at 334 cells (8.9e-3 without), 6.6e-4 at
- *   1000 (3.7e-3): the rest is the cells' discretisation, falling as 1 / directions. */
+ *   1000 (3.7e-3). What bounds the rest is the polar resolution (docs/methods.md, the slab
+ *   solver's error budget): the default partition's 12 rings per hemisphere at 334 cells are a
+ *   midpoint rule in mu (sum |Omega| k^2 3.1e-3 short of 2 pi / 3); pp_solve_collars with 55
+ *   collars brings the same 334 cells within 9.9e-5 for g <= 0.9 and 4.3e-4 at g 0.95. */
 #ifndef PPB_PPSOLVER_H
 #define PPB_PPSOLVER_H
 
@@ -124,6 +127,18 @@ double pp_fresnel_ring_mean(double lo, double hi, double n);
 /* pp_solve_fresnel with delta-M mode delta_m (PP_DELTA_M_*). */
 int pp_solve_delta_m(const pp_params *p, double n, int delta_m, const pp_solution *share,
                      pp_solution **out, pp_timing *t, ppb_err *err);
+/* pp_solve_delta_m on the partition with `collars` collars per hemisphere below the cap
+ * ([pp] collars; 0: the near-square cells every other entry point uses, bit for bit;
+ * directions.h: pp_dirs_make_collars). Polar resolution is what the slab's totals need: at 334
+ * cells the default partition has 12 polar rings per hemisphere (docs/methods.md, the slab
+ * solver's error budget). share is used only when it has the same collars. */
+int pp_solve_collars(const pp_params *p, double n, int delta_m, int collars,
+                     const pp_solution *share, pp_solution **out, pp_timing *t, ppb_err *err);
+/* [pp] collars against [pp] directions (ppslab's and pp's checks, before any work): a clear
+ * error naming the key (in `section`, the methods' settings section) where it exceeds
+ * pp_dirs_max_collars. */
+struct ppb_config;
+int pp_collars_check(const struct ppb_config *cfg, const char *section, ppb_err *err);
 /* Whether mode delta_m applies delta-M at asymmetry g. */
 int pp_delta_m_wanted(int delta_m, double g);
 /* The forward fraction F the solve took as unscattered (0: delta-M off). */

@@ -8,6 +8,7 @@
 
 #include "base/memory.h"
 #include "methods/pp/march.h"
+#include "physics/ppsolver.h"
 #include "physics/totals.h"
 #include "methods/result_check.h"
 
@@ -103,7 +104,7 @@ int ppb_pp_check(const ppb_config *cfg, ppb_err *err)
         return ppb_config_key_fail(cfg, "light", "width", err,
                                    "pp: a searchlight (a strip or line narrower than S1) has no "
                                    "plane-parallel field; leave pp out or light the whole face");
-    return 0;
+    return pp_collars_check(cfg, "pp", err);
 }
 
 /* Rays the marcher traces (cells x samples_dir^2 x samples_seg) and steps along the longest

@@ -34,7 +34,7 @@ int ppb_method_ppslab(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     double tau0 = sc->height * sc->sigma_t;
     pp_params p = {tau0, sc->albedo, sc->g, ppb_scene_cos_theta_l(sc), cfg->pp.directions};
     pp_solution *s = NULL;
-    if (pp_solve_delta_m(&p, sc->n, cfg->pp.delta_m, NULL, &s, NULL, err) != 0)
+    if (pp_solve_collars(&p, sc->n, cfg->pp.delta_m, cfg->pp.collars, NULL, &s, NULL, err) != 0)
         return -1;
     int samples = cfg->samples_dir > 0 ? cfg->samples_dir : 1;
     ppb_progress pr; /* the bins take longer than the solve at large directions */
