@@ -15,13 +15,13 @@ set output "$dir/figure.png"
 lin(s) = s <= 0.04045 ? s / 12.92 : ((s + 0.055) / 1.055) ** 2.4
 srgb(x) = x <= 0.0031308 ? 12.92 * x : 1.055 * x ** (1 / 2.4) - 0.055
 err(r, g, b) = (r >= b ? 1 : -1) * (1 - g / 255.0) * 0.1
-set multiplot layout 2,3 title "$name: images (one exposure) and errors against mc3d"
+set multiplot layout 2,3 title "$name: images on one exposure (L_{max}: mc3d's brightest pixel), errors against mc3d (clamped at 0.1 L_{max})"
 unset xtics; unset ytics; unset key
 set size ratio -1
 set yrange [*:*] reverse
 set palette functions srgb(gray), srgb(gray), srgb(gray)
 set cbrange [0:1]
-set cblabel "L / (mc3d's brightest pixel)"
+set cblabel "L / L_{max}"
 do for [m in "mc3d ss3d pp3d"] {
   set title m.(m eq "mc3d" ? " (reference)" : "")
   plot "$img/".m.".png" binary filetype=png using (lin(\$1 / 255.0)) with image
@@ -29,7 +29,7 @@ do for [m in "mc3d ss3d pp3d"] {
 set multiplot next
 set palette defined (-0.1 "blue", 0 "white", 0.1 "red")
 set cbrange [-0.1:0.1]
-set cblabel "(L - L_{mc3d}) / (mc3d's brightest pixel), clamped at 0.1"
+set cblabel "(L - L_{mc3d}) / L_{max}"
 set title "ss3d - mc3d"
 plot "$img/ss3d_error.png" binary filetype=png using (err(\$1, \$2, \$3)) with image
 set title "pp3d - mc3d"

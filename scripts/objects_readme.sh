@@ -11,12 +11,13 @@ cat <<'EOF'
 # The paper's method on three-dimensional objects
 
 `bash scripts/objects_study.sh` (part of `make bench`): each object of `configs/objects/` with
-`mc3d` (the reference, 2e6 photons, 16 batches), `ss3d` (single scattering) and `pp3d` (the
+`mc3d` (the reference, 2e7 photons, 16 batches), `ss3d` (single scattering) and `pp3d` (the
 paper's plane-parallel method, Sec. 3.3-3.5), 334 directions, 2 x 2 direction samples a bin,
 the paper's albedos where it gives them (Fig. 9: alpha 0.95, g 0 for the bunny's material; the
 yokan's and the chestnut's red channel, 0.16 and 0.51). Per object `<object>/figure.png`
-(images on one exposure, error images against mc3d), `regions.csv`, `radiance.csv` and the
-images (docs/reference.md, Objects).
+(images on one exposure, error images against mc3d), `regions.csv`, `timings.csv`,
+`totals_*.csv` and the PNG images (docs/reference.md, Objects; the EXR images, `radiance.csv`
+and `object.vox` are not kept: rerun `ppbench object` with the study's settings for them).
 
 Tables: rms_rel = RMS of (method - mc3d) over a region's cells divided by mc3d's mean there,
 over the patch cells (radiance per patch and direction bin) and over the camera's pixels;
