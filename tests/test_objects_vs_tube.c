@@ -2,9 +2,10 @@
  * noise. (1) mc3d in the middle of a box long in z whose cross-section is the study tube's
  * (10 x 3 mfp, configs/uniform_g0_normal.ini's medium, lit from the top) against the tube's mc
  * (methods/mc: its own OpenCL kernel, 2-D geometry, its own tallies): per (surface, segment,
- * theta bin) of the middle slice and per face. (2) ss3d (host march, methods/pp3d) against
- * mc3d1 (the Monte Carlo's once-scattered photons) on a box, a sphere and the yokan with its
- * inclusion, every patch cell. ss3d and pp3d against the tube's ss and pp are in test_pp3d.
+ * theta bin) of the middle slice's S1 and S2, and per face (R, T, the sides). (2) ss3d (host march,
+ * methods/pp3d) against mc3d1 (the Monte Carlo's once-scattered photons) on a box, a sphere and the
+ * yokan with its inclusion, every patch cell. ss3d and pp3d against the tube's ss and pp are in
+ * test_pp3d.
  *
  * Statistics: the Monte Carlo's standard errors come from B = 16 batch means, so
  * (x - ref) / se is a Student t with 15 degrees of freedom, whose square has mean 15/13 and
@@ -187,6 +188,31 @@ static void test_mc3d_long_box_is_tube(void **state)
            "cell %.3f (bound %.3f)\n",
            ncells, chi2 / ncells, chi2_bound(ncells));
     assert_true(chi2 / ncells < chi2_bound(ncells));
+    /* The sides: the box's faces x = 0 and x = 10 (axis 0) in the slice against S3 + S4 (3
+     * segments of 1 mfp each), as fluxes per unit length over W E_perp. */
+    double sb = 0.0, sbv = 0.0, st = 0.0, stv = 0.0;
+    for (int i = 0; i < p.npatch; i++) {
+        const ppb_object_patch *pa = &p.patch[i];
+        if (pa->axis != 0 || pa->c[2] < z0 || pa->c[2] > z1)
+            continue;
+        double f = pa->area * PPB_PI / nb / (W * (z1 - z0));
+        for (int b = 0; b < nb; b++) {
+            size_t c = (size_t)i * nb + b;
+            sb += r[0].patch_rad[c] * f, sbv += r[0].patch_se[c] * r[0].patch_se[c] * f * f;
+        }
+    }
+    for (int s = PPB_S3; s <= PPB_S4; s++)
+        for (int seg = 0; seg < lo.nseg[s]; seg++)
+            for (int b = 0; b < lo.nbins; b++) {
+                size_t c = ppb_cell(&lo, s, seg, b);
+                double f = (3.0 / lo.nseg[s]) * PPB_PI / lo.nbins / W;
+                st += tube->radiance[c] * f, stv += tube->se[c] * tube->se[c] * f * f;
+            }
+    double zs = (sb - st) / sqrt(sbv + stv);
+    printf("mc3d's long box vs the tube's mc, sides (S3 + S4) flux: %.5f +- %.5f vs %.5f +- %.5f "
+           "(%.2f sigma)\n",
+           sb, sqrt(sbv), st, sqrt(stv), zs);
+    assert_true(fabs(zs) < 4.0);
     for (int i = 0; i < 2; i++)
         ppb_result_free(&tr[i]);
     for (int i = 0; i < 2; i++)
