@@ -24,7 +24,10 @@ over the patch cells (radiance per patch and direction bin) and over the camera'
 noise = mc3d's mean standard error over its mean (what the reference cannot resolve). Regions
 (docs/reference.md, Objects): faces, edges, corners by the voxels' boundary faces, shadowed
 (facing away from the light or behind medium), inclusion (the chestnut). A region with no cells
-is left out.
+is left out. The figures' error images saturate at +-10 % of L_max (the driver's PNG scale,
+docs/reference.md, Objects) and pp3d's image is clipped at white where it passes L_max: at
+albedo 0.95 pp3d's errors pass that nearly everywhere, so the tables carry the magnitudes (a
+wider scale needs the EXR images, which the study does not keep).
 
 EOF
 for o in "$@"; do
