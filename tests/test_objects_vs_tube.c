@@ -279,7 +279,8 @@ static void test_ss3d_box(void **state)
 /* A staircase sphere's faces see the radiance change within a face: ss3d's Latin-square samples
  * (docs/methods.md, pp3d) converge to the area average as samples_dir grows (on an 8-mfp ball
  * of 0.5-mfp voxels, sum of cells over mc3d1's: 1.0208 at 2 x 2 samples, 1.0087 at 4 x 4, both
- * beyond the noise), so this ball has 0.25-mfp voxels and 8 x 8 samples. */
+ * beyond the noise; a 4-mfp ball: 1.0078 at 0.25-mfp voxels, 1.0028 +- 0.0021 at 0.125, both
+ * 4 x 4), so this ball has 0.25-mfp voxels and 8 x 8 samples. */
 static void test_ss3d_sphere(void **state)
 {
     (void)state;
