@@ -25,6 +25,7 @@ done
 # standard error over its mean is under 1 % a pixel and 2-10 % a patch cell (the staircase
 # ball's and blob's small patches), the noise column of the README, below the errors reported. 2 x 2 direction samples a bin keep pp3d's
 # patches to seconds; 334 directions as the paper's.
+# shellcheck disable=SC2054 # the commas are inside one value
 common=(--set experiment.methods=mc3d,ss3d,pp3d --set mc.photons=2e7 --set mc.batches=16
         --set bins.samples_dir=2 --set pp.directions=334)
 objects=(box cube_two_faces sphere yokan blob)
