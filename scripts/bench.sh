@@ -71,6 +71,10 @@ bash scripts/summary_plot.sh "$out" "${cases[@]}"
 # of configs/materials.list into $out/materials, with their own report.
 [ $quick = 1 ] && mkdir -p "$out/materials" && cp "$out/notes.md" "$out/materials/notes.md"
 bash scripts/materials_study.sh --out "$out/materials" --cache "$cache" "${sets[@]}"
+# The three-dimensional study (scripts/objects_study.sh; docs/reference.md: Objects): mc3d,
+# ss3d and pp3d on configs/objects into $out/objects, its own README (6-9 minutes; the quick
+# study's settings apply).
+bash scripts/objects_study.sh --out "$out/objects" "${sets[@]}"
 printf 'study written to %s/ in %ds: see %s/README.md\n' "$out" $(( $(date +%s) - t0 )) "$out" >&2
 # The shipped references (references/<case>/, docs/reference.md: Keys) come from this study's
 # cache by `make references` (scripts/references.sh), run after a full bench.

@@ -20,6 +20,7 @@
 
 #include "base/progress.h"
 #include "kernels/ppb_conventions.h"
+#include "kernels/ppb_object.h"
 #include "methods/pp3d/walk.h"
 
 /* What one ray reads from the tables: its angle node pair and its fixed phase. */
@@ -233,44 +234,18 @@ static void cross3(const double *a, const double *b, double *c)
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-int ppb_pp3d_camera_init(const ppb_object *o, ppb_pp3d_camera *c, ppb_err *err)
+/* The camera is kernels/ppb_object.h's, as mc3d's kernel and the driver's pixel regions use it
+ * (docs/reference.md, Objects): c toward the camera is -view_dir. */
+static int camera_make(const ppb_object *o, ppb_obj_camera *cam, ppb_err *err)
 {
-    memset(c, 0, sizeof *c);
     double n = sqrt(dot3(o->view_dir, o->view_dir));
     if (!(n > 0.0) || o->img_w < 1 || o->img_h < 1)
         return ppb_fail(err, "%s: the camera needs a view direction and at least one pixel",
                         o->name);
-    for (int a = 0; a < 3; a++)
-        c->to_cam[a] = -o->view_dir[a] / n;
-    double yup[3] = {0.0, 1.0, 0.0}, zup[3] = {0.0, 0.0, 1.0};
-    cross3(fabs(c->to_cam[1]) > 0.999 ? zup : yup, c->to_cam, c->right);
-    double r = sqrt(dot3(c->right, c->right));
-    for (int a = 0; a < 3; a++)
-        c->right[a] /= r;
-    cross3(c->to_cam, c->right, c->up);
-    double ext[3] = {o->nx * o->voxel, o->ny * o->voxel, o->nz * o->voxel};
-    double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
-    for (int k = 0; k < 3; k++)
-        c->centre[k] = 0.5 * ext[k];
-    for (int q = 0; q < 8; q++) {
-        double p[3] = {(q & 1) ? ext[0] : 0.0, (q & 2) ? ext[1] : 0.0, (q & 4) ? ext[2] : 0.0};
-        for (int k = 0; k < 3; k++)
-            p[k] -= c->centre[k];
-        umin = fmin(umin, dot3(p, c->right)), umax = fmax(umax, dot3(p, c->right));
-        vmin = fmin(vmin, dot3(p, c->up)), vmax = fmax(vmax, dot3(p, c->up));
-    }
-    /* Square pixels, the larger extent over its pixel count, the image centred. */
-    c->pixel = fmax((umax - umin) / o->img_w, (vmax - vmin) / o->img_h);
-    c->u0 = 0.5 * (umin + umax) - 0.5 * o->img_w * c->pixel;
-    c->v1 = 0.5 * (vmin + vmax) + 0.5 * o->img_h * c->pixel;
+    double c[3] = {-o->view_dir[0] / n, -o->view_dir[1] / n, -o->view_dir[2] / n};
+    *cam = ppb_obj_camera_make(c, o->nx * o->voxel, o->ny * o->voxel, o->nz * o->voxel, o->img_w,
+                               o->img_h);
     return 0;
-}
-
-void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, double x, double y, double p[3])
-{
-    double u = c->u0 + x * c->pixel, v = c->v1 - y * c->pixel;
-    for (int k = 0; k < 3; k++)
-        p[k] = c->centre[k] + u * c->right[k] + v * c->up[k];
 }
 
 /* One boundary face's rays, added into its patch's bins (row of nbins): face f = 2 axis +
@@ -319,14 +294,15 @@ static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb
 
 /* The start of the ray through image point (x, y) (pixel units from the top-left corner):
  * beyond the grid box on the camera's side. */
-static void pixel_ray(const ppb_object *o, const ppb_pp3d_camera *cam, double x, double y,
+static void pixel_ray(const ppb_object *o, const ppb_obj_camera *cam, double x, double y,
                       double p0[3])
 {
-    double pix[3];
-    ppb_pp3d_camera_pixel(cam, x, y, pix);
-    double back = o->voxel * (o->nx + o->ny + o->nz);
+    double pr = cam->r0 + x * cam->pixel, pu = cam->u1 - y * cam->pixel;
+    /* along c: past the grid box's centre by the sum of its extents, beyond every corner */
+    double ctr[3] = {0.5 * o->nx * o->voxel, 0.5 * o->ny * o->voxel, 0.5 * o->nz * o->voxel};
+    double pc = dot3(ctr, cam->c) + o->voxel * (o->nx + o->ny + o->nz);
     for (int a = 0; a < 3; a++)
-        p0[a] = pix[a] + back * cam->to_cam[a];
+        p0[a] = pr * cam->r[a] + pu * cam->u[a] + pc * cam->c[a];
 }
 
 /* The work of one run, shared by its threads: items [0, npatch) are the patches (each one's
@@ -340,7 +316,7 @@ typedef struct render_job {
     int nsamp, nsub, with_patches;
     double step;
     const size_t *face_off, *faces; /* patch q's faces: faces[face_off[q] .. face_off[q + 1]) */
-    ppb_pp3d_camera cam;
+    ppb_obj_camera cam;
     double *patch_rad, *img;
     int nitems;
     atomic_int next, done;
@@ -365,7 +341,7 @@ static void render_item(render_job *j, int item)
             for (int b = 0; b < ns; b++) {
                 double p0[3];
                 pixel_ray(o, &j->cam, x + (b + 0.5) / ns, y + (a + 0.5) / ns, p0);
-                acc += ppb_pp3d_ray(o, j->m, j->tab, j->step, p0, j->cam.to_cam, -1);
+                acc += ppb_pp3d_ray(o, j->m, j->tab, j->step, p0, j->cam.c, -1);
             }
         j->img[(size_t)y * o->img_w + x] = acc / (ns * ns);
     }
@@ -458,7 +434,7 @@ static int render(const ppb_object *o, const ppb_object_patches *p, const ppb_pp
                     .patch_rad = patch_rad,
                     .img = img};
     size_t *off = NULL, *faces = NULL;
-    if (ppb_pp3d_camera_init(o, &j.cam, err) || (p && patch_faces(o, p, &off, &faces, err)))
+    if (camera_make(o, &j.cam, err) || (p && patch_faces(o, p, &off, &faces, err)))
         return -1;
     j.face_off = off, j.faces = faces;
     j.nitems = (p ? p->npatch : 0) + o->img_h;

@@ -132,19 +132,4 @@ int ppb_pp3d_image(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_ta
 double ppb_pp3d_ray(const ppb_object *o, const ppb_pp3d_map *m, const ppb_pp3d_tables *tab,
                     double step, const double p0[3], const double w_out[3], long start);
 
-/* The orthographic camera (docs/reference.md, Objects; kernels/ppb_object.h's on the object
- * branch, the same numbers): to_cam = -view_dir; right = normalise(y x to_cam) (z x to_cam
- * when |to_cam.y| > 0.999); up = to_cam x right. Square pixels of edge `pixel`, the larger of
- * the grid box's extents along right and up over img_w and img_h, the image centred on the box's
- * projection: its top-left corner at (u0, v1) along (right, up) from the box's centre. */
-typedef struct ppb_pp3d_camera {
-    double to_cam[3], right[3], up[3], centre[3];
-    double u0, v1, pixel;
-} ppb_pp3d_camera;
-
-int ppb_pp3d_camera_init(const ppb_object *o, ppb_pp3d_camera *c, ppb_err *err);
-/* Image point (x, y), in pixels from the top-left corner (a pixel's centre at + 0.5), on the
- * plane through the grid box's centre across the view. */
-void ppb_pp3d_camera_pixel(const ppb_pp3d_camera *c, double x, double y, double p[3]);
-
 #endif
