@@ -400,23 +400,29 @@ static int write_timings(const ppb_experiment *ex, const char *dir, ppb_err *err
     return ppb_afile_commit(&af, err);
 }
 
+/* The lines every provenance.txt opens with: what wrote it, when, on which device, the build. */
+static void provenance_head(FILE *f, const ppb_experiment *ex)
+{
+    char when[64];
+    time_t now = time(NULL);
+    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
+    fprintf(f, "%s: what produced the files beside this one\n", provenance_mark);
+    fprintf(f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
+            when);
+    fprintf(f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)", ex->partial);
+    ppb_provenance_write_build(f, ex->device[0] ? &ex->ocl_versions : NULL);
+}
+
 /* provenance.txt; fig: the figures left out (NULL before they are drawn). */
 static int write_provenance(const ppb_experiment *ex, const char *dir, const ppb_figures *fig,
                             ppb_err *err)
 {
-    char path[PPB_PATH_MAX + 256], when[64];
+    char path[PPB_PATH_MAX + 256];
     out_path(dir, "provenance.txt", path, sizeof path);
     ppb_afile af;
     if (ppb_afile_open(&af, path, err))
         return -1;
-    time_t now = time(NULL);
-    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
-    fprintf(af.f, "%s: what produced the files beside this one\n", provenance_mark);
-    fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
-            when);
-    fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
-            ex->partial);
-    ppb_provenance_write_build(af.f, ex->device[0] ? &ex->ocl_versions : NULL);
+    provenance_head(af.f, ex);
     for (int i = 0; i < ex->n; i++)
         if (ex->res[i].photons)
             fprintf(af.f, "%s.photons_traced = %lld\n", ex->res[i].method, ex->res[i].photons);
@@ -727,19 +733,12 @@ static int write_channel_table(const char *dir, const char *file, ppb_err *err)
 static int write_colour_provenance(const ppb_experiment *ex, const char *dir,
                                    const ppb_figures *fig, ppb_err *err)
 {
-    char path[PPB_PATH_MAX + 256], when[64];
+    char path[PPB_PATH_MAX + 256];
     out_path(dir, "provenance.txt", path, sizeof path);
     ppb_afile af;
     if (ppb_afile_open(&af, path, err))
         return -1;
-    time_t now = time(NULL);
-    strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
-    fprintf(af.f, "%s: what produced the files beside this one\n", provenance_mark);
-    fprintf(af.f, "ppbench.version = %s\nconfig.path = %s\ndate = %s\n", PPB_VERSION, ex->cfg->path,
-            when);
-    fprintf(af.f, "device = %s\npartial = %d\n", ex->device[0] ? ex->device : "(none)",
-            ex->partial);
-    ppb_provenance_write_build(af.f, ex->device[0] ? &ex->ocl_versions : NULL);
+    provenance_head(af.f, ex);
     fprintf(af.f,
             "colour.subsets = r g b y (an output set each: the channels' and the luminance's)\n"
             "colour.primaries = Rec. 709 / sRGB, linear (the material's R, G, B channels)\n"
