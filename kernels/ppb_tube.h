@@ -211,17 +211,18 @@ PPB_FN int ppb_exit_nsamples(const ppb_medium *M, int npts, int nsamp)
 }
 
 /* Sample k of such a cell, k = (ip nsamp + a) nsamp + b in [0, ppb_exit_nsamples): the exit
- * point ip of the segment (ppb_segment_sample) in (*px, *py) and the bin's direction sample
- * (a, b) in w[0..2] (ppb_bin_sample_dir). Returns the sample's index (ppb_bin_sample_index), the
- * order of the marchers' tables and source planes. */
+ * point ip of the segment (ppb_segment_sample) in (*px, *py), the bin's direction sample (a, b)
+ * in w[0..2] and its weight in *weight (ppb_bin_sample_dir: the cell's value is the sum of
+ * weight x radiance over its samples / ppb_exit_nsamples). Returns the sample's index
+ * (ppb_bin_sample_index), the order of the marchers' tables and source planes. */
 PPB_FN int ppb_exit_sample(const ppb_medium *M, int surf, int seg, int nseg, int bin, int npts,
                            int nsamp, int ntheta, int nphi, int k, double *px, double *py,
-                           double *w)
+                           double *w, double *weight)
 {
     int b = k % nsamp, a = k / nsamp % nsamp, ip = k / (nsamp * nsamp);
     npts = M->tube ? npts : 1;
     ppb_segment_sample(M->tube, surf, seg, nseg, M->width, M->height, ip, npts, px, py);
-    ppb_bin_sample_dir(surf, bin, a, b, nsamp, ntheta, nphi, &w[0], &w[1], &w[2]);
+    *weight = ppb_bin_sample_dir(surf, bin, a, b, nsamp, ntheta, nphi, &w[0], &w[1], &w[2]);
     return ppb_bin_sample_index(surf, bin, a, b, nsamp, ppb_bin_count(ntheta, nphi));
 }
 

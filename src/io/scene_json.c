@@ -35,7 +35,9 @@ static const char *const conventions[][2] = {
                   "directions weighted by projected solid angle (uniform in sin^2(theta) and "
                   "phi): energy through the segment within the bin / (segment length x w_k) per "
                   "unit length in z; bins[].directions are the n x n directions (samples_dir) "
-                  "the built-in deterministic methods average, in the local frame (n, t, b)"},
+                  "the built-in deterministic methods average, in the local frame (n, t, b), "
+                  "bins[].weights their weights (mean 1: the bin's value is the weighted "
+                  "mean; the last theta row's samples are graded toward the tangent plane)"},
     {"metrics", "rms_rel(m; P) = sqrt(sum w_k (L_m - L_r)^2 / sum w_k L_r^2) over points P and "
                 "bins k, L_r the Monte Carlo reference; noise_rel from its standard errors; "
                 "rms_excess = sqrt(max(0, rms_rel^2 - noise_rel^2))"},
@@ -124,28 +126,35 @@ static json_t *bins(const ppb_scene *sc, int n)
             double cx, cy, cz; /* the index as the tallies compute it, from the centre */
             ppb_bin_direction(PPB_S1, it, ip, 0.5, 0.5, sc->ntheta, sc->nphi, &cx, &cy, &cz);
             int index = ppb_dir_bin(PPB_S1, cx, cy, cz, sc->ntheta, sc->nphi);
-            json_t *dirs = json_array();
-            for (int a = 0; dirs && a < n; a++)
-                for (int b = 0; b < n; b++) {
-                    double w[3];
-                    local_dir(it, ip, (a + 0.5) / n, (b + 0.5) / n, sc, w);
-                    if (json_array_append_new(dirs, vec(w[0], w[1], w[2]))) {
-                        json_decref(dirs);
-                        dirs = NULL;
-                        break;
-                    }
+            /* The built-in methods' samples and weights (ppb_bin_sample_u, reference: Bins). */
+            json_t *dirs = json_array(), *wts = json_array();
+            int ok = dirs && wts;
+            for (int a = 0; ok && a < n; a++)
+                for (int b = 0; ok && b < n; b++) {
+                    double w[3], u, weight = ppb_bin_sample_u(it, a, n, sc->ntheta, &u);
+                    local_dir(it, ip, u, (b + 0.5) / n, sc, w);
+                    ok = !json_array_append_new(dirs, vec(w[0], w[1], w[2])) &&
+                         !json_array_append_new(wts, json_real(weight));
                 }
-            json_t *bn = json_pack("{sisisis[ff]s[ff]sfsfsf}", "index", index, "theta_bin", it,
-                                   "phi_bin", ip, "theta_edges", acos(lo[0]), acos(hi[0]),
-                                   "phi_edges", atan2(p0[2], p0[1]), atan2(p1[2], p1[1]),
-                                   "theta_centre", ppb_theta_bin_centre(it, sc->ntheta),
-                                   "phi_centre", ppb_phi_bin_centre(ip, sc->nphi), "w_k", wk);
-            if (!bn || !dirs || json_object_set_new(bn, "directions", dirs) ||
-                json_array_append_new(arr, bn)) {
+            json_t *bn = ok ? json_pack("{sisisis[ff]s[ff]sfsfsf}", "index", index, "theta_bin", it,
+                                        "phi_bin", ip, "theta_edges", acos(lo[0]), acos(hi[0]),
+                                        "phi_edges", atan2(p0[2], p0[1]), atan2(p1[2], p1[1]),
+                                        "theta_centre", ppb_theta_bin_centre(it, sc->ntheta),
+                                        "phi_centre", ppb_phi_bin_centre(ip, sc->nphi), "w_k", wk)
+                            : NULL;
+            /* json_object_set_new takes its value's reference even when it fails. */
+            if (!bn || json_object_set_new(bn, "directions", json_incref(dirs)) ||
+                json_object_set_new(bn, "weights", json_incref(wts)) ||
+                json_array_append_new(arr, json_incref(bn))) {
+                json_decref(dirs);
+                json_decref(wts);
                 json_decref(bn);
                 json_decref(arr);
                 return NULL;
             }
+            json_decref(dirs);
+            json_decref(wts);
+            json_decref(bn);
         }
     return arr;
 }

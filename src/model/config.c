@@ -199,9 +199,6 @@ static const key_def keys[] = {
     {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
      "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
      "truncates nothing"},
-    {"rte2d", "graded_bins", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.graded), 0, 0, "on", on_off_names,
-     "rte2d: the bins next to the face's tangent plane averaged on samples graded toward it "
-     "(Gauss points), off: the midpoints every marcher uses"},
     /* [object]: `ppbench object` only (docs/reference.md, Objects); the tube's Monte Carlo
      * never reads them, so none is part of its reference cache's key. */
     {"object", "shape", K_ENUM, PPB_NOT_MC_KEY, F(object.shape), 0, 0, "box", shape_names,
@@ -316,6 +313,17 @@ int ppb_name_distance(const char *typed, const char *known)
  * --set writes it: "light.theta_deg"). */
 static void unknown_why(const char *section, const char *key, int dotted, char *why, size_t n)
 {
+    /* Retired keys: what replaced them (docs/reference.md, Keys). */
+    static const char *const retired[][3] = {
+        {"rte2d", "graded_bins",
+         "retired key: every deterministic method grades the last theta row of bins toward the "
+         "tangent plane now (docs/reference.md, Bins); delete the line"},
+    };
+    for (size_t i = 0; i < sizeof retired / sizeof retired[0]; i++)
+        if (strcmp(section, retired[i][0]) == 0 && strcmp(key, retired[i][1]) == 0) {
+            snprintf(why, n, "%s", retired[i][2]);
+            return;
+        }
     int known = section_known(section), best = -1, bestd = 99, same = 0;
     for (int i = 0; i < NKEYS; i++) {
         int in = strcmp(keys[i].section, section) == 0;

@@ -91,7 +91,6 @@ typedef struct ppb_rte2d_settings {
     int refinements; /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
     int delta_m;     /* 1: delta-M scaling with the single-scattering correction (TMS) */
     int moment;      /* 1: the cells' phase matrix corrected to HG's first moment */
-    int graded;      /* 1: the exit's last theta row of samples graded toward the tangent plane */
 } ppb_rte2d_settings;
 
 /* A three-dimensional object's settings ([object]; docs/reference.md, Objects). Material 1 is

@@ -448,7 +448,7 @@ inline double ppb_march_ray_fresnel(const ppb_march_params *P, __global const do
 }
 
 /* One work-item per (segment row, bin): the bin-averaged exit radiance over the segment's points
- * and the bin's direction samples (reference: Bins). */
+ * and the bin's direction samples, each with its weight (reference: Bins). */
 __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *map,
                                __global const double *tabR, __global const double *tabS,
                                __global const double *coefC, __global double *out)
@@ -463,14 +463,14 @@ __kernel void ppb_march_kernel(const ppb_march_params P, __global const double *
     int ns = ppb_exit_nsamples(&P.med, P.npts, P.nsamp);
     double sum = 0.0;
     for (int k = 0; k < ns; k++) {
-        double px, py, w[3];
+        double px, py, w[3], wk;
         int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
-                                  P.nphi, k, &px, &py, w);
+                                  P.nphi, k, &px, &py, w, &wk);
         if (P.med.n > 1.0)
-            sum += ppb_march_ray_fresnel(&P, map, tabR, tabS, coefC, ndir, dir, surf, px, py, w[0],
-                                         w[1], w[2]);
+            sum += wk * ppb_march_ray_fresnel(&P, map, tabR, tabS, coefC, ndir, dir, surf, px, py,
+                                              w[0], w[1], w[2]);
         else
-            sum += ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, w[0], w[1]);
+            sum += wk * ppb_march_ray(&P, map, tabR, tabS, coefC, ndir, dir, px, py, w[0], w[1]);
     }
     out[ppb_cell_index(P.offset[surf], seg, nbins, bin)] = sum / ns;
 }

@@ -249,9 +249,10 @@ static int camera_make(const ppb_object *o, ppb_obj_camera *cam, ppb_err *err)
 }
 
 /* One boundary face's rays, added into its patch's bins (row of nbins): face f = 2 axis +
- * (side > 0) of voxel v, nsamp x nsamp directions per bin uniform in (sin^2 theta, phi) (the
- * tube's stratified samples, reference: Bins, with phi over [0, 2 pi) in the patch's frame),
- * each from its own point of the face. A patch's bin is the mean over its faces and samples:
+ * (side > 0) of voxel v, nsamp x nsamp directions per bin in (sin^2 theta, phi) with their
+ * weights (the tube's stratified samples, ppb_bin_sample_u: the last theta row graded toward the
+ * tangent plane; reference: Bins, with phi over [0, 2 pi) in the patch's frame), each from its
+ * own point of the face. A patch's bin is the mean over its faces and samples:
  * the radiance averaged over the patch's area and the bin (docs/reference.md, Objects). */
 static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb_pp3d_map *m,
                       const ppb_pp3d_tables *tab, int nsamp, double step, size_t v, int f,
@@ -275,7 +276,8 @@ static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb
         double acc = 0.0;
         for (int sa = 0; sa < nsamp; sa++)
             for (int sb = 0; sb < nsamp; sb++) {
-                double s2 = (ith + (sa + 0.5) / nsamp) / o->ntheta;
+                double u, wk = ppb_bin_sample_u(ith, sa, nsamp, o->ntheta, &u);
+                double s2 = (ith + u) / o->ntheta;
                 double st = sqrt(s2), ct = sqrt(1.0 - s2);
                 double phi = (iph + (sb + 0.5) / nsamp) * 2.0 * PPB_PI / o->nphi;
                 double w[3];
@@ -286,7 +288,7 @@ static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb
                 double q[3] = {c[0], c[1], c[2]};
                 q[(axis + 1) % 3] += ((sa + 0.5) / nsamp - 0.5) * h;
                 q[(axis + 2) % 3] += (((sa + sb) % nsamp + 0.5) / nsamp - 0.5) * h;
-                acc += ppb_pp3d_ray(o, m, tab, step, q, w, (long)v);
+                acc += wk * ppb_pp3d_ray(o, m, tab, step, q, w, (long)v);
             }
         row[bin] += wgt * acc;
     }

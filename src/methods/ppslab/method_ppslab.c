@@ -7,20 +7,20 @@
 #include "base/progress.h"
 #include "physics/ppsolver.h"
 
-/* Bin average over samples x samples directions uniform in projected solid angle (reference:
- * Bins), through ppb_bin_direction so the bins match every other method's. */
+/* Bin average over samples x samples directions, each weighted (ppb_bin_sample_dir: the
+ * midpoints in projected solid angle, the last theta row graded toward the tangent plane;
+ * reference: Bins), so the bins match every other method's. */
 static double bin_average(const pp_solution *s, const ppb_scene *sc, int surf, int bin, int samples,
                           double tau)
 {
-    int itheta = bin / sc->nphi, iphi = bin % sc->nphi;
     double sum = 0.0;
     for (int a = 0; a < samples; a++)
         for (int b = 0; b < samples; b++) {
             double w[3];
-            ppb_bin_direction(surf, itheta, iphi, (a + 0.5) / samples, (b + 0.5) / samples,
-                              sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            double wk = ppb_bin_sample_dir(surf, bin, a, b, samples, sc->ntheta, sc->nphi, &w[0],
+                                           &w[1], &w[2]);
             /* n > 1: air-side bins, the n^2 law (ppsolver.h); n = 1 as it always was */
-            sum += sc->n > 1.0 ? pp_exit_radiance(s, w) : pp_radiance(s, tau, w);
+            sum += wk * (sc->n > 1.0 ? pp_exit_radiance(s, w) : pp_radiance(s, tau, w));
         }
     return sum / ((double)samples * samples);
 }

@@ -11,7 +11,6 @@
 #include "base/clock.h"
 #include "base/memory.h"
 #include "base/progress.h"
-#include "base/quadrature.h"
 #include "kernels/ppb_fresnel.h"
 #include "methods/result_check.h"
 #include "model/metrics.h"
@@ -32,7 +31,7 @@ typedef struct rte_exit {
     int nsamp, npts, ndir;
     double *Fx; /* [ndir][nc] */
     double *bx; /* n > 1: [ndir][4] slots of the samples' mirrors (PPB_RTE_ARG_BND); else NULL */
-    double *wd; /* [ndir][4]: each sample's direction (air side) and weight (rte_bin_sample) */
+    double *wd; /* [ndir][3]: each sample's direction (air side; ppb_bin_sample_dir) */
 } rte_exit;
 
 typedef struct rte_solver {
@@ -250,31 +249,6 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, int m
 
 /* The exit directions' cell integrals of a sampling, once per solve (every exit march of that
  * sampling reuses them). */
-/* Direction sample (a, b) of bin `bin` and its weight in the bin's average (reference: Bins):
- * the midpoints of an n x n grid in (sin^2 theta, phi), weight 1, as ppb_bin_sample_dir, but in
- * the last theta row, which reaches the face's tangent plane, sin^2 theta = 1 - (1 - t)^2 / T
- * (T the theta bins) with t on the n-point Gauss-Legendre rule over [0, 1] and weight
- * n W_a 2 (1 - t_a) (the Jacobian; the weights average to 1). There the exiting radiance goes as
- * a + b cos(theta) = a + b sqrt(1 - sin^2 theta) (the Fresnel transmittance at n > 1 falls to 0
- * as cos(theta); at n = 1 a half-space's exit radiance has the same square root), which the
- * midpoints integrate with an error of order n^-1.5: the 4 x 4 samples put that bin 1.1-1.4 %
- * above the Monte Carlo at n = 1.4 (uniform_g0_normal_n14; 0.2-0.4 % at 8 x 8) and 0.3-0.4 % at
- * n = 1. In t the integrand is smooth and Gauss-Legendre exact to order 2n - 1. gl: the n-point
- * rule's nodes and weights (ppb_gauss_legendre, on [-1, 1]). */
-static void rte_bin_sample(int surf, int bin, int a, int b, int n, int ntheta, int nphi,
-                           const double *glx, const double *glw, double *w, double *weight)
-{
-    int it = bin / nphi;
-    double u = (a + 0.5) / n;
-    *weight = 1.0;
-    if (glx && it == ntheta - 1) {
-        double t = 0.5 * (1.0 - glx[a]);
-        u = 1.0 - (1.0 - t) * (1.0 - t);
-        *weight = n * 0.5 * glw[a] * 2.0 * (1.0 - t);
-    }
-    ppb_bin_direction(surf, it, bin % nphi, u, (b + 0.5) / n, ntheta, nphi, &w[0], &w[1], &w[2]);
-}
-
 static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo, int nsamp,
                       int npts, rte_exit *ex, ppb_err *err)
 {
@@ -286,23 +260,20 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
     double *w = malloc(sizeof(double) * 3 * ex->ndir);
     ex->Fx = malloc(sizeof(double) * (size_t)ex->ndir * s->G.nc);
     ex->bx = sc->n > 1.0 ? malloc(sizeof(double) * 4 * (size_t)ex->ndir) : NULL;
-    ex->wd = malloc(sizeof(double) * 4 * (size_t)ex->ndir);
-    double *glx = malloc(sizeof(double) * 2 * nsamp), *glw = glx ? glx + nsamp : NULL;
-    if (!w || !ex->Fx || (sc->n > 1.0 && !ex->bx) || !ex->wd || !glx) {
+    ex->wd = malloc(sizeof(double) * 3 * (size_t)ex->ndir);
+    if (!w || !ex->Fx || (sc->n > 1.0 && !ex->bx) || !ex->wd) {
         free(w);
-        free(glx);
         return ppb_fail(err, "rte2d: out of memory (exit source)");
     }
-    ppb_gauss_legendre(nsamp, glx, glw);
     for (int surf = 0; surf < nsurf; surf++)
         for (int bin = 0; bin < nbins; bin++)
             for (int a = 0; a < nsamp; a++)
                 for (int b = 0; b < nsamp; b++) {
                     int d = ppb_bin_sample_index(surf, bin, a, b, nsamp, nbins);
-                    rte_bin_sample(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi,
-                                   cfg->rte2d.graded ? glx : NULL, glw, &w[3 * d],
-                                   &ex->wd[4 * d + 3]);
-                    memcpy(ex->wd + 4 * d, w + 3 * d, 3 * sizeof(double));
+                    /* The kernel weights it by the same function (ppb_exit_sample). */
+                    ppb_bin_sample_dir(surf, bin, a, b, nsamp, sc->ntheta, sc->nphi, &w[3 * d],
+                                       &w[3 * d + 1], &w[3 * d + 2]);
+                    memcpy(ex->wd + 3 * d, w + 3 * d, 3 * sizeof(double));
                     if (sc->n > 1.0) {
                         /* Inside along Snell's direction (the exit kernel maps it the same
                          * way); its mirrors in each face for the wall term. */
@@ -316,7 +287,6 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
                 }
     int rc = ppb_rte_exit_coeffs(&s->G, sc->g, w, ex->ndir, ex->Fx, err);
     free(w);
-    free(glx);
     return rc;
 }
 
@@ -352,7 +322,7 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
             rc = -1;
     }
     cl_mem wd = NULL;
-    if (!rc && !(wd = buffer(s->ocl, CL_MEM_READ_ONLY, 4 * (size_t)ndir, ex->wd,
+    if (!rc && !(wd = buffer(s->ocl, CL_MEM_READ_ONLY, 3 * (size_t)ndir, ex->wd,
                              "rte2d exit samples", err)))
         rc = -1;
     ppb_rte_params P = s->G.P;

@@ -3,8 +3,8 @@
  * One refinement of Eq. 5, I_n = K I_(n-1) + I_0, is a sweep of every direction cell's tracks
  * through the flat-source regions (ppb_rte_moc, below: conservative by construction). The exit
  * radiance is a march from every segment point in every direction sample of every bin
- * (ppb_rte_exit), as `pp` averages its bins (reference: Bins; the samples and their weights the
- * host's, the last theta row graded toward the tangent plane), along q = p - l w:
+ * (ppb_rte_exit), as `pp` averages its bins (reference: Bins; ppb_bin_sample_dir's samples and
+ * weights, the last theta row graded toward the tangent plane), along q = p - l w:
  *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
  * where J is the converged scattered-light source per unit scattering coefficient (bilinear in
  * the nodes, each node its dual region's average, rte2d_params.h) and C E the direct beam's
@@ -212,13 +212,12 @@ __kernel void ppb_rte_exit(const ppb_rte_params P, __global const double *dirs,
     int ns = ppb_exit_nsamples(&P.med, P.npts, P.nsamp);
     double sum = 0.0;
     for (int k = 0; k < ns; k++) {
-        double px, py, v[3];
+        double px, py, v[3], wk;
         int dir = ppb_exit_sample(&P.med, surf, seg, P.nseg[surf], bin, P.npts, P.nsamp, P.ntheta,
-                                  P.nphi, k, &px, &py, v);
-        /* The host's sample of that index and its weight (method_rte2d.c, rte_bin_sample: the
-         * last theta row graded toward the tangent plane). */
-        v[0] = dirs[4 * dir], v[1] = dirs[4 * dir + 1], v[2] = dirs[4 * dir + 2];
-        double wk = dirs[4 * dir + 3];
+                                  P.nphi, k, &px, &py, v, &wk);
+        /* The host's copy of that sample (method_rte2d.c, exit_setup: the same
+         * ppb_bin_sample_dir), the direction its cell slots and mirrors were looked up for. */
+        v[0] = dirs[3 * dir], v[1] = dirs[3 * dir + 1], v[2] = dirs[3 * dir + 2];
         if (P.med.n > 1.0) {
             /* Air-side sample w = v: inside along Snell's direction, (1 - F) / n^2 times the
              * inside radiance (the n^2 law, reference: Medium). */
