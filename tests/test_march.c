@@ -95,13 +95,14 @@ static void test_ss_slab_closed_form(void **state)
             ppb_layout lo = ppb_scene_layout(&sc);
             for (int surf = 0; surf < 2; surf++)
                 for (int bin = 0; bin < lo.nbins; bin++) {
-                    double ref = 0.0; /* the same n x n directions the method averages */
+                    /* the same n x n directions and weights the method averages */
+                    double ref = 0.0;
                     for (int a = 0; a < n; a++)
                         for (int b = 0; b < n; b++) {
                             double w[3];
-                            ppb_bin_sample_dir(surf, bin, a, b, n, sc.ntheta, sc.nphi, &w[0], &w[1],
-                                               &w[2]);
-                            ref += ss_slab_closed(&sc, surf, w) / (n * n);
+                            double wk = ppb_bin_sample_dir(surf, bin, a, b, n, sc.ntheta, sc.nphi,
+                                                           &w[0], &w[1], &w[2]);
+                            ref += wk * ss_slab_closed(&sc, surf, w) / (n * n);
                         }
                     assert_close(rad[ppb_cell(&lo, surf, 0, bin)], ref, 1e-9 * ref + 1e-14);
                 }
@@ -183,15 +184,17 @@ static ppb_march_tables pp_tables(const ppb_scene *sc, int directions, int table
     return pp_tables_res(sc, directions, table, nsamp, PPB_MARCH_TAU_PER_MFP);
 }
 
-/* Bin average of the solver's exact exit radiance over the march's direction samples. */
+/* Bin average of the solver's exact exit radiance over the march's direction samples and
+ * weights. */
 static double solver_bin(const pp_solution *sol, const ppb_scene *sc, int surf, int bin, int n)
 {
     double sum = 0.0;
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++) {
             double w[3];
-            ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
-            sum += pp_radiance(sol, surf == PPB_S1 ? 0.0 : sc->sigma_t * sc->height, w);
+            double wk =
+                ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            sum += wk * pp_radiance(sol, surf == PPB_S1 ? 0.0 : sc->sigma_t * sc->height, w);
         }
     return sum / (n * n);
 }
@@ -388,7 +391,7 @@ static void test_tube_irregular_pieces(void **state)
 }
 
 /* Bin average of the exact exit radiance of a slab of optical thickness tau0 (sol) over the
- * march's direction samples. */
+ * march's direction samples and weights. */
 static double col_solver_bin(const pp_solution *sol, double tau0, const ppb_scene *sc, int surf,
                              int bin, int n)
 {
@@ -396,8 +399,9 @@ static double col_solver_bin(const pp_solution *sol, double tau0, const ppb_scen
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++) {
             double w[3];
-            ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
-            sum += pp_radiance(sol, surf == PPB_S1 ? 0.0 : tau0, w);
+            double wk =
+                ppb_bin_sample_dir(surf, bin, a, b, n, sc->ntheta, sc->nphi, &w[0], &w[1], &w[2]);
+            sum += wk * pp_radiance(sol, surf == PPB_S1 ? 0.0 : tau0, w);
         }
     return sum / (n * n);
 }

@@ -150,8 +150,9 @@ static double ss_slab(double t0, double alpha, double g, const double wl[3], con
     return alpha * p * mu0 / (mu0 - mu) * (exp(-t0 / mu0) - exp(-t0 / mu));
 }
 
-/* The bin average over o's direction samples (object.h's bins, uniform in sin^2 theta and phi)
- * of f at patch pa's frame. */
+/* The bin average over o's direction samples and weights (object.h's bins in sin^2 theta and
+ * phi, ppb_bin_sample_u: the last theta row graded toward the tangent plane) of f at patch pa's
+ * frame. */
 static double bin_average(const ppb_object *o, const ppb_object_patch *pa, int bin, int ns,
                           double (*f)(const double w[3], void *arg), void *arg)
 {
@@ -161,13 +162,14 @@ static double bin_average(const ppb_object *o, const ppb_object_patch *pa, int b
     double sum = 0.0;
     for (int sa = 0; sa < ns; sa++)
         for (int sb = 0; sb < ns; sb++) {
-            double s2 = (bin / o->nphi + (sa + 0.5) / ns) / o->ntheta;
+            double u, wk = ppb_bin_sample_u(bin / o->nphi, sa, ns, o->ntheta, &u);
+            double s2 = (bin / o->nphi + u) / o->ntheta;
             double phi = (bin % o->nphi + (sb + 0.5) / ns) * 2.0 * PPB_PI / o->nphi;
             double w[3];
             for (int k = 0; k < 3; k++)
                 w[k] =
                     sqrt(1.0 - s2) * pa->n[k] + sqrt(s2) * (cos(phi) * pa->t[k] + sin(phi) * b[k]);
-            sum += f(w, arg) / (ns * ns);
+            sum += wk * f(w, arg) / (ns * ns);
         }
     return sum;
 }
@@ -298,11 +300,20 @@ typedef struct shadow_arg {
     const ppb_object *o;
     int face; /* 0: the lower slab's top, 1: its bottom */
     pp_solution *sol;
+    const ppb_object_patch *pa; /* the patch averaged */
 } shadow_arg;
 
 /* ss: the lower slab's own single scattering under the beam e^{-1} it receives, and through its
  * bottom also the upper slab's (unshadowed) downward single scattering, attenuated by the lower
- * slab along the ray, e^{-2/mu} (the slab closed forms above). */
+ * slab along the ray, e^{-2/mu} (the slab closed forms above). That term is the infinite slab's;
+ * the box is 28 wide in x and z, and a ray from the bottom face travels tan(theta) sideways per
+ * unit of height: it crosses the upper slab (heights 3 to 3.5 above the bottom face) inside the
+ * box when 3.5 tan(theta) is under the distance from every point of the patch to the box's side
+ * (at least 14 - |c - 14| - r in x and z, r = sqrt(area) above the patch's half-diagonal), and
+ * leaves through the side below the upper slab, so that the term is 0, when 3 tan(theta) is over
+ * the farthest such distance, (14 + |c - 14| + r) sqrt(2). The graded last row's grazing sample
+ * (mu = 0.12 at 2 x 2 of 3 rows) is of the second kind; a direction between the two would make
+ * the box's answer depend on where on the patch the ray starts, which this test does not model. */
 static double shadow_ss(const double w[3], void *arg)
 {
     const shadow_arg *a = arg;
@@ -310,8 +321,14 @@ static double shadow_ss(const double w[3], void *arg)
     double al = a->o->material[1].albedo, g = a->o->g;
     if (a->face == 0)
         return exp(-1.0) * ss_slab(2.0, al, g, wl, w, 1);
-    return exp(-1.0) * ss_slab(2.0, al, g, wl, w, 0) +
-           ss_slab(1.0, al, g, wl, w, 0) * exp(-2.0 / -w[1]);
+    double mu = -w[1], tn = sqrt(1.0 - mu * mu) / mu, r = sqrt(a->pa->area);
+    double off = fmax(fabs(a->pa->c[0] - 14.0), fabs(a->pa->c[2] - 14.0));
+    double upper = ss_slab(1.0, al, g, wl, w, 0) * exp(-2.0 / mu);
+    if (3.0 * tn > (14.0 + off + r) * sqrt(2.0))
+        upper = 0.0; /* the ray leaves the box below the upper slab */
+    else if (!(3.5 * tn < 14.0 - off - r))
+        fail_msg("direction mu = %g: its ray leaves the box's side within the upper slab", mu);
+    return exp(-1.0) * ss_slab(2.0, al, g, wl, w, 0) + upper;
 }
 
 /* pp3d reads the lower slab's own solution under the beam it receives (pp3d.h: e^{-Dpre} R):
@@ -349,6 +366,7 @@ static void test_shadowed_slab(void **state)
         for (arg.face = 0; arg.face < 2 - mi; arg.face++) {
             double c3[3] = {14.0, arg.face ? 0.0 : 1.0, 14.0};
             int q = patch_at(&p, 1, arg.face ? -1 : 1, c3);
+            arg.pa = &p.patch[q];
             for (int bin = 0; bin < o.ntheta * o.nphi; bin++) {
                 double ref = bin_average(&o, &p.patch[q], bin, cfg.samples_dir,
                                          mi ? shadow_pp : shadow_ss, &arg);
