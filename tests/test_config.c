@@ -77,6 +77,9 @@ static void test_errors(void **state)
     (void)state;
     expect_error("unksec", "[experiment]\n\n[nope]\nx = 1\n", ":4: [nope] x: unknown section");
     expect_error("unkkey", "[medium]\nalbdo = 0.9\n", ":2: [medium] albdo: unknown key");
+    /* A retired key says what replaced it (docs/reference.md, Keys). */
+    expect_error("retired", "[rte2d]\ngraded_bins = on\n",
+                 ":2: [rte2d] graded_bins: retired key: every deterministic method grades");
     expect_error("nan", "[medium]\ng = abc\n", ":2: [medium] g: 'abc' is not a number");
     expect_error("range", "[medium]\n\ng = 1.5\n", ":3: [medium] g: 1.5 is out of range");
     expect_error("nonint", "[mc]\nphotons = 1.5e0\n", "[mc] photons: '1.5e0' is not an integer");

@@ -65,6 +65,14 @@ static void test_scene_json(void **state)
         wsum += num(b, "w_k");
         json_t *dirs = json_object_get(b, "directions");
         assert_int_equal(json_array_size(dirs), 2 * 2);
+        /* One weight per direction; a bin's weights sum to n^2, its projected solid angle in
+         * units of one midpoint sample's (reference: Bins). */
+        json_t *wts = json_object_get(b, "weights");
+        assert_int_equal(json_array_size(wts), 2 * 2);
+        double ws = 0.0;
+        for (size_t k = 0; k < json_array_size(wts); k++)
+            ws += json_number_value(json_array_get(wts, k));
+        assert_close(ws, 2.0 * 2.0, 1e-12);
         for (size_t k = 0; k < json_array_size(dirs); k++) {
             json_t *w = json_array_get(dirs, k);
             double n = json_number_value(json_array_get(w, 0));
