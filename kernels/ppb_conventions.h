@@ -2,11 +2,12 @@
  *
  * Owns: surface ids, the surface count, and their local frames (n, b = +z, t = n x b), the
  * direction bins (equal sin^2(theta) theta bins, phi folded to [0, 180] deg) and their count,
- * the (surface, segment, bin) cell index of every radiance array, segment centres and lengths,
- * the piecewise-constant medium and the Henyey-Greenstein phase function (and its factored form
- * for sums over many cosines). Where each surface's rows start (the offsets) is the host's
- * ppb_scene_layout (src/model/scene.h); kernels receive those offsets. Plain C that is
- * also OpenCL C: the host includes it from src/, kernels with -I kernels. Nothing here
+ * the deterministic methods' direction samples of a bin and their weights (with the
+ * Gauss-Legendre rule they use), the (surface, segment, bin) cell index of every radiance array,
+ * segment centres and lengths, the piecewise-constant medium and the Henyey-Greenstein phase
+ * function (and its factored form for sums over many cosines). Where each surface's rows start (the
+ * offsets) is the host's ppb_scene_layout (src/model/scene.h); kernels receive those offsets. Plain
+ * C that is also OpenCL C: the host includes it from src/, kernels with -I kernels. Nothing here
  * allocates or keeps state. */
 #ifndef PPB_CONVENTIONS_H
 #define PPB_CONVENTIONS_H

@@ -41,7 +41,7 @@
 /* Arguments of the exit march ppb_rte_exit (rte2d.cl), by index. */
 enum {
     PPB_RTE_ARG_PARAMS = 0, /* ppb_rte_params by value */
-    PPB_RTE_ARG_DIRS = 1,   /* [ndir][4]: each exit sample's direction and weight */
+    PPB_RTE_ARG_DIRS = 1,   /* [ndir][3]: each exit sample's direction (ppb_bin_sample_dir) */
     PPB_RTE_ARG_SRC = 2,    /* source planes J [ndir][nnodes], one per exit direction sample */
     PPB_RTE_ARG_OUT = 3,    /* radiance [rows][nbins] */
     PPB_RTE_ARG_RAD = 4,    /* n > 1: the converged field I [ncell][nnodes] the walls reflect */
