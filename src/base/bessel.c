@@ -22,16 +22,16 @@ static double k0_series(double x)
     return -(log(0.5 * x) + EULER_GAMMA) * i0 + rest;
 }
 
-/* A&S 9.6.24 with the trapezoidal rule: e^x K0(x) = int_0^inf exp(-x (cosh t - 1)) dt; the
- * integrand is analytic in |Im t| < pi/2, where it grows at most like e^x, so the rule's error
- * is about e^(x - pi^2/h) (Trefethen & Weideman 2014, Thm 5.1): below 1e-17 for x < 20 at
- * h = 1/8. */
-static double k0_trapezoid(double x)
+/* A&S 9.6.24 with the trapezoidal rule: e^x K_nu(x) = int_0^inf exp(-x (cosh t - 1)) cosh(nu t)
+ * dt (nu = 0, 1); the integrand is analytic in |Im t| < pi/2, where it grows at most like e^x,
+ * so the rule's error is about e^(x - pi^2/h) (Trefethen & Weideman 2014, Thm 5.1): below 1e-17
+ * for x < 20 at h = 1/8. */
+static double kn_trapezoid(int nu, double x)
 {
     const double h = 0.125;
     double sum = 0.5; /* t = 0 with the half weight */
     for (int k = 1; k < 100000; k++) {
-        double term = exp(-x * (cosh(k * h) - 1.0));
+        double term = exp(-x * (cosh(k * h) - 1.0)) * (nu ? cosh(k * h) : 1.0);
         sum += term;
         if (term < 1e-18 * sum)
             break;
@@ -39,13 +39,13 @@ static double k0_trapezoid(double x)
     return exp(-x) * h * sum;
 }
 
-/* A&S 9.7.2 at nu = 0: K0(x) ~ sqrt(pi / 2x) e^-x sum_k a_k, a_0 = 1,
- * a_k = -a_{k-1} (2k - 1)^2 / (8 k x); summed while the terms fall (to k ~ 2x). */
-static double k0_asymptotic(double x)
+/* A&S 9.7.2: K_nu(x) ~ sqrt(pi / 2x) e^-x sum_k a_k, a_0 = 1,
+ * a_k = a_{k-1} (4 nu^2 - (2k - 1)^2) / (8 k x); summed while the terms fall (to k ~ 2x). */
+static double kn_asymptotic(int nu, double x)
 {
-    double term = 1.0, sum = 1.0;
+    double term = 1.0, sum = 1.0, mu = 4.0 * nu * nu;
     for (int k = 1; k < 200; k++) {
-        double next = -term * (2.0 * k - 1.0) * (2.0 * k - 1.0) / (8.0 * k * x);
+        double next = term * (mu - (2.0 * k - 1.0) * (2.0 * k - 1.0)) / (8.0 * k * x);
         if (fabs(next) >= fabs(term))
             break;
         term = next;
@@ -56,17 +56,23 @@ static double k0_asymptotic(double x)
     return sqrt(M_PI / (2.0 * x)) * exp(-x) * sum;
 }
 
-double ppb_bessel_k0(double x)
+/* K_nu for nu = 0, 1: the series below 2 (series(x)), the trapezoid to 20, the expansion beyond. */
+static double kn(int nu, double x, double (*series)(double))
 {
     if (!(x > 0.0))
         return x == 0.0 ? INFINITY : NAN;
     if (isinf(x))
         return 0.0;
     if (x <= 2.0)
-        return k0_series(x);
+        return series(x);
     if (x < 20.0)
-        return k0_trapezoid(x);
-    return k0_asymptotic(x);
+        return kn_trapezoid(nu, x);
+    return kn_asymptotic(nu, x);
+}
+
+double ppb_bessel_k0(double x)
+{
+    return kn(0, x, k0_series);
 }
 
 /* A&S 9.6.11 at n = 1: K1(x) = 1/x + ln(x/2) I1(x) - (x/4) sum_{k>=0} (psi(k+1) + psi(k+2))
@@ -88,46 +94,7 @@ static double k1_series(double x)
     return 1.0 / x + log(0.5 * x) * 0.5 * x * i1 - 0.25 * x * rest;
 }
 
-/* A&S 9.6.24 at nu = 1: e^x K1(x) = int_0^inf exp(-x (cosh t - 1)) cosh t dt, the trapezoidal
- * rule at h = 1/8 as k0_trapezoid (the same strip of analyticity). */
-static double k1_trapezoid(double x)
-{
-    const double h = 0.125;
-    double sum = 0.5;
-    for (int k = 1; k < 100000; k++) {
-        double term = exp(-x * (cosh(k * h) - 1.0)) * cosh(k * h);
-        sum += term;
-        if (term < 1e-18 * sum)
-            break;
-    }
-    return exp(-x) * h * sum;
-}
-
-/* A&S 9.7.2 at nu = 1 (mu = 4): a_k = a_{k-1} (4 - (2k - 1)^2) / (8 k x). */
-static double k1_asymptotic(double x)
-{
-    double term = 1.0, sum = 1.0;
-    for (int k = 1; k < 200; k++) {
-        double next = term * (4.0 - (2.0 * k - 1.0) * (2.0 * k - 1.0)) / (8.0 * k * x);
-        if (fabs(next) >= fabs(term))
-            break;
-        term = next;
-        sum += term;
-        if (fabs(term) < 1e-18 * fabs(sum))
-            break;
-    }
-    return sqrt(M_PI / (2.0 * x)) * exp(-x) * sum;
-}
-
 double ppb_bessel_k1(double x)
 {
-    if (!(x > 0.0))
-        return x == 0.0 ? INFINITY : NAN;
-    if (isinf(x))
-        return 0.0;
-    if (x <= 2.0)
-        return k1_series(x);
-    if (x < 20.0)
-        return k1_trapezoid(x);
-    return k1_asymptotic(x);
+    return kn(1, x, k1_series);
 }
