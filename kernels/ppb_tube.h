@@ -192,38 +192,4 @@ PPB_FN int ppb_tube_breaks(const ppb_medium *M, double tan_l, double px, double 
     return nb;
 }
 
-/* The exit cells of the deterministic marchers (`pp`, `ss`, `rte2d`; reference: Bins): work-item
- * gid of a launch that starts at layout row row0 owns the (segment row, bin) cell
- * row0 + gid / nbins, bin gid % nbins. Returns the row's surface (-1 past the layout) with *seg
- * and *bin. */
-PPB_FN int ppb_exit_cell(int gid, int row0, int nbins, const int *offset, const int *nseg, int *seg,
-                         int *bin)
-{
-    *bin = gid % nbins;
-    return ppb_row_surface(row0 + gid / nbins, offset, nseg, seg);
-}
-
-/* The samples of such a cell: npts points of its segment (slab: the face's one point) times the
- * bin's nsamp x nsamp directions. */
-PPB_FN int ppb_exit_nsamples(const ppb_medium *M, int npts, int nsamp)
-{
-    return (M->tube ? npts : 1) * nsamp * nsamp;
-}
-
-/* Sample k of such a cell, k = (ip nsamp + a) nsamp + b in [0, ppb_exit_nsamples): the exit
- * point ip of the segment (ppb_segment_sample) in (*px, *py), the bin's direction sample (a, b)
- * in w[0..2] and its weight in *weight (ppb_bin_sample_dir: the cell's value is the sum of
- * weight x radiance over its samples / ppb_exit_nsamples). Returns the sample's index
- * (ppb_bin_sample_index), the order of the marchers' tables and source planes. */
-PPB_FN int ppb_exit_sample(const ppb_medium *M, int surf, int seg, int nseg, int bin, int npts,
-                           int nsamp, int ntheta, int nphi, int k, double *px, double *py,
-                           double *w, double *weight)
-{
-    int b = k % nsamp, a = k / nsamp % nsamp, ip = k / (nsamp * nsamp);
-    npts = M->tube ? npts : 1;
-    ppb_segment_sample(M->tube, surf, seg, nseg, M->width, M->height, ip, npts, px, py);
-    *weight = ppb_bin_sample_dir(surf, bin, a, b, nsamp, ntheta, nphi, &w[0], &w[1], &w[2]);
-    return ppb_bin_sample_index(surf, bin, a, b, nsamp, ppb_bin_count(ntheta, nphi));
-}
-
 #endif

@@ -7,6 +7,7 @@
 
 #include <math.h>
 
+#include "kernels/ppb_bin_samples.h"
 #include "methods/pp/march.h"
 #include "physics/totals.h"
 #include "methods/pp/method_pp.h"

@@ -11,6 +11,7 @@
 
 #include "base/clock.h"
 #include "kernels/march_params.h"
+#include "kernels/ppb_bin_samples.h"
 #include "methods/pp/method_pp.h"
 #include "methods/pp/method_ss.h"
 #include "methods/pp3d/pp3d.h"

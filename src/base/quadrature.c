@@ -2,7 +2,7 @@
 
 #include <math.h>
 
-#include "kernels/ppb_conventions.h"
+#include "kernels/ppb_bin_samples.h"
 
 /* The nodes of ppb_gauss_legendre_node (kernels/ppb_conventions.h), the one code of the rule. */
 void ppb_gauss_legendre(int q, double *x, double *w)

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "kernels/ppb_bin_samples.h"
 #include "base/atomic_file.h"
 #include "model/scene.h"
 

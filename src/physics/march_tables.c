@@ -1,4 +1,5 @@
 /* march_tables.c: builds the R and S tables and the beam coefficients (march_tables.h). */
+#include "kernels/ppb_bin_samples.h"
 #include "physics/march_tables.h"
 
 /* ppsolver.h first: cblas.h pulls in complex.h, whose macro I would break its prototypes. */

@@ -26,6 +26,7 @@
  * slab's, the S formula does not hold and that step uses the R rule. */
 #include "march_params.h"
 #include "ppb_beam_images.h"
+#include "ppb_bin_samples.h"
 #include "ppb_fresnel.h"
 #include "ppb_sort.h"
 

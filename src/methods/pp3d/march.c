@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "kernels/ppb_bin_samples.h"
 #include "base/progress.h"
 #include "kernels/ppb_conventions.h"
 #include "kernels/ppb_object.h"

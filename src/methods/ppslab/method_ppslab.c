@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "kernels/ppb_bin_samples.h"
 #include "base/progress.h"
 #include "physics/ppsolver.h"
 

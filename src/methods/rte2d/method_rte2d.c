@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "kernels/ppb_bin_samples.h"
 #include "base/atomic_file.h"
 #include "base/clock.h"
 #include "base/memory.h"

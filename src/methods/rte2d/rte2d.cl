@@ -22,6 +22,7 @@
  *   x = sigma_t h, a = 1 - e^{-x}; exact for a source linear along the step whatever its
  *   optical length (directions close to z cross many mfp in a short planar distance). */
 #include "ppb_beam_images.h"
+#include "ppb_bin_samples.h"
 #include "ppb_fresnel.h"
 #include "ppb_sort.h"
 #include "rte2d_params.h"
