@@ -160,6 +160,12 @@ static int run_channels(ppb_colour *col, const char *id, const ppb_method *m, pp
     for (int c = 0; c < 3; c++) {
         memcpy(out[c], &all[2 * c], (size_t)nout * sizeof *out[c]);
         end_method(&col->sub[c], id, m, nout, rc != 0, &why, seconds, ctx);
+        if (m->reference == 1) { /* each channel's own reference file (provenance.txt) */
+            ppb_experiment *s = &col->sub[c];
+            snprintf(s->mc_reference, sizeof s->mc_reference, "%s", ctx->mc_channel_reference[c]);
+            snprintf(s->mc_shipped_key, sizeof s->mc_shipped_key, "%s",
+                     ctx->mc_channel_shipped_key[c]);
+        }
     }
     return 0;
 }

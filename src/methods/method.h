@@ -55,6 +55,11 @@ typedef struct ppb_run_ctx {
     char mc_reference[4096 + 160];
     char mc_shipped_key[64];  /* its shipped layer's name, mc-<key>.bin (mc_cache.h) */
     int mc_reference_shipped; /* 1: mc_reference is the shipped layer's */
+    /* The same per channel (R, G, B) of a colour run whose reference served every channel from
+     * its own single-channel file (run_channels); "" when they were traced together. Each
+     * channel's output set names its own (provenance.txt), which `make references` ships. */
+    char mc_channel_reference[3][4096 + 160];
+    char mc_channel_shipped_key[3][64];
     ppb_method_state state[PPB_MAX_STATES];
     int nstate;
 } ppb_run_ctx;

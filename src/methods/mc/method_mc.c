@@ -651,12 +651,19 @@ static int cached_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, pp
             break;
         if (!ppb_mc_cache_get(ctx, chunk, &t[found]))
             break;
+        ppb_mc_cache_note_key(ctx, chunk);
+        snprintf(ctx->mc_channel_reference[found], sizeof ctx->mc_channel_reference[found], "%s",
+                 ctx->mc_reference);
+        snprintf(ctx->mc_channel_shipped_key[found], sizeof ctx->mc_channel_shipped_key[found],
+                 "%s", ctx->mc_shipped_key);
     }
     ctx->cfg = own;
     if (found == nch)
         return 1;
     for (int c = 0; c < found; c++)
         ppb_mc_tallies_free(&t[c]);
+    for (int c = 0; c < 3; c++)
+        ctx->mc_channel_reference[c][0] = ctx->mc_channel_shipped_key[c][0] = '\0';
     ctx->mc_reference[0] = '\0';
     ctx->mc_reference_shipped = 0;
     return 0;
@@ -671,6 +678,8 @@ int ppb_mc_run_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_r
     ctx->mc_reference[0] = '\0';
     ctx->mc_shipped_key[0] = '\0';
     ctx->mc_reference_shipped = 0;
+    for (int c = 0; c < 3; c++)
+        ctx->mc_channel_reference[c][0] = ctx->mc_channel_shipped_key[c][0] = '\0';
     ppb_mc_tallies t[PPB_MC_MAX_CH];
     memset(t, 0, sizeof t);
     ppb_mc_trace_info info = {0};
