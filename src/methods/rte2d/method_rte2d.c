@@ -775,13 +775,16 @@ static int finish_result(rte_solver *s, const ppb_config *cfg, const double *rad
 static void print_run(const ppb_config *cfg, const ppb_rte2d_stats *st,
                       const ppb_rte2d_study *study)
 {
+    char clip[64] = "";
+    if (st->clipped > 0.0) /* the series' negative lobes (phase.h): said, not silent */
+        snprintf(clip, sizeof clip, " (negative phase set to 0: %.2g of a row)", st->clipped);
     fprintf(stderr,
             "%s: rte2d: %d nodes x %d cells, %d sweeps (%.2f s each), residual %.2g, "
-            "refinement study to K = %d (%d sweeps, %.1f s), delta-M f %.3g, %.1f s\n",
+            "refinement study to K = %d (%d sweeps, %.1f s), delta-M f %.3g%s, %.1f s\n",
             cfg->name, st->nodes, st->cells, st->sweeps,
             st->sweeps ? st->t_sweeps / st->sweeps : 0.0, st->resid,
             st->record_rungs ? study->K[st->record_rungs - 1] : 0, st->record_sweeps, st->t_record,
-            st->delta_f, st->t_total);
+            st->delta_f, clip, st->t_total);
 }
 
 /* The solve of a converged or K-step run on the config cfg (under delta-M the scaled one), the
@@ -878,6 +881,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_f
         rc = finish_result(&s, cfg, rad, out, &st, err);
     st.nodes = s.G.nnodes;
     st.cells = s.G.nc;
+    st.clipped = s.G.clipped;
     st.sweeps = s.sweeps;
     st.t_sweeps = s.t_sweeps;
     double tr = ppb_now();

@@ -39,6 +39,8 @@ typedef struct ppb_rte2d_stats {
     int record_sweeps; /* its sweeps (not in sweeps) */
     double t_record;   /* seconds it took (in t_total) */
     double delta_f;    /* delta-M's truncated fraction f (0: off, or not applied) */
+    double clipped;    /* delta_m = legendre: the largest share of a phase row whose negative
+                          cell integrals were set to 0 (physics/phase.h), else 0 */
 } ppb_rte2d_stats;
 
 /* The refinement study of a converged run (reference: rte2d_refinements.csv): run where the
