@@ -202,7 +202,8 @@ static const key_def keys[] = {
      "single-scattering correction of the exit radiance: on = the truncated function an HG, "
      "legendre = the Legendre series truncated at delta_m_order"},
     {"rte2d", "delta_m_order", K_INT, PPB_NOT_MC_KEY, F(rte2d.delta_m_order), 0, 64, "0", NULL,
-     "rte2d: delta_m = legendre's truncation order L (f = g^L); 0 = sqrt(2 directions)"},
+     "rte2d: delta-M's truncation order L (f = g^L; legendre: the series' length); 0 = "
+     "sqrt(2 directions)"},
     {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
      "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
      "truncates nothing"},

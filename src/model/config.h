@@ -97,7 +97,7 @@ typedef struct ppb_rte2d_settings {
     double tol;        /* relative residual of the converged solve */
     int refinements;   /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
     int delta_m;       /* PPB_RTE_DELTA_M_*: delta-M with the single-scattering correction (TMS) */
-    int delta_m_order; /* delta_m = legendre: the truncation order L; 0 = sqrt(2 directions) */
+    int delta_m_order; /* delta-M's truncation order L (f = g^L); 0 = sqrt(2 directions) */
     int moment;        /* 1: the cells' phase matrix corrected to HG's first moment */
     int graded;        /* 1: the exit's last theta row of samples graded toward the tangent plane */
 } ppb_rte2d_settings;

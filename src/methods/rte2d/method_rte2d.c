@@ -814,7 +814,8 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
                                              : (int)lround(sqrt(2.0 * cfg->rte2d.directions));
         f = ppb_rte_delta_m_series(&cfg->scene, L, &dc->scene, &ph);
     } else {
-        f = ppb_rte_delta_m(&cfg->scene, cfg->rte2d.directions, &dc->scene);
+        f = ppb_rte_delta_m(&cfg->scene, cfg->rte2d.directions, cfg->rte2d.delta_m_order,
+                            &dc->scene);
         ph = (pp_phase_fn){dc->scene.g, 0, {0}};
     }
     ppb_rte2d_stats st;

@@ -455,9 +455,10 @@ static double delta_m_scale(const ppb_scene *sc, double f, ppb_scene *out)
     return f;
 }
 
-double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out)
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, int order, ppb_scene *out)
 {
-    return delta_m_scale(sc, sc->g > 0.0 ? pow(sc->g, sqrt(2.0 * directions)) : 0.0, out);
+    double L = order > 0 ? order : sqrt(2.0 * directions);
+    return delta_m_scale(sc, sc->g > 0.0 ? pow(sc->g, L) : 0.0, out);
 }
 
 double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_phase_fn *ph)

@@ -97,8 +97,9 @@ void ppb_rte_grid_free(ppb_rte_grid *G);
  * DISORT's f = g^(2N) for 2N streams). *out = sc with g*, and in every medium of a step
  * sigma_t' = (1 - alpha f) sigma_t, alpha' = alpha (1 - f) / (1 - alpha f) (sigma_a kept, the
  * delta part counted as unscattered). Returns f; 0 with *out = sc where the scaled media cannot
- * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. */
-double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out);
+ * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. order > 0
+ * (`[rte2d] delta_m_order`): L = order instead. */
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, int order, ppb_scene *out);
 
 /* Delta-M proper (Wiscombe 1977, as DISORT; `[rte2d] delta_m = legendre`): f = g^L and the
  * retained function the Legendre series truncated at order L with moments
