@@ -35,7 +35,7 @@ static ppb_rte_params scene_params(const ppb_scene *sc)
 {
     ppb_rte_grid G;
     ppb_err err;
-    if (ppb_rte_grid_make(sc, 0.5, 4, 0.5, 0, &G, &err))
+    if (ppb_rte_grid_make(sc, 0.5, 4, 0.5, 0, NULL, &G, &err))
         fail_msg("%s", err.msg);
     ppb_rte_params P = G.P;
     ppb_rte_grid_free(&G);

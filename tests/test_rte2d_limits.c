@@ -44,7 +44,8 @@ static void test_nodes_exact(void **state)
         ppb_rte_grid G;
         ppb_err err;
         const ppb_rte2d_settings *r = &cfg.rte2d;
-        if (ppb_rte_grid_make(&cfg.scene, r->spacing, r->directions, r->step, r->moment, &G, &err))
+        if (ppb_rte_grid_make(&cfg.scene, r->spacing, r->directions, r->step, r->moment, NULL, &G,
+                              &err))
             fail_msg("%s: %s", names[c], err.msg);
         assert_int_equal((int)ppb_rte_nodes(&cfg.scene, r->spacing), G.nnodes);
         ppb_rte_grid_free(&G);

@@ -57,6 +57,10 @@ static const enum_name channel_names[] = {
 static const enum_name delta_m_names[] = {
     {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 static const enum_name on_off_names[] = {{0, "off"}, {1, "on"}, {0, NULL}};
+static const enum_name rte_delta_m_names[] = {{PPB_RTE_DELTA_M_OFF, "off"},
+                                              {PPB_RTE_DELTA_M_HG, "on"},
+                                              {PPB_RTE_DELTA_M_LEGENDRE, "legendre"},
+                                              {0, NULL}};
 static const enum_name shape_names[] = {{PPB_OBJ_BOX, "box"},     {PPB_OBJ_SPHERE, "sphere"},
                                         {PPB_OBJ_YOKAN, "yokan"}, {PPB_OBJ_MESH, "mesh"},
                                         {PPB_OBJ_FILE, "file"},   {0, NULL}};
@@ -193,9 +197,13 @@ static const key_def keys[] = {
      "rte2d: relative residual at which the solve stops"},
     {"rte2d", "refinements", K_INT, PPB_NOT_MC_KEY, F(rte2d.refinements), 0, 10000, "0", NULL,
      "rte2d: K steps of Eq. 5 from I_pp (1 = the paper's method on the grid); 0 = converge"},
-    {"rte2d", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.delta_m), 0, 0, "on", on_off_names,
+    {"rte2d", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.delta_m), 0, 0, "on", rte_delta_m_names,
      "rte2d: delta-M scaling of the forward peak the direction cells cannot resolve, with the "
-     "single-scattering correction of the exit radiance"},
+     "single-scattering correction of the exit radiance: on = the truncated function an HG, "
+     "legendre = the Legendre series truncated at delta_m_order"},
+    {"rte2d", "delta_m_order", K_INT, PPB_NOT_MC_KEY, F(rte2d.delta_m_order), 0, 64, "0", NULL,
+     "rte2d: delta-M's truncation order L (f = g^L; legendre: the series' length); 0 = "
+     "sqrt(2 directions)"},
     {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
      "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
      "truncates nothing"},

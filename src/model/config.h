@@ -83,14 +83,22 @@ typedef struct ppb_dirpole_settings {
     int samples; /* nodes per diffusion length along the strip and per unit of t along z */
 } ppb_dirpole_settings;
 
+/* [rte2d] delta_m: none, the truncated function an HG (on), or the Legendre series (legendre). */
+typedef enum {
+    PPB_RTE_DELTA_M_OFF = 0,
+    PPB_RTE_DELTA_M_HG = 1,
+    PPB_RTE_DELTA_M_LEGENDRE = 2
+} ppb_rte_delta_m_kind;
+
 typedef struct ppb_rte2d_settings {
-    double spacing;  /* grid node spacing over the cross-section, mfp */
-    int directions;  /* direction cells per hemisphere */
-    double step;     /* march step in the x-y plane, mfp */
-    double tol;      /* relative residual of the converged solve */
-    int refinements; /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
-    int delta_m;     /* 1: delta-M scaling with the single-scattering correction (TMS) */
-    int moment;      /* 1: the cells' phase matrix corrected to HG's first moment */
+    double spacing;    /* grid node spacing over the cross-section, mfp */
+    int directions;    /* direction cells per hemisphere */
+    double step;       /* march step in the x-y plane, mfp */
+    double tol;        /* relative residual of the converged solve */
+    int refinements;   /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
+    int delta_m;       /* PPB_RTE_DELTA_M_*: delta-M with the single-scattering correction (TMS) */
+    int delta_m_order; /* delta-M's truncation order L (f = g^L); 0 = sqrt(2 directions) */
+    int moment;        /* 1: the cells' phase matrix corrected to HG's first moment */
 } ppb_rte2d_settings;
 
 /* A three-dimensional object's settings ([object]; docs/reference.md, Objects). Material 1 is

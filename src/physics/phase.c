@@ -1,4 +1,5 @@
-/* phase.c: HG cell-pair and point-cell integrals by order-adaptive product Gauss (phase.h). */
+/* phase.c: HG and truncated-series cell-pair and point-cell integrals by product Gauss
+ * (phase.h). */
 #include "physics/phase.h"
 
 #include "kernels/ppb_conventions.h"
@@ -99,6 +100,63 @@ static double pair_sum(double g, const double *na, const double *nb, int nq)
     return c1 * sum;
 }
 
+/* The series' terms (2l + 1) chi_l / (4 pi), l < L. */
+static void series_coeffs(const pp_phase_fn *ph, double *c)
+{
+    for (int l = 0; l < ph->nmom; l++)
+        c[l] = (2.0 * l + 1.0) * ph->chi[l] / (4.0 * PPB_PI);
+}
+
+/* sum_{l < L} c_l P_l(x) by the upward three-term recurrence of P_l (stable on [-1, 1]). */
+static double series_sum(const double *c, int L, double x)
+{
+    double p0 = 1.0, p1 = x, sum = c[0] + (L > 1 ? c[1] * x : 0.0);
+    for (int l = 1; l + 1 < L; l++) {
+        double p2 = ((2.0 * l + 1.0) * x * p1 - l * p0) / (l + 1.0);
+        sum += c[l + 1] * p2;
+        p0 = p1, p1 = p2;
+    }
+    return sum;
+}
+
+double pp_phase_eval(const pp_phase_fn *ph, double cos_theta)
+{
+    if (ph->nmom == 0)
+        return pp_hg(ph->g, cos_theta);
+    double c[PP_SERIES_MAX];
+    series_coeffs(ph, c);
+    return series_sum(c, ph->nmom, cos_theta);
+}
+
+/* Gauss order per axis for the series over cells of half-length h: along an axis it is a
+ * trigonometric polynomial of degree L - 1 (L with the sin(theta) weight), and Gauss-Legendre
+ * on [-h, h] integrates e^{i L t} to about (e L h / 4q)^{2q}; the least q with that under
+ * PHASE_TOL, at least 2, at most PP_QMAX (6 at L = 16 on 128 cells, where the ring sums of
+ * tests/test_phase_series.c agree with the addition theorem within 1e-12 sr^2). */
+static int series_order(int L, double h)
+{
+    for (int q = 2; q < PP_QMAX; q++)
+        if (2.0 * q * log(exp(1.0) * L * h / (4.0 * q)) < log(PHASE_TOL))
+            return q;
+    return PP_QMAX;
+}
+
+/* Sum over node pairs of w_a w_b p(x_a . x_b) for the series with terms c. */
+static double series_pair_sum(const double *c, int L, const double *na, const double *nb, int nq)
+{
+    double sum = 0.0;
+    for (int a = 0; a < nq; a++) {
+        const double *x = na + 4 * a;
+        double inner = 0.0;
+        for (int b = 0; b < nq; b++) {
+            const double *y = nb + 4 * b;
+            inner += y[3] * series_sum(c, L, dot3(x, y));
+        }
+        sum += x[3] * inner;
+    }
+    return sum;
+}
+
 static double cell_radius(const pp_dirs *d, int cell)
 {
     return d->radius[cell % d->n];
@@ -153,11 +211,22 @@ static int azimuth_order(const pp_dirs *d, double g, int a, const double *cb)
 }
 
 /* S between cells a and b (any hemispheres), a != b; cr, sr: cosines and sines of the up
- * cells' corner radii. */
-static int pair_integral(pp_dirs *d, double g, int a, int b, const double *cr, const double *sr,
-                         double *out, ppb_err *err)
+ * cells' corner radii (HG only). */
+static int pair_integral(pp_dirs *d, const pp_phase_fn *ph, int a, int b, const double *cr,
+                         const double *sr, double *out, ppb_err *err)
 {
     int ua = a % d->n, ub = b % d->n;
+    if (ph->nmom > 0) {
+        int q = series_order(ph->nmom, fmax(cell_half(d, a), cell_half(d, b)));
+        const double *na = pp_dirs_nodes(d, a, q, err), *nb = pp_dirs_nodes(d, b, q, err);
+        if (!na || !nb)
+            return -1;
+        double c[PP_SERIES_MAX];
+        series_coeffs(ph, c);
+        *out = series_pair_sum(c, ph->nmom, na, nb, q * q);
+        return 0;
+    }
+    double g = ph->g;
     double cos_r = cr[ua] * cr[ub] - sr[ua] * sr[ub], sin_r = sr[ua] * cr[ub] + cr[ua] * sr[ub];
     double cmin = cos_gap(g, d->centre + 3 * a, d->centre + 3 * b, cos_r, sin_r);
     int q = gauss_order(g, cmin, fmax(cell_half(d, a), cell_half(d, b)));
@@ -169,6 +238,18 @@ static int pair_integral(pp_dirs *d, double g, int a, int b, const double *cr, c
     if (!na || !nb)
         return -1;
     *out = pair_sum(g, na, nb, q * q);
+    return 0;
+}
+
+static int check_series(const pp_phase_fn *ph, ppb_err *err)
+{
+    if (ph->nmom < 1 || ph->nmom > PP_SERIES_MAX)
+        return ppb_fail(err, "phase series: %d moments, need 1 .. %d", ph->nmom, PP_SERIES_MAX);
+    for (int l = 0; l < ph->nmom; l++)
+        if (!(fabs(ph->chi[l]) <= 1.0))
+            return ppb_fail(err, "phase series: moment %d = %g, need |chi| <= 1", l, ph->chi[l]);
+    if (ph->chi[0] != 1.0)
+        return ppb_fail(err, "phase series: chi_0 = %g, need 1", ph->chi[0]);
     return 0;
 }
 
@@ -239,9 +320,31 @@ static int antipodal(const pp_dirs *d)
     return 1;
 }
 
+/* A series' negative cell integrals set to 0 (phase.h), S_ij and S_ji alike, so S stays
+ * symmetric; the diagonal, conserved afterwards, takes what they held. *clipped: the largest
+ * share of a row so moved. */
+static void clip_negative(const pp_dirs *d, double *Sa, double *Sb, double *clipped)
+{
+    size_t n = (size_t)d->n;
+    double most = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double row = 0.0;
+        for (size_t j = 0; j < n; j++) {
+            if (j != i && Sa[i * n + j] < 0.0)
+                row -= Sa[i * n + j], Sa[i * n + j] = 0.0;
+            if (Sb[i * n + j] < 0.0)
+                row -= Sb[i * n + j], Sb[i * n + j] = 0.0;
+        }
+        most = fmax(most, row / d->solid);
+    }
+    if (clipped)
+        *clipped = most;
+}
+
 /* The blocks by quadrature: one pair integral per orbit of the ring pair's rotations, the z
  * mirror and the transpose (each orbit's members are copied, so the symmetries hold exactly). */
-static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
+static int blocks_by_quadrature(pp_dirs *d, const pp_phase_fn *ph, double *Sa, double *Sb,
+                                double *clipped, ppb_err *err)
 {
     size_t n = (size_t)d->n;
     unsigned char *done = calloc(n * n, 1);
@@ -262,8 +365,8 @@ static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, pp
                 continue;
             double va = 0.0, vb = 0.0;
             if (j > i)
-                rc |= pair_integral(d, g, i, j, cr, sr, &va, err);
-            rc |= pair_integral(d, g, i, d->n + j, cr, sr, &vb, err);
+                rc |= pair_integral(d, ph, i, j, cr, sr, &va, err);
+            rc |= pair_integral(d, ph, i, d->n + j, cr, sr, &vb, err);
             int si, sj, G = ring_pair_symmetry(d, i, j, &si, &sj);
             for (int t = 0; t < G; t++) {
                 int it = turn(d, i, t * si), jt = turn(d, j, t * sj);
@@ -276,21 +379,30 @@ static int blocks_by_quadrature(pp_dirs *d, double g, double *Sa, double *Sb, pp
     }
     free(zm), free(cr), free(sr);
     free(done);
+    if (rc == 0 && ph->nmom > 0)
+        clip_negative(d, Sa, Sb, clipped);
     if (rc == 0)
         conserve_rows(d, Sa, Sb);
     return rc;
 }
 
-int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
+int pp_phase_blocks_fn(pp_dirs *d, const pp_phase_fn *ph, double *Sa, double *Sb, double *clipped,
+                       ppb_err *err)
 {
+    if (clipped)
+        *clipped = 0.0;
+    if (ph->nmom > 0) /* no peak: integrated directly for either sign of its moments */
+        return check_series(ph, err) ? -1 : blocks_by_quadrature(d, ph, Sa, Sb, clipped, err);
+    double g = ph->g;
     if (check_g(g, err) != 0)
         return -1;
     if (g >= 0 || !antipodal(d))
-        return blocks_by_quadrature(d, g, Sa, Sb, err);
+        return blocks_by_quadrature(d, ph, Sa, Sb, NULL, err);
     /* p(x.y; g) = p(x.(-y); -g): S(i, j; g) = S(i, antipode(j); -g). With a the up cell of
      * antipode(up j), Sa(g)_ij = Sb(-g)_i,a(j) and Sb(g)_ij = Sa(-g)_i,a(j): the peak of the
      * backward matrix is the conserved self term of the forward one. */
-    if (blocks_by_quadrature(d, -g, Sa, Sb, err) != 0)
+    pp_phase_fn neg = {-g, 0, {0}};
+    if (blocks_by_quadrature(d, &neg, Sa, Sb, NULL, err) != 0)
         return -1;
     size_t n = (size_t)d->n;
     for (size_t i = 0; i < n; i++) {
@@ -308,11 +420,17 @@ int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
     return 0;
 }
 
-int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err)
+int pp_phase_blocks(pp_dirs *d, double g, double *Sa, double *Sb, ppb_err *err)
+{
+    pp_phase_fn ph = {g, 0, {0}};
+    return pp_phase_blocks_fn(d, &ph, Sa, Sb, NULL, err);
+}
+
+int pp_phase_matrix_fn(pp_dirs *d, const pp_phase_fn *ph, double *P, double *clipped, ppb_err *err)
 {
     size_t n = (size_t)d->n, m = 2 * n;
     double *Sa = malloc(sizeof(double) * n * n), *Sb = malloc(sizeof(double) * n * n);
-    int rc = (Sa && Sb) ? pp_phase_blocks(d, g, Sa, Sb, err)
+    int rc = (Sa && Sb) ? pp_phase_blocks_fn(d, ph, Sa, Sb, clipped, err)
                         : ppb_fail(err, "phase matrix: out of memory");
     for (size_t i = 0; rc == 0 && i < n; i++) {
         for (size_t j = 0; j < n; j++) {
@@ -323,6 +441,12 @@ int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err)
     free(Sa);
     free(Sb);
     return rc;
+}
+
+int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err)
+{
+    pp_phase_fn ph = {g, 0, {0}};
+    return pp_phase_matrix_fn(d, &ph, P, NULL, err);
 }
 
 static void rect_dir(double theta, double phi, double ysign, double *v)
@@ -409,8 +533,43 @@ static int row_by_quadrature(pp_dirs *d, double g, const double w[3], double *F,
     return 0;
 }
 
-int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err)
+/* F of the series: one q x q rule per cell (series_order), negative cells set to 0
+ * (phase.h), the cell holding w by conservation. */
+static int row_series(pp_dirs *d, const pp_phase_fn *ph, const double w[3], double *F,
+                      double *clipped, ppb_err *err)
 {
+    int m = 2 * d->n, own = pp_dirs_cell_of(d, w);
+    double c[PP_SERIES_MAX], rest = 0.0, neg = 0.0;
+    series_coeffs(ph, c);
+    for (int j = 0; j < m; j++) {
+        if (j == own)
+            continue;
+        int q = series_order(ph->nmom, cell_half(d, j));
+        const double *nj = pp_dirs_nodes(d, j, q, err);
+        if (!nj)
+            return -1;
+        double sum = 0.0;
+        for (int b = 0; b < q * q; b++)
+            sum += nj[4 * b + 3] * series_sum(c, ph->nmom, dot3(w, nj + 4 * b));
+        if (sum < 0.0)
+            neg -= sum, sum = 0.0;
+        F[j] = sum;
+        rest += sum;
+    }
+    F[own] = 1.0 - rest;
+    if (clipped)
+        *clipped = neg;
+    return 0;
+}
+
+int pp_phase_row_fn(pp_dirs *d, const pp_phase_fn *ph, const double w[3], double *F,
+                    double *clipped, ppb_err *err)
+{
+    if (clipped)
+        *clipped = 0.0;
+    if (ph->nmom > 0)
+        return check_series(ph, err) ? -1 : row_series(d, ph, w, F, clipped, err);
+    double g = ph->g;
     if (check_g(g, err) != 0)
         return -1;
     if (g >= 0 || !antipodal(d))
@@ -426,4 +585,10 @@ int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *er
         }
     }
     return 0;
+}
+
+int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err)
+{
+    pp_phase_fn ph = {g, 0, {0}};
+    return pp_phase_row_fn(d, &ph, w, F, NULL, err);
 }

@@ -31,6 +31,15 @@
  * On a partition without antipodes (the default one for even N) g < 0 is integrated directly,
  * with the old limitation: the backward peak's residual lands on the diagonal (-1e-2 of a row
  * at N = 40, g = -0.95; rows still sum to 1). */
+/* The truncated Legendre series (pp_phase_fn with nmom = L > 0; reference: Methods, `rte2d`,
+ * delta-M): p(cos) = sum_{l < L} (2l + 1) chi_l P_l(cos) / (4 pi), a polynomial of degree L - 1,
+ * which delta-M's Legendre truncation retains (Wiscombe 1977). It is entire, so one product
+ * Gauss order per pair fixed by L times the cells' half-length integrates it (pp_phase_series_
+ * order); the symmetries, the orbits and the conserved self terms are the HG matrix's. A
+ * truncated series can dip below 0 (at g = 0.9, L = 16 down to -0.013 / sr near cos = -1): a
+ * negative cell integral is set to 0 before the rows are conserved (S stays symmetric, rows sum
+ * to 1, no cell receives negative light), and the largest share of a row so moved is reported
+ * (*clipped). */
 #ifndef PPB_PHASE_H
 #define PPB_PHASE_H
 
@@ -49,5 +58,27 @@ int pp_phase_matrix(pp_dirs *d, double g, double *P, ppb_err *err);
 
 /* F[j] = integral over cell j of p(w . w') dw' for j in [0, 2N), summing to 1. */
 int pp_phase_row(pp_dirs *d, double g, const double w[3], double *F, ppb_err *err);
+
+#define PP_SERIES_MAX 64 /* Legendre moments a series phase function may have */
+
+/* A phase function the cells integrate: HG(g) where nmom = 0, else the series of the moments
+ * chi[0 .. nmom - 1] (chi[0] = 1; g unused). */
+typedef struct pp_phase_fn {
+    double g;
+    int nmom;
+    double chi[PP_SERIES_MAX];
+} pp_phase_fn;
+
+/* The phase function per steradian at cos (HG or the series, by Clenshaw's recurrence). */
+double pp_phase_eval(const pp_phase_fn *ph, double cos_theta);
+
+/* pp_phase_blocks, pp_phase_matrix and pp_phase_row of either kind of phase function; clipped
+ * (may be NULL): for a series the largest share of a row whose negative integrals were set to
+ * 0, else 0. */
+int pp_phase_blocks_fn(pp_dirs *d, const pp_phase_fn *ph, double *Sa, double *Sb, double *clipped,
+                       ppb_err *err);
+int pp_phase_matrix_fn(pp_dirs *d, const pp_phase_fn *ph, double *P, double *clipped, ppb_err *err);
+int pp_phase_row_fn(pp_dirs *d, const pp_phase_fn *ph, const double w[3], double *F,
+                    double *clipped, ppb_err *err);
 
 #endif

@@ -198,13 +198,13 @@ static int matvec(void *ctx, const double *x, double *y, ppb_err *err)
 }
 
 static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, int moment,
-                       size_t src_planes, size_t out_cells, ppb_err *err)
+                       const pp_phase_fn *ph, size_t src_planes, size_t out_cells, ppb_err *err)
 {
     memset(s, 0, sizeof *s);
     s->ocl = ocl;
     const ppb_rte2d_settings *r = &cfg->rte2d;
     ppb_rte_grid *G = &s->G;
-    if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, moment, G, err))
+    if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, moment, ph, G, err))
         return -1;
     s->nvec = ppb_rte_nvec(G);
     size_t nq = (size_t)G->nc * G->nf, nb = (size_t)G->nc * G->nb;
@@ -286,7 +286,7 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
                         bx[PPB_S3] = bx[PPB_S4] = s->G.slot[pp_dirs_cell_of(&s->G.dirs, mx)];
                     }
                 }
-    int rc = ppb_rte_exit_coeffs(&s->G, sc->g, w, ex->ndir, ex->Fx, err);
+    int rc = ppb_rte_exit_coeffs(&s->G, w, ex->ndir, ex->Fx, err);
     free(w);
     return rc;
 }
@@ -746,25 +746,29 @@ static int finish_result(rte_solver *s, const ppb_config *cfg, const double *rad
 static void print_run(const ppb_config *cfg, const ppb_rte2d_stats *st,
                       const ppb_rte2d_study *study)
 {
+    char clip[64] = "";
+    if (st->clipped > 0.0) /* the series' negative lobes (phase.h): said, not silent */
+        snprintf(clip, sizeof clip, " (negative phase set to 0: %.2g of a row)", st->clipped);
     fprintf(stderr,
             "%s: rte2d: %d nodes x %d cells, %d sweeps (%.2f s each), residual %.2g, "
-            "refinement study to K = %d (%d sweeps, %.1f s), delta-M f %.3g, %.1f s\n",
+            "refinement study to K = %d (%d sweeps, %.1f s), delta-M f %.3g%s, %.1f s\n",
             cfg->name, st->nodes, st->cells, st->sweeps,
             st->sweeps ? st->t_sweeps / st->sweeps : 0.0, st->resid,
             st->record_rungs ? study->K[st->record_rungs - 1] : 0, st->record_sweeps, st->t_record,
-            st->delta_f, st->t_total);
+            st->delta_f, clip, st->t_total);
 }
 
-/* The solve of a converged or K-step run on the config cfg (under delta-M the scaled one),
- * the beam's first scattering along the exit rays with phase g_ss and weight ss_w. */
-static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, double ss_w,
-                       ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
+/* The solve of a converged or K-step run on the config cfg (under delta-M the scaled one), the
+ * cells integrating ph (NULL: HG of cfg's g), the beam's first scattering along the exit rays
+ * with phase g_ss and weight ss_w. */
+static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_fn *ph, double g_ss,
+                       double ss_w, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err);
 
 int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err)
 {
     const ppb_config *cfg = ctx->cfg;
     if (!cfg->rte2d.delta_m)
-        return rte2d_solve(ctx, cfg, cfg->scene.g, 1.0, out, stats, err);
+        return rte2d_solve(ctx, cfg, NULL, cfg->scene.g, 1.0, out, stats, err);
     /* Delta-M (ppb_rte_delta_m): the whole solve on the scaled medium, so the grid, the beam's
      * collisions (attenuated with sigma_t'), I_pp, the walls and the ballistic total are the
      * scaled problem's and its balance closes; the exit rays' first scattering then takes the
@@ -773,17 +777,28 @@ int ppb_rte2d_run(ppb_run_ctx *ctx, ppb_result *out, ppb_rte2d_stats *stats, ppb
     if (!dc)
         return ppb_fail(err, "rte2d: out of memory");
     *dc = *cfg;
-    double f = ppb_rte_delta_m(&cfg->scene, cfg->rte2d.directions, &dc->scene);
+    pp_phase_fn ph;
+    double f;
+    if (cfg->rte2d.delta_m == PPB_RTE_DELTA_M_LEGENDRE) {
+        /* the retained function the truncated Legendre series, L = sqrt(2N) unless given */
+        int L = cfg->rte2d.delta_m_order > 0 ? cfg->rte2d.delta_m_order
+                                             : (int)lround(sqrt(2.0 * cfg->rte2d.directions));
+        f = ppb_rte_delta_m_series(&cfg->scene, L, &dc->scene, &ph);
+    } else {
+        f = ppb_rte_delta_m(&cfg->scene, cfg->rte2d.directions, cfg->rte2d.delta_m_order,
+                            &dc->scene);
+        ph = (pp_phase_fn){dc->scene.g, 0, {0}};
+    }
     ppb_rte2d_stats st;
-    int rc = rte2d_solve(ctx, dc, cfg->scene.g, 1.0 / (1.0 - f), out, &st, err);
+    int rc = rte2d_solve(ctx, dc, &ph, cfg->scene.g, 1.0 / (1.0 - f), out, &st, err);
     if (stats)
         *stats = st;
     free(dc);
     return rc;
 }
 
-static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, double ss_w,
-                       ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err)
+static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_fn *ph, double g_ss,
+                       double ss_w, ppb_result *out, ppb_rte2d_stats *stats, ppb_err *err)
 {
     double t0 = ppb_now();
     const ppb_layout *lo = &out->layout;
@@ -815,7 +830,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, dou
     double g = cfg->scene.g;
     int moment =
         cfg->rte2d.moment && !(g > 0.0 && pow(g, sqrt(2.0 * cfg->rte2d.directions)) >= 1e-3);
-    if (solver_init(&s, ocl, cfg, moment, planes, lo->ncells, err) ||
+    if (solver_init(&s, ocl, cfg, moment, ph, planes, lo->ncells, err) ||
         exit_setup(&s, cfg, lo, nsamp, cfg->samples_seg < 1 ? 1 : cfg->samples_seg, &ex, err)) {
         free(ex.Fx);
         free(ex.bx);
@@ -838,6 +853,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, double g_ss, dou
         rc = finish_result(&s, cfg, rad, out, &st, err);
     st.nodes = s.G.nnodes;
     st.cells = s.G.nc;
+    st.clipped = s.G.clipped;
     st.sweeps = s.sweeps;
     st.t_sweeps = s.t_sweeps;
     double tr = ppb_now();

@@ -16,8 +16,9 @@
  * reflection (a march reaching a face adds F times the mirror cell's radiance there, so GMRES
  * iterates it with the scattering), and the exit march maps each air-side sample inside by Snell,
  * (1 - F) / n^2.
- * Delta-M (`[rte2d] delta_m`, rte2d_grid.h's ppb_rte_delta_m): all of this on the scaled medium,
- * the exit rays' first scattering with the exact phase (TMS). */
+ * Delta-M (`[rte2d] delta_m`, rte2d_grid.h's ppb_rte_delta_m, or ppb_rte_delta_m_series for
+ * `legendre`, whose cells integrate the truncated Legendre series): all of this on the scaled
+ * medium, the exit rays' first scattering with the exact phase (TMS). */
 #ifndef PPB_METHOD_RTE2D_H
 #define PPB_METHOD_RTE2D_H
 
@@ -39,6 +40,8 @@ typedef struct ppb_rte2d_stats {
     int record_sweeps; /* its sweeps (not in sweeps) */
     double t_record;   /* seconds it took (in t_total) */
     double delta_f;    /* delta-M's truncated fraction f (0: off, or not applied) */
+    double clipped;    /* delta_m = legendre: the largest share of a phase row whose negative
+                          cell integrals were set to 0 (physics/phase.h), else 0 */
 } ppb_rte2d_stats;
 
 /* The refinement study of a converged run (reference: rte2d_refinements.csv): run where the

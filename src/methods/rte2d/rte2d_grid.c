@@ -97,7 +97,7 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
     double s = P->sin_theta_l, c = P->cos_theta_l;
     double wu[3][3] = {{s, c, 0.0}, {-s, -c, 0.0}, {-s, c, 0.0}};
     for (int k = 0; k < 3; k++)
-        if (pp_phase_row(&G->dirs, sc->g, wu[k], Fu + (size_t)k * m, err)) {
+        if (pp_phase_row_fn(&G->dirs, &G->phase, wu[k], Fu + (size_t)k * m, NULL, err)) {
             free(Fu);
             return -1;
         }
@@ -439,10 +439,10 @@ double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int re
     return 8.0 * (nodes * nc * (restart + 8) + 4.0 * directions * directions);
 }
 
-double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out)
+/* The scaled medium of truncation f (ppb_rte_delta_m); 0 where not done. */
+static double delta_m_scale(const ppb_scene *sc, double f, ppb_scene *out)
 {
     *out = *sc;
-    double f = sc->g > 0.0 ? pow(sc->g, sqrt(2.0 * directions)) : 0.0;
     int albedo_step = sc->geometry == PPB_GEOM_TUBE && sc->step == PPB_STEP_ALBEDO &&
                       sc->albedo_right != sc->albedo;
     if (!(f >= 1e-12) || albedo_step)
@@ -455,10 +455,35 @@ double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out)
     return f;
 }
 
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, int order, ppb_scene *out)
+{
+    double L = order > 0 ? order : sqrt(2.0 * directions);
+    return delta_m_scale(sc, sc->g > 0.0 ? pow(sc->g, L) : 0.0, out);
+}
+
+double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_phase_fn *ph)
+{
+    memset(ph, 0, sizeof *ph);
+    ph->g = sc->g;
+    L = L < 2 ? 2 : (L > PP_SERIES_MAX ? PP_SERIES_MAX : L);
+    double f = delta_m_scale(sc, sc->g > 0.0 ? pow(sc->g, L) : 0.0, out);
+    if (f == 0.0)
+        return 0.0;
+    ph->nmom = L;
+    for (int l = 0; l < L; l++)
+        ph->chi[l] = (pow(sc->g, l) - f) / (1.0 - f);
+    ph->chi[0] = 1.0;
+    out->g = ph->chi[1];
+    return f;
+}
+
 int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep, int moment,
-                      ppb_rte_grid *G, ppb_err *err)
+                      const pp_phase_fn *ph, ppb_rte_grid *G, ppb_err *err)
 {
     memset(G, 0, sizeof *G);
+    G->phase.g = sc->g;
+    if (ph)
+        G->phase = *ph;
     if (!(spacing > 0.0) || !(hstep > 0.0) || directions < 1)
         return ppb_fail(err, "rte2d: spacing, step and directions must be positive");
     int tube = sc->geometry == PPB_GEOM_TUBE;
@@ -526,9 +551,9 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     double wl[3] = {P->sin_theta_l, -P->cos_theta_l, 0.0};
     rc = (G->dir4 && G->Pf) ? 0 : ppb_fail(err, "rte2d: out of memory");
     if (!rc)
-        rc = pp_phase_matrix(&G->dirs, sc->g, Pfull, err);
+        rc = pp_phase_matrix_fn(&G->dirs, &G->phase, Pfull, &G->clipped, err);
     if (!rc)
-        rc = pp_phase_row(&G->dirs, sc->g, wl, F, err);
+        rc = pp_phase_row_fn(&G->dirs, &G->phase, wl, F, NULL, err);
     if (!rc && moment)
         G->moment_b = ppb_rte_moment_fix(&G->dirs, sc->g, Pfull);
     if (!rc) {
@@ -580,8 +605,7 @@ void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J)
                 x, G->nf + G->nb, 0.0, J, G->nf);
 }
 
-int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, double *F,
-                        ppb_err *err)
+int ppb_rte_exit_coeffs(ppb_rte_grid *G, const double *w, int ndir, double *F, ppb_err *err)
 {
     int m = 2 * G->dirs.n;
     double *row = malloc(sizeof(double) * m);
@@ -589,7 +613,7 @@ int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, do
         return ppb_fail(err, "rte2d: out of memory");
     memset(F, 0, sizeof(double) * (size_t)ndir * G->nc);
     for (int d = 0; d < ndir; d++) {
-        if (pp_phase_row(&G->dirs, g, w + 3 * d, row, err)) {
+        if (pp_phase_row_fn(&G->dirs, &G->phase, w + 3 * d, row, NULL, err)) {
             free(row);
             return -1;
         }

@@ -28,20 +28,23 @@
 #include "methods/rte2d/rte2d_params.h"
 #include "model/scene.h"
 #include "physics/directions.h"
+#include "physics/phase.h"
 
 typedef struct ppb_rte_grid {
     ppb_rte_params P; /* the grid and medium fields (launch fields left to the caller) */
     int nnodes;
-    pp_dirs dirs;    /* the solver's partition: antipodal for g < 0, as ppsolver.c builds it */
-    int nc;          /* transported cells */
-    int *rep;        /* [nc]: the cell of dirs each transported cell is */
-    int *slot;       /* [2N]: transported index of every cell (its mirror's where not itself) */
-    double *mult;    /* [nc]: 1 or 2, cells the transported one stands for */
-    double *dir4;    /* [nc][4]: transport direction (the centre; in the tube x scaled so the
-                        cells integrate w_x^2 exactly) and the cell average of p(w.w_L) */
-    double *Pf;      /* [nc][nc] row-major: folded phase matrix */
-    double moment_b; /* the first-moment correction's mix b (0: none; ppb_rte_moment_fix) */
-    double *bnd;     /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
+    pp_dirs dirs;      /* the solver's partition: antipodal for g < 0, as ppsolver.c builds it */
+    int nc;            /* transported cells */
+    int *rep;          /* [nc]: the cell of dirs each transported cell is */
+    int *slot;         /* [2N]: transported index of every cell (its mirror's where not itself) */
+    double *mult;      /* [nc]: 1 or 2, cells the transported one stands for */
+    double *dir4;      /* [nc][4]: transport direction (the centre; in the tube x scaled so the
+                          cells integrate w_x^2 exactly) and the cell average of p(w.w_L) */
+    double *Pf;        /* [nc][nc] row-major: folded phase matrix */
+    pp_phase_fn phase; /* what the cells integrate: HG(g), or delta-M's truncated series */
+    double clipped;    /* series: the largest share of a row set to 0 (phase.h), else 0 */
+    double moment_b;   /* the first-moment correction's mix b (0: none; ppb_rte_moment_fix) */
+    double *bnd;       /* n > 1: [nc][9] walls (rte2d_params.h, PPB_RTE_ARG_BND); NULL at n = 1 */
     /* The flat-source regions (FSRs) of the conservative sweep: the nodes' dual cells, the
      * column of the node on the step split in two at step_x (so sigma_t and alpha are constant
      * in each); slab: one column of unit width. */
@@ -80,9 +83,11 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x);
  * the beam reflected at S2. */
 
 /* Builds the grid with node spacing about `spacing` mfp (each part of the x range, and y, get
- * ceil(length / spacing) cells), `directions` cells per hemisphere and march step hstep mfp. */
+ * ceil(length / spacing) cells), `directions` cells per hemisphere and march step hstep mfp;
+ * the cells integrate ph (every phase integral of the grid: matrix, beam, walls, exit rows), or
+ * HG(sc->g) where ph is NULL. */
 int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep, int moment,
-                      ppb_rte_grid *G, ppb_err *err);
+                      const pp_phase_fn *ph, ppb_rte_grid *G, ppb_err *err);
 void ppb_rte_grid_free(ppb_rte_grid *G);
 
 /* Delta-M (Wiscombe 1977; reference: Methods, `rte2d`): the phase function p_g taken as
@@ -92,8 +97,17 @@ void ppb_rte_grid_free(ppb_rte_grid *G);
  * DISORT's f = g^(2N) for 2N streams). *out = sc with g*, and in every medium of a step
  * sigma_t' = (1 - alpha f) sigma_t, alpha' = alpha (1 - f) / (1 - alpha f) (sigma_a kept, the
  * delta part counted as unscattered). Returns f; 0 with *out = sc where the scaled media cannot
- * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. */
-double ppb_rte_delta_m(const ppb_scene *sc, int directions, ppb_scene *out);
+ * be written as a scene (an albedo step: sigma_t' would step too) or f < 1e-12. order > 0
+ * (`[rte2d] delta_m_order`): L = order instead. */
+double ppb_rte_delta_m(const ppb_scene *sc, int directions, int order, ppb_scene *out);
+
+/* Delta-M proper (Wiscombe 1977, as DISORT; `[rte2d] delta_m = legendre`): f = g^L and the
+ * retained function the Legendre series truncated at order L with moments
+ * chi*_l = (g^l - f) / (1 - f), l < L (*ph, pp_phase_fn; a polynomial in cos the cells hold,
+ * unlike HG(g*)); *out scaled as ppb_rte_delta_m's, with out->g = chi*_1 = g*. L in
+ * [2, PP_SERIES_MAX]. Returns f; 0 with *out = sc and ph an HG of sc->g where the scaling is not
+ * done (ppb_rte_delta_m's conditions). */
+double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_phase_fn *ph);
 
 /* The first-moment correction of the full 2N x 2N cell phase matrix P (pp_phase_matrix's, of
  * HG g, on d; for g < 0 d must be the antipodal partition): P <- (1 - b) P + b A, A the identity
@@ -114,9 +128,9 @@ double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int re
 void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J);
 
 /* Folded cell integrals of the exit directions: F[d][c] = sum over the cells c stands for of
- * integral_{Omega_j} p(w_d . w') dw', for the ndir unit vectors w (rows of 3). */
-int ppb_rte_exit_coeffs(ppb_rte_grid *G, double g, const double *w, int ndir, double *F,
-                        ppb_err *err);
+ * integral_{Omega_j} p(w_d . w') dw' (p the grid's phase), for the ndir unit vectors w (rows
+ * of 3). */
+int ppb_rte_exit_coeffs(ppb_rte_grid *G, const double *w, int ndir, double *F, ppb_err *err);
 
 /* I_pp: at every lit node the cell field of its column's slab (sigma_t(x) H, alpha(x)) at
  * tau = D cos(theta_L) clamped to the slab (reference: Methods, pp), 0 where unlit. */
