@@ -75,6 +75,21 @@ static void test_series_moments(void **state)
     assert_close((1.0 - pow(0.9, 16)) * (1.0 - mom[1]), 1.0 - 0.9, 1e-10);
 }
 
+/* The 2n x 2n cell matrix of the phase function ph on the default partition of n cells per
+ * hemisphere (d is built; the caller frees both), with the share its clipping moved in
+ * *clipped. */
+static double *series_matrix(const pp_phase_fn *ph, int n, pp_dirs *d, double *clipped)
+{
+    ppb_err err;
+    int m = 2 * n;
+    assert_int_equal(pp_dirs_make(n, d, &err), 0);
+    double *P = malloc(sizeof(double) * m * m);
+    assert_non_null(P);
+    *clipped = -1.0;
+    assert_int_equal(pp_phase_matrix_fn(d, ph, P, clipped, &err), 0);
+    return P;
+}
+
 /* Ring-pair sums of S against the addition theorem, every pair of rings, up-up and up-down
  * blocks; series non-negative (g = 0.8, L = 11 and 16: the least value of p 8e-4 / sr), so
  * nothing is clipped and the sums are the series' own. */
@@ -87,11 +102,8 @@ static void test_ring_sums_match_addition_theorem(void **state)
         int n = ns[t], m = 2 * n, L = Ls[t];
         pp_phase_fn ph = deltam_series(0.8, L);
         pp_dirs d;
-        ppb_err err;
-        assert_int_equal(pp_dirs_make(n, &d, &err), 0);
-        double *P = malloc(sizeof(double) * m * m), clipped = -1.0;
-        assert_non_null(P);
-        assert_int_equal(pp_phase_matrix_fn(&d, &ph, P, &clipped, &err), 0);
+        double clipped;
+        double *P = series_matrix(&ph, n, &d, &clipped);
         assert_close(clipped, 0.0, 0.0);
         double Ir[64][PP_SERIES_MAX], Is[64][PP_SERIES_MAX], a, b;
         assert_true(d.nrings <= 64);
@@ -168,10 +180,8 @@ static void test_negative_lobes_clipped(void **state)
     pp_phase_fn ph = deltam_series(0.9, 16);
     pp_dirs d;
     ppb_err err;
-    assert_int_equal(pp_dirs_make(n, &d, &err), 0);
-    double *P = malloc(sizeof(double) * m * m), clipped = -1.0;
-    assert_non_null(P);
-    assert_int_equal(pp_phase_matrix_fn(&d, &ph, P, &clipped, &err), 0);
+    double clipped;
+    double *P = series_matrix(&ph, n, &d, &clipped);
     assert_true(clipped > 0.0 && clipped < 9.3e-4);
     for (int i = 0; i < m; i++) {
         double row = 0.0;
