@@ -152,8 +152,8 @@ static double ss_slab(double t0, double alpha, double g, const double wl[3], con
 }
 
 /* The bin average over o's direction samples and weights (object.h's bins in sin^2 theta and
- * phi, ppb_bin_sample_u: the last theta row graded toward the tangent plane) of f at patch pa's
- * frame. */
+ * phi, ppb_bin_sample_u: the first and last theta rows graded toward the normal and the tangent
+ * plane) of f at patch pa's frame. */
 static double bin_average(const ppb_object *o, const ppb_object_patch *pa, int bin, int ns,
                           double (*f)(const double w[3], void *arg), void *arg)
 {

@@ -251,8 +251,9 @@ static int camera_make(const ppb_object *o, ppb_obj_camera *cam, ppb_err *err)
 
 /* One boundary face's rays, added into its patch's bins (row of nbins): face f = 2 axis +
  * (side > 0) of voxel v, nsamp x nsamp directions per bin in (sin^2 theta, phi) with their
- * weights (the tube's stratified samples, ppb_bin_sample_u: the last theta row graded toward the
- * tangent plane; reference: Bins, with phi over [0, 2 pi) in the patch's frame), each from its
+ * weights (the tube's stratified samples, ppb_bin_sample_u: the first and last theta rows
+ * graded toward the normal and the tangent plane; reference: Bins, with phi over [0, 2 pi) in
+ * the patch's frame), each from its
  * own point of the face. A patch's bin is the mean over its faces and samples:
  * the radiance averaged over the patch's area and the bin (docs/reference.md, Objects). */
 static void face_rays(const ppb_object *o, const ppb_object_patch *pa, const ppb_pp3d_map *m,

@@ -9,8 +9,8 @@
 #include "physics/ppsolver.h"
 
 /* Bin average over samples x samples directions, each weighted (ppb_bin_sample_dir: the
- * midpoints in projected solid angle, the last theta row graded toward the tangent plane;
- * reference: Bins), so the bins match every other method's. */
+ * midpoints in projected solid angle, the first and last theta rows graded toward the normal and
+ * the tangent plane; reference: Bins), so the bins match every other method's. */
 static double bin_average(const pp_solution *s, const ppb_scene *sc, int surf, int bin, int samples,
                           double tau)
 {

@@ -4,7 +4,8 @@
  * through the flat-source regions (ppb_rte_moc, below: conservative by construction). The exit
  * radiance is a march from every segment point in every direction sample of every bin
  * (ppb_rte_exit), as `pp` averages its bins (reference: Bins; ppb_bin_sample_dir's samples and
- * weights, the last theta row graded toward the tangent plane), along q = p - l w:
+ * weights, the first and last theta rows graded toward the normal and the tangent plane),
+ * along q = p - l w:
  *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
  * where J is the converged scattered-light source per unit scattering coefficient (bilinear in
  * the nodes, each node its dual region's average, rte2d_params.h) and C E the direct beam's
