@@ -4,6 +4,7 @@
  * of the tube at normal incidence, the totals' bookkeeping, the column slabs of a density step
  * (each vertical column reads its own slab's solution) and the table cache of sweeps. */
 #include "testutil.h"
+#include "deviceutil.h"
 
 #include <math.h>
 
@@ -12,26 +13,6 @@
 #include "physics/totals.h"
 #include "methods/pp/method_pp.h"
 #include "physics/ppsolver.h"
-
-static ppb_ocl g_ocl;
-
-static int open_device(void **state)
-{
-    (void)state;
-    ppb_err err;
-    if (ppb_ocl_open(&g_ocl, NULL, &err)) {
-        fprintf(stderr, "%s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int close_device(void **state)
-{
-    (void)state;
-    ppb_ocl_close(&g_ocl);
-    return 0;
-}
 
 /* Marches every cell of sc's layout with the given tables; returns the radiance (caller frees). */
 static double *march(const ppb_scene *sc, const ppb_march_tables *tab, ppb_march_opts opts)
@@ -43,7 +24,7 @@ static double *march(const ppb_scene *sc, const ppb_march_tables *tab, ppb_march
     ppb_layout lo = ppb_scene_layout(sc);
     double *rad = malloc(lo.ncells * sizeof *rad);
     int partial;
-    if (ppb_march_all(&g_ocl, sc, &maps, tab, &opts, "test", 1, rad, &partial, &err))
+    if (ppb_march_all(tu_ocl(), sc, &maps, tab, &opts, "test", 1, rad, &partial, &err))
         fail_msg("%s", err.msg);
     ppb_maps_free(&maps);
     return rad;
@@ -684,7 +665,7 @@ static void test_march_method_cache(void **state)
     cfg.scene.segments_top = 16;
     cfg.scene.segments_side = 6;
     cfg.pp.directions = 24;
-    ppb_run_ctx fresh = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx fresh = {.cfg = &cfg, .ocl = *tu_ocl(), .ocl_open = 1, .quiet = 1};
     ppb_run_ctx ctx = fresh;
     ppb_layout lo = ppb_scene_layout(&cfg.scene);
     ppb_result r[3];
@@ -724,5 +705,5 @@ int main(void)
         cmocka_unit_test(test_march_cache),
         cmocka_unit_test(test_march_method_cache),
     };
-    return cmocka_run_group_tests(tests, open_device, close_device);
+    return cmocka_run_group_tests(tests, tu_open_device, tu_close_device);
 }

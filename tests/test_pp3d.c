@@ -5,6 +5,7 @@
  * tables), and the time of a pp3d frame of a 64^3 ball at 334 directions (paper Sec. 4.2:
  * 0.17 s a frame on a CPU). */
 #include "testutil.h"
+#include "deviceutil.h"
 
 #include <math.h>
 #include <time.h>
@@ -16,26 +17,6 @@
 #include "methods/pp/method_ss.h"
 #include "methods/pp3d/pp3d.h"
 #include "physics/ppsolver.h"
-
-static ppb_ocl g_ocl;
-
-static int open_device(void **state)
-{
-    (void)state;
-    ppb_err err;
-    if (ppb_ocl_open(&g_ocl, NULL, &err)) {
-        fprintf(stderr, "%s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int close_device(void **state)
-{
-    (void)state;
-    ppb_ocl_close(&g_ocl);
-    return 0;
-}
 
 /* A box of nx x ny x nz voxels of edge h, one material. */
 static ppb_object box(int nx, int ny, int nz, double h, double sigma_t, double albedo, double g)
@@ -253,7 +234,7 @@ static void test_box_reproduces_tube(void **state)
     cfg.pp.directions = 64, cfg.pp.table = PPB_TABLE_R, cfg.pp.step = 0.05;
     ppb_layout lo = ppb_scene_layout(sc);
     ppb_result tube[2];
-    ppb_run_ctx tctx = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx tctx = {.cfg = &cfg, .ocl = *tu_ocl(), .ocl_open = 1, .quiet = 1};
     for (int i = 0; i < 2; i++)
         if (ppb_result_init(&tube[i], i ? "pp" : "ss", &lo, &err) ||
             (i ? ppb_method_pp(&tctx, &tube[i], &err) : ppb_method_ss(&tctx, &tube[i], &err)))
@@ -589,5 +570,5 @@ int main(void)
         cmocka_unit_test(test_box_reproduces_tube),   cmocka_unit_test(test_shadowed_slab),
         cmocka_unit_test(test_pp3d_ball_frame),
     };
-    return cmocka_run_group_tests(tests, open_device, close_device);
+    return cmocka_run_group_tests(tests, tu_open_device, tu_close_device);
 }

@@ -20,6 +20,7 @@
  *   halves (a scheme of order >= 1); on the study's first case, halving the grid, the
  *   directions' solid angle, and both change every summary cell by less than 0.3 %. */
 #include "testutil.h"
+#include "deviceutil.h"
 
 #include <lapacke.h>
 
@@ -29,26 +30,6 @@
 #include "model/config.h"
 #include "model/metrics.h"
 #include "physics/gmres.h"
-
-static ppb_ocl g_ocl;
-
-static int open_device(void **state)
-{
-    (void)state;
-    ppb_err err;
-    if (ppb_ocl_open(&g_ocl, NULL, &err)) {
-        fprintf(stderr, "no OpenCL device: %s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int close_device(void **state)
-{
-    (void)state;
-    ppb_ocl_close(&g_ocl);
-    return 0;
-}
 
 /* ---- GMRES ---- */
 
@@ -185,7 +166,7 @@ static void run(ppb_config *cfg, const char *id, ppb_result *r, ppb_rte2d_stats 
     ppb_layout lo = ppb_scene_layout(&cfg->scene);
     if (ppb_result_init(r, id, &lo, &err))
         fail_msg("%s", err.msg);
-    ppb_run_ctx ctx = {.cfg = cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx ctx = {.cfg = cfg, .ocl = *tu_ocl(), .ocl_open = 1, .quiet = 1};
     int rc;
     if (strcmp(id, "mc") == 0) {
         /* mc fills its companion mc1 in out[1] too (method.h): one result was an overflow
@@ -752,7 +733,7 @@ static void test_refinement_study(void **state)
     if (ppb_result_init(&conv, "rte2d", &lo, &err))
         fail_msg("%s", err.msg);
     ppb_rte2d_stats st, st_bare;
-    ppb_run_ctx ctx = {.cfg = &cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1, .extras = 1};
+    ppb_run_ctx ctx = {.cfg = &cfg, .ocl = *tu_ocl(), .ocl_open = 1, .quiet = 1, .extras = 1};
     if (ppb_rte2d_run(&ctx, &conv, &st, &err) || ppb_result_write_extra(&conv, dir, &err))
         fail_msg("%s", err.msg);
     const ppb_rte2d_study *study = conv.extra.data; /* the result carries its study */
@@ -845,5 +826,5 @@ int main(void)
     /* RTE2D_TEST=pattern runs the matching tests alone (a quick check of one). */
     if (getenv("RTE2D_TEST"))
         cmocka_set_test_filter(getenv("RTE2D_TEST"));
-    return cmocka_run_group_tests(tests, open_device, close_device);
+    return cmocka_run_group_tests(tests, tu_open_device, tu_close_device);
 }

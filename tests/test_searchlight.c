@@ -21,6 +21,7 @@
  * - the line as the limit of narrow strips: mc's line and a strip of width 1e-3 (the same
  *   photons, moved by at most 5e-4) agree in every total within 4 standard errors. */
 #include "testutil.h"
+#include "deviceutil.h"
 
 #include "kernels/ppb_light.h"
 #include "methods/mc/mc_tally.h"
@@ -31,26 +32,6 @@
 #include "model/config.h"
 #include "physics/maps.h"
 #include "physics/medium.h"
-
-static ppb_ocl g_ocl;
-
-static int open_device(void **state)
-{
-    (void)state;
-    ppb_err err;
-    if (ppb_ocl_open(&g_ocl, NULL, &err)) {
-        fprintf(stderr, "no OpenCL device: %s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int close_device(void **state)
-{
-    (void)state;
-    ppb_ocl_close(&g_ocl);
-    return 0;
-}
 
 /* ---- keys and refusals ---- */
 
@@ -197,7 +178,7 @@ static void run_mc(ppb_config *cfg, mc_run *r)
 {
     ppb_err err;
     ppb_layout lo = ppb_scene_layout(&cfg->scene);
-    ppb_run_ctx ctx = {.cfg = cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx ctx = {.cfg = cfg, .ocl = *tu_ocl(), .ocl_open = 1, .quiet = 1};
     ppb_mc_tallies t;
     ppb_mc_trace_info info;
     if (ppb_mc_tallies_init(&t, &cfg->scene, (uint64_t)cfg->mc.seed, cfg->mc.batches, &err) ||
@@ -222,7 +203,7 @@ static void run(ppb_config *cfg, const char *id, ppb_result *r)
     ppb_layout lo = ppb_scene_layout(&cfg->scene);
     if (ppb_result_init(r, id, &lo, &err))
         fail_msg("%s", err.msg);
-    ppb_run_ctx ctx = {.cfg = cfg, .ocl = g_ocl, .ocl_open = 1, .quiet = 1};
+    ppb_run_ctx ctx = {.cfg = cfg, .ocl = *tu_ocl(), .ocl_open = 1, .quiet = 1};
     int rc =
         strcmp(id, "ss") == 0 ? ppb_method_ss(&ctx, r, &err) : ppb_rte2d_run(&ctx, r, NULL, &err);
     if (rc)
@@ -477,5 +458,5 @@ int main(void)
         cmocka_unit_test(test_ss_matches_mc1), cmocka_unit_test(test_line_is_narrow_strip_limit),
         cmocka_unit_test(test_semi_infinite),
     };
-    return cmocka_run_group_tests(tests, open_device, close_device);
+    return cmocka_run_group_tests(tests, tu_open_device, tu_close_device);
 }
