@@ -46,7 +46,7 @@ n=$#
   echo "set grid ytics lc rgb '#dddddd'"
   echo "set xrange [-0.6:$n - 0.4]"
   echo "set key outside right top vertical"
-  echo "set lmargin 8"
+  echo "set lmargin 15" # room for the first case name, rotated below it
   echo "set rmargin 16"
   xt="" xe=""
   k=0
