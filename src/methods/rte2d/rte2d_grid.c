@@ -466,7 +466,7 @@ double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_pha
     memset(ph, 0, sizeof *ph);
     ph->g = sc->g;
     L = L < 2 ? 2 : (L > PP_SERIES_MAX ? PP_SERIES_MAX : L);
-    double f = delta_m_scale(sc, sc->g > 0.0 ? pow(sc->g, L) : 0.0, out);
+    double f = ppb_rte_delta_m(sc, 0, L, out);
     if (f == 0.0)
         return 0.0;
     ph->nmom = L;
