@@ -417,6 +417,46 @@ static void test_seeds(void **state)
     ppb_ctx_close(&f.ctx);
 }
 
+/* The totals' standard errors (ppb_mc_tallies_totals, written to mc_totals.csv) against the
+ * spread of independent seeds, the variance they estimate: 60 seeds of 20000 photons, the
+ * sample variance of each total over the seeds (59 degrees of freedom) over the mean of the
+ * squared batch errors, averaged over R, T, sides, absorbed and ballistic. Were the five fully
+ * correlated the average would be distributed as chi^2_59 / 59, within [0.50, 1.72] with
+ * probability 0.999 (Wilson-Hilferty); they are not, so the spread is narrower. A standard
+ * error off by 1.5 x moves the ratio to 0.44 or 2.25. */
+static void test_totals_se_match_seed_spread(void **state)
+{
+    (void)state;
+    mc_fixture f = {0};
+    fixture_init(&f, tu_tube(), 0);
+    enum { NSEED = 60, NQ = 5 };
+    double v[NSEED][NQ], se2[NQ] = {0};
+    for (int k = 0; k < NSEED; k++) {
+        ppb_mc_tallies t;
+        f.cfg.mc.seed = 100 + k;
+        trace(&f, 0, 20000, &t);
+        ppb_mc_totals_stats s = totals_of(&f, &t, 0);
+        double m[NQ] = {s.mean.R, s.mean.T, s.mean.sides, s.mean.absorbed, s.mean.ballistic};
+        double e[NQ] = {s.se.R, s.se.T, s.se.sides, s.se.absorbed, s.se.ballistic};
+        for (int q = 0; q < NQ; q++)
+            v[k][q] = m[q], se2[q] += e[q] * e[q] / NSEED;
+        ppb_mc_tallies_free(&t);
+    }
+    double ratio = 0;
+    for (int q = 0; q < NQ; q++) {
+        double mean = 0, ss = 0;
+        for (int k = 0; k < NSEED; k++)
+            mean += v[k][q] / NSEED;
+        for (int k = 0; k < NSEED; k++)
+            ss += (v[k][q] - mean) * (v[k][q] - mean);
+        ratio += ss / (NSEED - 1) / se2[q] / NQ;
+    }
+    print_message("seed variance / squared batch error %.3f\n", ratio);
+    if (ratio < 0.50 || ratio > 1.72)
+        fail_msg("seed variance / squared batch error: %.3f (want 0.50..1.72)", ratio);
+    ppb_ctx_close(&f.ctx);
+}
+
 /* Mirror symmetry x -> -x of the normal-incidence tube without a step (reference: Bins): S3 <-> S4,
  * S1/S2 segment i <-> segments-1-i, phi bin k <-> nphi-1-k, theta bins unchanged. The two
  * halves come from the same photons, so they are correlated only through photons that reach
@@ -925,6 +965,7 @@ int main(void)
         cmocka_unit_test(test_single_scattering),
         cmocka_unit_test(test_bit_identical),
         cmocka_unit_test(test_seeds),
+        cmocka_unit_test(test_totals_se_match_seed_spread),
         cmocka_unit_test(test_mirror_symmetry),
         cmocka_unit_test(test_method_entry),
         cmocka_unit_test(test_slab_vs_ppslab),

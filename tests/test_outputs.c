@@ -85,6 +85,7 @@ static void test_rerun_with_fewer_methods_leaves_nothing_stale(void **state)
     snprintf(args, sizeof args, "run --quiet --out %s %s", d, cfg);
     cli_expect(args, 0, "");
     assert_exists("%s/summary.csv", d);
+    assert_exists("%s/mc_totals.csv", d);
     assert_exists("%s/images/error_mp.png", d);
     snprintf(args, sizeof args, "run --quiet --set experiment.methods=mp --out %s %s", d, cfg);
     cli_expect(args, 0, "");
@@ -92,7 +93,7 @@ static void test_rerun_with_fewer_methods_leaves_nothing_stale(void **state)
     assert_exists("%s/images/mp.png", d);
     const char *stale[] = {"summary.csv",          "rms.csv",       "regions.csv",
                            "summary_mc1.csv",      "images/mc.png", "images/error_mp.png",
-                           "images/error_mc1.png", "images/mc.exr"};
+                           "images/error_mc1.png", "images/mc.exr", "mc_totals.csv"};
     for (size_t i = 0; i < sizeof stale / sizeof stale[0]; i++)
         assert_absent("%s/%s", d, stale[i]);
     /* radiance.csv holds mp's rows only (its first column is the method). */

@@ -172,6 +172,9 @@ int ppb_mc_shard_merge(const ppb_config *cfg, const char *const *dirs, int ndirs
     if (rc == 0) {
         ppb_mc_tallies_to_results(&sum, &cfg->scene, &ex.res[0], &ex.res[1]);
         ex.res[0].photons = ex.res[1].photons = cfg->mc.photons;
+        rc = ppb_mc_tallies_attach_totals(&sum, &cfg->scene, &ex.res[0], err);
+    }
+    if (rc == 0) {
         rc = ppb_experiment_write(&ex, err);
     }
     if (rc == 0) /* the last line says where the results went, as `run` does */

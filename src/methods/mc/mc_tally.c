@@ -483,3 +483,50 @@ void ppb_mc_tallies_to_results(const ppb_mc_tallies *t, const ppb_scene *sc, ppb
     if (mc1)
         cells_to_result(t, sc, 1, mc1);
 }
+
+/* mc_totals.csv: one row per (tally, total); mc1's absorbed is not tracked (it is 1 - the rest
+ * in totals.csv), so it has no row. */
+typedef struct totals_extra {
+    ppb_mc_totals_stats st[2]; /* mc, mc1 */
+} totals_extra;
+
+static void totals_row(FILE *f, const char *tally, const char *name, double mean, double se)
+{
+    fprintf(f, "%s,%s,%.10g,%.6g\n", tally, name, mean, se);
+}
+
+static int write_totals_extra(const void *data, const char *dir, ppb_err *err)
+{
+    const totals_extra *x = data;
+    char path[PPB_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/mc_totals.csv", dir);
+    ppb_afile af;
+    if (ppb_afile_open(&af, path, err))
+        return -1;
+    fprintf(af.f, "tally,total,mean,se\n");
+    for (int once = 0; once < 2; once++) {
+        const ppb_mc_totals_stats *s = &x->st[once];
+        const char *id = once ? "mc1" : "mc";
+        totals_row(af.f, id, "R", s->mean.R, s->se.R);
+        totals_row(af.f, id, "T", s->mean.T, s->se.T);
+        totals_row(af.f, id, "sides", s->mean.sides, s->se.sides);
+        if (!once)
+            totals_row(af.f, id, "absorbed", s->mean.absorbed, s->se.absorbed);
+        totals_row(af.f, id, "ballistic", s->mean.ballistic, s->se.ballistic);
+    }
+    return ppb_afile_commit(&af, err);
+}
+
+int ppb_mc_tallies_attach_totals(const ppb_mc_tallies *t, const ppb_scene *sc, ppb_result *mc,
+                                 ppb_err *err)
+{
+    totals_extra *x = malloc(sizeof *x);
+    if (!x)
+        return ppb_fail(err, "mc: out of memory (mc_totals.csv)");
+    ppb_mc_tallies_totals(t, sc, 0, &x->st[0]);
+    ppb_mc_tallies_totals(t, sc, 1, &x->st[1]);
+    if (mc->extra.data && mc->extra.release)
+        mc->extra.release(mc->extra.data);
+    mc->extra = (ppb_result_extra){x, write_totals_extra, free};
+    return 0;
+}

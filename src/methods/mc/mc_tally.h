@@ -85,6 +85,12 @@ typedef struct ppb_mc_totals_stats {
 void ppb_mc_tallies_totals(const ppb_mc_tallies *t, const ppb_scene *sc, int once,
                            ppb_mc_totals_stats *st);
 
+/* Attaches mc_totals.csv to mc as its extra output (model/result.h): the totals of mc and mc1
+ * with their standard errors from the batch means (reference: Outputs), what a comparison per
+ * surface against the Monte Carlo needs (scripts/rte2d_reference.sh). */
+int ppb_mc_tallies_attach_totals(const ppb_mc_tallies *t, const ppb_scene *sc, ppb_result *mc,
+                                 ppb_err *err);
+
 /* The Monte Carlo kernel, in the source tree (runtime/ocl.h). */
 #define PPB_MC_KERNEL "src/methods/mc/mc.cl"
 

@@ -572,6 +572,7 @@ int ppb_method_mc(ppb_run_ctx *ctx, ppb_result *out, ppb_err *err)
     if (status == 0) {
         note_capped(cfg, &t);
         ppb_mc_tallies_to_results(&t, &cfg->scene, &out[0], &out[1]);
+        status = ppb_mc_tallies_attach_totals(&t, &cfg->scene, &out[0], err);
         for (int i = 0; i < 2; i++) {
             out[i].partial = info.interrupted;
             out[i].photons = info.traced;
@@ -710,6 +711,7 @@ int ppb_mc_run_channels(ppb_run_ctx *ctx, const ppb_config *cfgs, int nch, ppb_r
     for (int c = 0; c < nch && status == 0; c++) {
         note_capped(&cfgs[c], &t[c]);
         ppb_mc_tallies_to_results(&t[c], &cfgs[c].scene, &out[2 * c], &out[2 * c + 1]);
+        status = ppb_mc_tallies_attach_totals(&t[c], &cfgs[c].scene, &out[2 * c], err);
         for (int i = 2 * c; i < 2 * c + 2; i++) {
             out[i].partial = info.interrupted;
             out[i].photons = info.traced;
