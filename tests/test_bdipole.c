@@ -8,6 +8,7 @@
  * the robustness grid's corners and in slab mode; bdipole+ss = bdipole + ss cell by cell. */
 #include "testutil.h"
 #include "study_cases.h"
+#include "profileutil.h"
 
 #include <math.h>
 
@@ -86,33 +87,6 @@ static void test_rd_closed_form(void **state)
     assert_close(ppb_bdipole_plane(&z, 0.0), 0.0, 0.0);
 }
 
-/* int_a^b f by 10-point Gauss-Legendre panels halving toward a from b (down to 1e-15 of b - a),
- * then uniform panels: an independent quadrature (test_burley.c's). */
-typedef double (*fn1)(double x, const void *arg);
-static double graded(fn1 f, const void *arg, double a, double b, double h)
-{
-    static const double x[5] = {0.1488743389816312, 0.4333953941292472, 0.6794095682990244,
-                                0.8650633666889845, 0.9739065285171717};
-    static const double w[5] = {0.2955242247147529, 0.2692667193099963, 0.2190863625159820,
-                                0.1494513491505806, 0.0666713443086881};
-    double sum = 0, c = fmin(b, a + h), hi = c;
-    for (;;) {
-        double lo = hi - a > 1e-15 * (c - a) ? a + 0.5 * (hi - a) : a;
-        double half = 0.5 * (hi - lo), mid = 0.5 * (hi + lo);
-        for (int j = 0; j < 5; j++)
-            sum += half * w[j] * (f(mid - half * x[j], arg) + f(mid + half * x[j], arg));
-        if (lo == a)
-            break;
-        hi = lo;
-    }
-    for (double lo = c; lo < b; lo += h) {
-        double hi2 = fmin(b, lo + h), half = 0.5 * (hi2 - lo), mid = 0.5 * (hi2 + lo);
-        for (int j = 0; j < 5; j++)
-            sum += half * w[j] * (f(mid - half * x[j], arg) + f(mid + half * x[j], arg));
-    }
-    return sum;
-}
-
 typedef struct prof_arg {
     const ppb_bdipole *b;
     double h; /* plane distance or in-plane distance, by use */
@@ -132,12 +106,13 @@ static double along_z(double z, const void *arg)
     return 2 * ppb_bdipole_R(p->b, sqrt(p->h * p->h + z * z));
 }
 
-/* int_0^inf f: [0, T] directly (panels of h beyond the grading toward 0), [T, inf) as
+/* int_0^inf f by pu_graded (test_burley.c's independent quadrature): [0, T] directly (panels of
+ * h beyond the grading toward 0), [T, inf) as
  * int_0^(1/T) f(1 / w) / w^2 dw (the algebraic tail at sigma_tr = 0 becomes smooth, and w is
  * exact near 0 where t is large). T = 200 / sigma_tr (the profile below e^-200 beyond) and
  * h = 0.25 / sigma_tr; at sigma_tr = 0, T = 1 and h = 0.25. */
 typedef struct inv_arg {
-    fn1 f;
+    pu_fn1 f;
     const void *arg;
 } inv_arg;
 
@@ -147,11 +122,11 @@ static double inverted(double w, const void *arg)
     return q->f(1 / w, q->arg) / (w * w);
 }
 
-static double to_infinity(fn1 f, const prof_arg *p)
+static double to_infinity(pu_fn1 f, const prof_arg *p)
 {
     double s = p->b->sigma_tr, T = s > 0 ? 200 / s : 1, h = s > 0 ? 0.25 / s : 0.25;
     inv_arg q = {f, p};
-    return graded(f, p, 0, T, h) + graded(inverted, &q, 0, 1 / T, 1e-3 / T);
+    return pu_graded(f, p, 0, T, h) + pu_graded(inverted, &q, 0, 1 / T, 1e-3 / T);
 }
 
 /* Media in units of 1/sigma_t: (sigma_t, albedo, g, n), from strongly absorbing to albedo 1
@@ -255,6 +230,28 @@ static void test_strip_quadrature(void **state)
     }
 }
 
+/* A study config's totals against the bounds of test_study_configs. */
+static void study_bounds(const char *name, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    const ppb_scene *sc = &ctx->cfg->scene;
+    double Rd = 0, PH = 0, entry = pu_entry(sc);
+    for (int side = 0; side < 2; side++) {
+        double st, al;
+        pu_side_medium(sc, side, &st, &al);
+        ppb_bdipole b = ppb_bdipole_make(st, al, sc->g, sc->n);
+        Rd = fmax(Rd, ppb_bdipole_plane(&b, 0.0));
+        PH = fmax(PH, ppb_bdipole_plane(&b, sc->height));
+    }
+    double sum = out->totals.R + out->totals.T + out->totals.sides;
+    print_message("%-24s R_d %.4f  R %.4f T %.4f sides %.4f  sum %.4f  ballistic %.4f\n", name, Rd,
+                  out->totals.R, out->totals.T, out->totals.sides, sum, out->totals.ballistic);
+    assert_le(out->totals.R, entry * Rd * (1 + 1e-12));
+    assert_le(out->totals.T, entry * PH * (1 + 1e-12));
+    assert_le(out->totals.sides, entry * Rd * (1 + 1e-12));
+    assert_lt(0, out->totals.T);               /* light does reach the far face */
+    assert_le(sum + out->totals.ballistic, 1); /* the result check's energy bound holds */
+}
+
 static void test_study_configs(void **state)
 {
     (void)state;
@@ -264,41 +261,16 @@ static void test_study_configs(void **state)
      * most R_d), S2 in the plane at distance H (at most P(H)), each side in a half plane at some
      * distance (at most R_d / 2); times the entering 1 - F(theta_L), with the larger of the
      * tube's two media. */
-    char names[STUDY_MAX_CASES][64];
-    int ncase = study_cases(names);
-    for (int c = 0; c < ncase; c++) {
-        ppb_config cfg;
-        study_load_config(names[c], &cfg);
-        const ppb_scene *sc = &cfg.scene;
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "bdipole", &out);
-        for (size_t i = 0; i < out.layout.ncells; i++) {
-            assert_true(isfinite(out.radiance[i]));
-            assert_true(out.radiance[i] >= 0);
-        }
-        double Rd = 0, PH = 0,
-               entry = sc->n > 1 ? 1 - ppb_fresnel(cos(sc->theta_deg * PPB_PI / 180), sc->n) : 1;
-        for (int side = 0; side < 2; side++) {
-            double st = side ? (sc->step == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t)
-                             : sc->sigma_t;
-            double al =
-                side ? (sc->step == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo) : sc->albedo;
-            ppb_bdipole b = ppb_bdipole_make(st, al, sc->g, sc->n);
-            Rd = fmax(Rd, ppb_bdipole_plane(&b, 0.0));
-            PH = fmax(PH, ppb_bdipole_plane(&b, sc->height));
-        }
-        double sum = out.totals.R + out.totals.T + out.totals.sides;
-        print_message("%-24s R_d %.4f  R %.4f T %.4f sides %.4f  sum %.4f  ballistic %.4f\n",
-                      names[c], Rd, out.totals.R, out.totals.T, out.totals.sides, sum,
-                      out.totals.ballistic);
-        assert_le(out.totals.R, entry * Rd * (1 + 1e-12));
-        assert_le(out.totals.T, entry * PH * (1 + 1e-12));
-        assert_le(out.totals.sides, entry * Rd * (1 + 1e-12));
-        assert_lt(0, out.totals.T);               /* light does reach the far face */
-        assert_le(sum + out.totals.ballistic, 1); /* the result check's energy bound holds */
-        ppb_result_free(&out);
-    }
+    pu_study_configs("bdipole", NULL, study_bounds);
+}
+
+/* R at a corner of the robustness grid within (1 - F) R_d (test_extremes). */
+static void corner_bounds(const pu_corner *c, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    ppb_bdipole b = ppb_bdipole_make(ctx->cfg->scene.sigma_t, c->albedo, c->g, c->n);
+    double Rd = ppb_bdipole_plane(&b, 0.0);
+    assert_between(Rd, 0, 1 + 1e-14);
+    assert_le(out->totals.R, Rd * (1 + 1e-12));
 }
 
 static void test_extremes(void **state)
@@ -309,43 +281,13 @@ static void test_extremes(void **state)
      * finite and >= 0, R within (1 - F) R_d, and the method's result checks passed. */
     const double albedo[] = {0, 0.01, 0.5, 0.999, 1}, g[] = {-0.95, 0, 0.95},
                  height[] = {1e-3, 1, 1e3}, theta[] = {0, 89}, n[] = {1, 2.5};
-    int runs = 0;
-    for (int geo = 0; geo < 2; geo++)
-        for (int ia = 0; ia < 5; ia++)
-            for (int ig = 0; ig < 3; ig++)
-                for (int ih = 0; ih < 3; ih++)
-                    for (int it = 0; it < 2; it++)
-                        for (int in = 0; in < 2; in++) {
-                            ppb_config cfg;
-                            ppb_err err;
-                            assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-                            cfg.scene =
-                                geo ? tu_slab(height[ih], albedo[ia], g[ig], theta[it]) : tu_tube();
-                            cfg.scene.albedo = albedo[ia];
-                            cfg.scene.g = g[ig];
-                            cfg.scene.height = height[ih];
-                            cfg.scene.theta_deg = theta[it];
-                            cfg.scene.n = n[in];
-                            cfg.scene.segments_top = 8;
-                            cfg.scene.segments_side = 4;
-                            cfg.samples_seg = 1;
-                            ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-                            ppb_result out;
-                            study_run_id(&ctx, "bdipole", &out);
-                            for (size_t i = 0; i < out.layout.ncells; i++)
-                                if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
-                                    fail_msg("albedo %g g %g H %g theta %g n %g: cell %zu = %g",
-                                             albedo[ia], g[ig], height[ih], theta[it], n[in], i,
-                                             out.radiance[i]);
-                            ppb_bdipole b =
-                                ppb_bdipole_make(cfg.scene.sigma_t, albedo[ia], g[ig], n[in]);
-                            double Rd = ppb_bdipole_plane(&b, 0.0);
-                            assert_between(Rd, 0, 1 + 1e-14);
-                            assert_le(out.totals.R, Rd * (1 + 1e-12));
-                            ppb_result_free(&out);
-                            runs++;
-                        }
-    print_message("%d runs at the extremes\n", runs);
+    pu_grid grid = {1, PU_AXIS(albedo), PU_AXIS(g), PU_AXIS(height), PU_AXIS(theta), PU_AXIS(n)};
+    pu_extremes("bdipole", &grid, NULL, corner_bounds);
+}
+
+static void set_samples(ppb_config *cfg, int samples)
+{
+    cfg->bdipole.samples = samples;
 }
 
 static void test_quadrature_converges_on_tube(void **state)
@@ -353,33 +295,19 @@ static void test_quadrature_converges_on_tube(void **state)
     (void)state;
     /* The method's quadrature error on the tube (uniform_g0_normal, density_step, and albedo 1
      * where sigma_tr = 0): every cell at [bdipole] samples = 16 (default) and 8 against 64. */
-    const char *names[] = {"uniform_g0_normal", "density_step", "uniform_g0_normal_n14"};
-    for (int c = 0; c < 3; c++) {
-        ppb_config cfg;
-        study_load_config(names[c], &cfg);
-        cfg.scene.segments_top = 32;
-        cfg.scene.segments_side = 12;
-        if (c == 2)
-            cfg.scene.albedo = 1.0;
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result ref, r;
-        cfg.bdipole.samples = 64;
-        study_run_id(&ctx, "bdipole", &ref);
-        const int nodes[] = {8, 16};
-        for (int k = 0; k < 2; k++) {
-            cfg.bdipole.samples = nodes[k];
-            study_run_id(&ctx, "bdipole", &r);
-            double worst = 0;
-            for (size_t i = 0; i < r.layout.ncells; i++)
-                worst = fmax(worst, fabs(r.radiance[i] - ref.radiance[i]) / ref.radiance[i]);
-            print_message("%s%s: samples %2d vs 64: largest relative cell difference %.2e\n",
-                          names[c], c == 2 ? " (albedo 1)" : "", nodes[k], worst);
-            if (nodes[k] == 16)
-                assert_lt(worst, 1e-10);
-            ppb_result_free(&r);
-        }
-        ppb_result_free(&ref);
-    }
+    pu_samples_converge("bdipole", "uniform_g0_normal", NAN, set_samples);
+    pu_samples_converge("bdipole", "density_step", NAN, set_samples);
+    pu_samples_converge("bdipole", "uniform_g0_normal_n14", 1.0, set_samples);
+}
+
+/* A slab's totals and S1's lobe (test_slab_mode). */
+static void slab_totals(ppb_run_ctx *ctx, const ppb_result *out, double mu, double entry)
+{
+    const ppb_scene *sc = &ctx->cfg->scene;
+    ppb_bdipole b = ppb_bdipole_make(sc->sigma_t, 0.95, 0.0, sc->n);
+    assert_rel(out->totals.R, entry * ppb_bdipole_plane(&b, 0.0), 1e-14);
+    assert_rel(out->totals.T, entry * ppb_bdipole_plane(&b, 3.0), 1e-14);
+    pu_assert_lobe_mean(out, mu);
 }
 
 static void test_slab_mode(void **state)
@@ -388,27 +316,7 @@ static void test_slab_mode(void **state)
     /* Slab mode: R = (1 - F) P(0) and T = (1 - F) P(H) (the closed-form plane integrals),
      * radiance R cos(theta_L) / pi on S1 at n = 1; at n = 1.4 the exit lobe distributes the
      * same flux (its bins' mean is 1). */
-    const double n[] = {1.0, 1.4};
-    for (int i = 0; i < 2; i++) {
-        ppb_config cfg;
-        ppb_err err;
-        assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-        cfg.scene = tu_slab(3.0, 0.95, 0.0, 30.0);
-        cfg.scene.n = n[i];
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "bdipole", &out);
-        double mu = cos(30 * PPB_PI / 180);
-        double entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
-        ppb_bdipole b = ppb_bdipole_make(cfg.scene.sigma_t, 0.95, 0.0, n[i]);
-        assert_rel(out.totals.R, entry * ppb_bdipole_plane(&b, 0.0), 1e-14);
-        assert_rel(out.totals.T, entry * ppb_bdipole_plane(&b, 3.0), 1e-14);
-        double mean = 0;
-        for (int bin = 0; bin < out.layout.nbins; bin++)
-            mean += out.radiance[ppb_cell(&out.layout, PPB_S1, 0, bin)] / out.layout.nbins;
-        assert_rel(mean, out.totals.R * mu / PPB_PI, 1e-12);
-        ppb_result_free(&out);
-    }
+    pu_slab_mode("bdipole", slab_totals);
 }
 
 static void test_sum_with_ss(void **state)

@@ -8,6 +8,7 @@
  * cell by cell. */
 #include "testutil.h"
 #include "study_cases.h"
+#include "profileutil.h"
 
 #include <math.h>
 
@@ -79,33 +80,6 @@ static void test_k1_tables(void **state)
     assert_close(ppb_bessel_k1(INFINITY), 0.0, 0.0);
 }
 
-/* int_a^b f by 10-point Gauss-Legendre panels halving toward a from b (down to 1e-15 of b - a),
- * then uniform panels: an independent quadrature of the profile's singular integrands. */
-typedef double (*fn1)(double x, const void *arg);
-static double graded(fn1 f, const void *arg, double a, double b, double h)
-{
-    static const double x[5] = {0.1488743389816312, 0.4333953941292472, 0.6794095682990244,
-                                0.8650633666889845, 0.9739065285171717};
-    static const double w[5] = {0.2955242247147529, 0.2692667193099963, 0.2190863625159820,
-                                0.1494513491505806, 0.0666713443086881};
-    double sum = 0, c = fmin(b, a + h), hi = c;
-    for (;;) {
-        double lo = hi - a > 1e-15 * (c - a) ? a + 0.5 * (hi - a) : a;
-        double half = 0.5 * (hi - lo), mid = 0.5 * (hi + lo);
-        for (int j = 0; j < 5; j++)
-            sum += half * w[j] * (f(mid - half * x[j], arg) + f(mid + half * x[j], arg));
-        if (lo == a)
-            break;
-        hi = lo;
-    }
-    for (double lo = c; lo < b; lo += h) {
-        double hi2 = fmin(b, lo + h), half = 0.5 * (hi2 - lo), mid = 0.5 * (hi2 + lo);
-        for (int j = 0; j < 5; j++)
-            sum += half * w[j] * (f(mid - half * x[j], arg) + f(mid + half * x[j], arg));
-    }
-    return sum;
-}
-
 static double ring(double r, const void *arg)
 {
     return 2 * PPB_PI * r * ppb_burley_R(arg, r);
@@ -119,11 +93,11 @@ static void test_profile_plane_integral(void **state)
     const double As[][2] = {{0.5, 1.0}, {0.9, 0.3}, {0.2, 4.0}, {1.0, 0.906}};
     for (int i = 0; i < 4; i++) {
         ppb_burley b = {As[i][0], As[i][1]};
-        double total = graded(ring, &b, 0, 200 / b.s, 0.25 / b.s);
+        double total = pu_graded(ring, &b, 0, 200 / b.s, 0.25 / b.s);
         assert_rel(total, b.A, 1e-12);
         for (double r = 0.1; r < 10; r *= 3)
-            assert_rel(graded(ring, &b, 0, r / b.s, 0.25 / b.s), b.A * ppb_burley_cdf(&b, r / b.s),
-                       1e-12);
+            assert_rel(pu_graded(ring, &b, 0, r / b.s, 0.25 / b.s),
+                       b.A * ppb_burley_cdf(&b, r / b.s), 1e-12);
     }
 }
 
@@ -147,7 +121,7 @@ static void test_line_kernel(void **state)
     const double rho[] = {1e-3, 0.05, 0.3, 1.0, 3.0, 10.0};
     for (int i = 0; i < 6; i++) {
         line_arg l = {&b, rho[i]};
-        double direct = graded(along_z, &l, 0, 400 / b.s, fmax(0.1, rho[i]) / b.s);
+        double direct = pu_graded(along_z, &l, 0, 400 / b.s, fmax(0.1, rho[i]) / b.s);
         assert_rel(ppb_burley_line(&b, rho[i]), direct, 1e-11);
     }
 }
@@ -278,6 +252,32 @@ static void test_albedo_exact(void **state)
     }
 }
 
+/* A study config's totals against the bounds of test_study_configs. */
+static void study_bounds(const char *name, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    const ppb_config *cfg = ctx->cfg;
+    const ppb_scene *sc = &cfg->scene;
+    ppb_err err;
+    double Amax = 0, smin = INFINITY, entry = pu_entry(sc);
+    for (int side = 0; side < 2; side++) {
+        double st, al, A;
+        pu_side_medium(sc, side, &st, &al);
+        assert_int_equal(ppb_burley_albedo(al, sc->g, sc->n, cos(sc->theta_deg * PPB_PI / 180),
+                                           cfg->burley.directions, &A, &err),
+                         0);
+        Amax = fmax(Amax, A);
+        smin = fmin(smin, ppb_burley_shape_searchlight(A) * st * (1 - al * sc->g));
+    }
+    ppb_burley far = {Amax, smin};
+    double sum = out->totals.R + out->totals.T + out->totals.sides;
+    print_message("%-24s A %.4f  R %.4f T %.4f sides %.4f  sum %.4f  ballistic %.4f\n", name, Amax,
+                  out->totals.R, out->totals.T, out->totals.sides, sum, out->totals.ballistic);
+    assert_le(out->totals.R, entry * Amax * (1 + 1e-12));
+    assert_le(out->totals.T, entry * Amax * (1 - ppb_burley_cdf(&far, sc->height)) * (1 + 1e-12));
+    assert_le(out->totals.sides, entry * Amax * (1 + 1e-12));
+    assert_le(sum, 1 + 1e-3); /* the result check's energy bound (reference: Methods) */
+}
+
 static void test_study_configs(void **state)
 {
     (void)state;
@@ -286,46 +286,24 @@ static void test_study_configs(void **state)
      * plane (at most A), S2 in the plane at distance H (at most A (1 - cdf(H))), each side in a
      * half plane through the entry point's normal line (at most A / 2); times the entering
      * 1 - F(theta_L), with A the largest and s the smallest of the tube's media. */
-    char names[STUDY_MAX_CASES][64];
-    int ncase = study_cases(names);
-    for (int c = 0; c < ncase; c++) {
-        ppb_config cfg;
-        study_load_config(names[c], &cfg);
-        const ppb_scene *sc = &cfg.scene;
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "burley", &out);
-        for (size_t i = 0; i < out.layout.ncells; i++) {
-            assert_true(isfinite(out.radiance[i]));
-            assert_true(out.radiance[i] >= 0);
-        }
-        ppb_err err;
-        double Amax = 0, smin = INFINITY,
-               entry = sc->n > 1 ? 1 - ppb_fresnel(cos(sc->theta_deg * PPB_PI / 180), sc->n) : 1;
-        for (int side = 0; side < 2; side++) {
-            double st = side ? (sc->step == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t)
-                             : sc->sigma_t;
-            double al =
-                side ? (sc->step == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo) : sc->albedo;
-            double A;
-            assert_int_equal(ppb_burley_albedo(al, sc->g, sc->n, cos(sc->theta_deg * PPB_PI / 180),
-                                               cfg.burley.directions, &A, &err),
-                             0);
-            Amax = fmax(Amax, A);
-            smin = fmin(smin, ppb_burley_shape_searchlight(A) * st * (1 - al * sc->g));
-        }
-        ppb_burley far = {Amax, smin};
-        double sum = out.totals.R + out.totals.T + out.totals.sides;
-        print_message("%-24s A %.4f  R %.4f T %.4f sides %.4f  sum %.4f  ballistic %.4f\n",
-                      names[c], Amax, out.totals.R, out.totals.T, out.totals.sides, sum,
-                      out.totals.ballistic);
-        assert_le(out.totals.R, entry * Amax * (1 + 1e-12));
-        assert_le(out.totals.T,
-                  entry * Amax * (1 - ppb_burley_cdf(&far, sc->height)) * (1 + 1e-12));
-        assert_le(out.totals.sides, entry * Amax * (1 + 1e-12));
-        assert_le(sum, 1 + 1e-3); /* the result check's energy bound (reference: Methods) */
-        ppb_result_free(&out);
-    }
+    pu_study_configs("burley", NULL, study_bounds);
+}
+
+/* 32 direction cells for A at the corners, in the method and in corner_bounds alike. */
+static void coarse_directions(ppb_config *cfg)
+{
+    cfg->burley.directions = 32;
+}
+
+/* R at a corner of the robustness grid within (1 - F) A (test_extremes). */
+static void corner_bounds(const pu_corner *c, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    (void)ctx;
+    ppb_err err;
+    double A, mu = cos(c->theta * PPB_PI / 180);
+    assert_int_equal(ppb_burley_albedo(c->albedo, c->g, c->n, mu, 32, &A, &err), 0);
+    assert_between(A, 0, 1);
+    assert_le(out->totals.R, A * (1 + 1e-12));
 }
 
 static void test_extremes(void **state)
@@ -336,44 +314,13 @@ static void test_extremes(void **state)
      * finite and >= 0, R within (1 - F) A, and the result checks of the method passed. */
     const double albedo[] = {0, 0.01, 0.5, 0.999, 1}, g[] = {-0.95, 0, 0.95},
                  height[] = {1e-3, 1, 1e3}, theta[] = {0, 89}, n[] = {1, 1.4};
-    int runs = 0;
-    for (int geo = 0; geo < 2; geo++)
-        for (int ia = 0; ia < 5; ia++)
-            for (int ig = 0; ig < 3; ig++)
-                for (int ih = 0; ih < 3; ih++)
-                    for (int it = 0; it < 2; it++)
-                        for (int in = 0; in < 2; in++) {
-                            ppb_config cfg;
-                            ppb_err err;
-                            assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-                            cfg.scene =
-                                geo ? tu_slab(height[ih], albedo[ia], g[ig], theta[it]) : tu_tube();
-                            cfg.scene.albedo = albedo[ia];
-                            cfg.scene.g = g[ig];
-                            cfg.scene.height = height[ih];
-                            cfg.scene.theta_deg = theta[it];
-                            cfg.scene.n = n[in];
-                            cfg.scene.segments_top = 8;
-                            cfg.scene.segments_side = 4;
-                            cfg.samples_seg = 1;
-                            cfg.burley.directions = 32;
-                            ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-                            ppb_result out;
-                            study_run_id(&ctx, "burley", &out);
-                            for (size_t i = 0; i < out.layout.ncells; i++)
-                                if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
-                                    fail_msg("albedo %g g %g H %g theta %g n %g: cell %zu = %g",
-                                             albedo[ia], g[ig], height[ih], theta[it], n[in], i,
-                                             out.radiance[i]);
-                            double A, mu = cos(theta[it] * PPB_PI / 180);
-                            assert_int_equal(
-                                ppb_burley_albedo(albedo[ia], g[ig], n[in], mu, 32, &A, &err), 0);
-                            assert_between(A, 0, 1);
-                            assert_le(out.totals.R, A * (1 + 1e-12));
-                            ppb_result_free(&out);
-                            runs++;
-                        }
-    print_message("%d runs at the extremes\n", runs);
+    pu_grid grid = {1, PU_AXIS(albedo), PU_AXIS(g), PU_AXIS(height), PU_AXIS(theta), PU_AXIS(n)};
+    pu_extremes("burley", &grid, coarse_directions, corner_bounds);
+}
+
+static void set_samples(ppb_config *cfg, int samples)
+{
+    cfg->burley.samples = samples;
 }
 
 static void test_quadrature_converges_on_tube(void **state)
@@ -381,31 +328,22 @@ static void test_quadrature_converges_on_tube(void **state)
     (void)state;
     /* The method's quadrature error on the tube (uniform_g0_normal and density_step): every
      * cell at [burley] samples = 16 (default) and 8 against 64 nodes per d. */
-    const char *names[] = {"uniform_g0_normal", "density_step"};
-    for (int c = 0; c < 2; c++) {
-        ppb_config cfg;
-        study_load_config(names[c], &cfg);
-        cfg.scene.segments_top = 32;
-        cfg.scene.segments_side = 12;
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result ref, r;
-        cfg.burley.samples = 64;
-        study_run_id(&ctx, "burley", &ref);
-        const int nodes[] = {8, 16};
-        for (int k = 0; k < 2; k++) {
-            cfg.burley.samples = nodes[k];
-            study_run_id(&ctx, "burley", &r);
-            double worst = 0;
-            for (size_t i = 0; i < r.layout.ncells; i++)
-                worst = fmax(worst, fabs(r.radiance[i] - ref.radiance[i]) / ref.radiance[i]);
-            print_message("%s: samples %2d vs 64: largest relative cell difference %.2e\n",
-                          names[c], nodes[k], worst);
-            if (nodes[k] == 16)
-                assert_lt(worst, 1e-10);
-            ppb_result_free(&r);
-        }
-        ppb_result_free(&ref);
-    }
+    pu_samples_converge("burley", "uniform_g0_normal", NAN, set_samples);
+    pu_samples_converge("burley", "density_step", NAN, set_samples);
+}
+
+/* A slab's totals and S1's lobe (test_slab_mode). */
+static void slab_totals(ppb_run_ctx *ctx, const ppb_result *out, double mu, double entry)
+{
+    ppb_err err;
+    double A;
+    assert_int_equal(
+        ppb_burley_albedo(0.95, 0.0, ctx->cfg->scene.n, mu, ctx->cfg->burley.directions, &A, &err),
+        0);
+    ppb_burley b = {A, ppb_burley_shape_searchlight(A) * (1 - 0.95 * 0.0)};
+    assert_rel(out->totals.R, entry * A, 1e-14);
+    assert_rel(out->totals.T, entry * A * (1 - ppb_burley_cdf(&b, 3.0)), 1e-14);
+    pu_assert_lobe_mean(out, mu);
 }
 
 static void test_slab_mode(void **state)
@@ -414,29 +352,7 @@ static void test_slab_mode(void **state)
     /* Slab mode: R = (1 - F) A and T = (1 - F) A (1 - cdf(H)) (the profile over the planes at
      * distance 0 and H), radiance R cos(theta_L) / pi on S1 at n = 1; at n = 1.4 the exit lobe
      * distributes the same flux (its bins' mean is 1). */
-    const double n[] = {1.0, 1.4};
-    for (int i = 0; i < 2; i++) {
-        ppb_config cfg;
-        ppb_err err;
-        assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-        cfg.scene = tu_slab(3.0, 0.95, 0.0, 30.0);
-        cfg.scene.n = n[i];
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "burley", &out);
-        double mu = cos(30 * PPB_PI / 180), A;
-        double entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
-        assert_int_equal(ppb_burley_albedo(0.95, 0.0, n[i], mu, cfg.burley.directions, &A, &err),
-                         0);
-        ppb_burley b = {A, ppb_burley_shape_searchlight(A) * (1 - 0.95 * 0.0)};
-        assert_rel(out.totals.R, entry * A, 1e-14);
-        assert_rel(out.totals.T, entry * A * (1 - ppb_burley_cdf(&b, 3.0)), 1e-14);
-        double mean = 0;
-        for (int bin = 0; bin < out.layout.nbins; bin++)
-            mean += out.radiance[ppb_cell(&out.layout, PPB_S1, 0, bin)] / out.layout.nbins;
-        assert_rel(mean, out.totals.R * mu / PPB_PI, 1e-12);
-        ppb_result_free(&out);
-    }
+    pu_slab_mode("burley", slab_totals);
 }
 
 static void test_sum_with_ss(void **state)

@@ -9,6 +9,7 @@
  * bounds) and dirpole+ss = dirpole + ss cell by cell. */
 #include "testutil.h"
 #include "study_cases.h"
+#include "profileutil.h"
 
 #include <math.h>
 
@@ -258,14 +259,28 @@ static void plane_bounds(const ppb_scene *sc, double *R, double *T)
     beam(sc->theta_deg, sc->n > 1 ? sc->n : 1.0, w);
     *R = *T = 0;
     for (int side = 0; side < 2; side++) {
-        double st = side && sc->step == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t;
-        double al = side && sc->step == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo;
+        double st, al;
+        pu_side_medium(sc, side, &st, &al);
         ppb_dirpole p;
         ppb_dirpole_init(&p, st, al, sc->g, sc->n, w);
         double wide = 100 / p.sigma_tr;
         *R = fmax(*R, ppb_dirpole_strip(&p, -wide, wide, 0, UP, 16));
         *T = fmax(*T, ppb_dirpole_strip(&p, -wide, wide, -sc->height, DOWN, 16));
     }
+}
+
+/* S1's and S2's totals against the bounds of test_study_configs. */
+static void study_bounds(const char *name, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    const ppb_scene *sc = &ctx->cfg->scene;
+    double entry = pu_entry(sc), Rp, Tp;
+    double wide = sc->width / ppb_scene_lit_width(sc);
+    plane_bounds(sc, &Rp, &Tp);
+    print_message("%-24s R %.4f (plane %.4f) T %.4f (plane %.4f) sides %.4f\n", name, out->totals.R,
+                  Rp, out->totals.T, Tp, out->totals.sides);
+    assert_le(out->totals.R, entry * Rp * wide * (1 + 1e-9));
+    assert_le(out->totals.T, entry * Tp * wide * (1 + 1e-9));
+    assert_true(out->totals.sides >= 0 && out->totals.sides <= entry * Rp * wide);
 }
 
 static void test_study_configs(void **state)
@@ -276,30 +291,24 @@ static void test_study_configs(void **state)
      * gives each exit point at most what the whole plane of entry points gives, R_plane at the
      * face and T_plane at depth H; over the face that is at most (1 - F) R_plane W / W_lit of
      * the entering power (W_lit the lit width), likewise T. */
-    char names[STUDY_MAX_CASES][64];
-    int ncase = study_cases(names);
-    for (int c = 0; c < ncase; c++) {
-        ppb_config cfg;
-        study_load_config(names[c], &cfg);
-        const ppb_scene *sc = &cfg.scene;
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "dirpole", &out);
-        for (size_t i = 0; i < out.layout.ncells; i++) {
-            assert_true(isfinite(out.radiance[i]));
-            assert_true(out.radiance[i] >= 0);
-        }
-        double mu = cos(sc->theta_deg * PPB_PI / 180);
-        double entry = sc->n > 1 ? 1 - ppb_fresnel(mu, sc->n) : 1, Rp, Tp;
-        double wide = sc->width / ppb_scene_lit_width(sc);
-        plane_bounds(sc, &Rp, &Tp);
-        print_message("%-24s R %.4f (plane %.4f) T %.4f (plane %.4f) sides %.4f\n", names[c],
-                      out.totals.R, Rp, out.totals.T, Tp, out.totals.sides);
-        assert_le(out.totals.R, entry * Rp * wide * (1 + 1e-9));
-        assert_le(out.totals.T, entry * Tp * wide * (1 + 1e-9));
-        assert_true(out.totals.sides >= 0 && out.totals.sides <= entry * Rp * wide);
-        ppb_result_free(&out);
-    }
+    pu_study_configs("dirpole", NULL, study_bounds);
+}
+
+/* The corners at 4 [dirpole] samples: short runs (accuracy is test_strip_converges's). */
+static void coarse_samples(ppb_config *cfg)
+{
+    cfg->dirpole.samples = 4;
+}
+
+/* Nothing at all leaves at albedo 0 (test_extremes). */
+static void corner_dark(const pu_corner *c, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    (void)ctx;
+    double sum = 0;
+    for (size_t i = 0; i < out->layout.ncells; i++)
+        sum += out->radiance[i];
+    if (c->albedo == 0)
+        assert_close(sum, 0, 0);
 }
 
 static void test_extremes(void **state)
@@ -311,44 +320,20 @@ static void test_extremes(void **state)
      * alpha' = 0, the extrapolation distance infinite). */
     const double albedo[] = {0, 0.5, 1}, g[] = {-0.95, 0.95}, height[] = {1e-3, 1e3},
                  theta[] = {0, 89}, n[] = {1, 1.4};
-    int runs = 0;
-    for (int geo = 0; geo < 2; geo++)
-        for (int ia = 0; ia < 3; ia++)
-            for (int ig = 0; ig < 2; ig++)
-                for (int ih = 0; ih < 2; ih++)
-                    for (int it = 0; it < 2; it++)
-                        for (int in = 0; in < 2; in++) {
-                            ppb_config cfg;
-                            ppb_err err;
-                            assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-                            cfg.scene =
-                                geo ? tu_slab(height[ih], albedo[ia], g[ig], theta[it]) : tu_tube();
-                            cfg.scene.albedo = albedo[ia];
-                            cfg.scene.g = g[ig];
-                            cfg.scene.height = height[ih];
-                            cfg.scene.theta_deg = theta[it];
-                            cfg.scene.n = n[in];
-                            cfg.scene.segments_top = 8;
-                            cfg.scene.segments_side = 4;
-                            cfg.samples_seg = 1;
-                            cfg.dirpole.samples = 4;
-                            ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-                            ppb_result out;
-                            study_run_id(&ctx, "dirpole", &out);
-                            double sum = 0;
-                            for (size_t i = 0; i < out.layout.ncells; i++) {
-                                if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
-                                    fail_msg("albedo %g g %g H %g theta %g n %g: cell %zu = %g",
-                                             albedo[ia], g[ig], height[ih], theta[it], n[in], i,
-                                             out.radiance[i]);
-                                sum += out.radiance[i];
-                            }
-                            if (albedo[ia] == 0)
-                                assert_close(sum, 0, 0);
-                            ppb_result_free(&out);
-                            runs++;
-                        }
-    print_message("%d runs at the extremes\n", runs);
+    pu_grid grid = {1, PU_AXIS(albedo), PU_AXIS(g), PU_AXIS(height), PU_AXIS(theta), PU_AXIS(n)};
+    pu_extremes("dirpole", &grid, coarse_samples, corner_dark);
+}
+
+/* A slab's totals and S1's lobe (test_slab_mode). */
+static void slab_totals(ppb_run_ctx *ctx, const ppb_result *out, double mu, double entry)
+{
+    double n = ctx->cfg->scene.n, w[3];
+    ppb_dirpole p;
+    beam(30, n, w);
+    ppb_dirpole_init(&p, 1.0, 0.95, 0.0, n, w);
+    assert_rel(out->totals.R, entry * plane_polar(&p, 0, UP), 1e-10);
+    assert_rel(out->totals.T, entry * plane_polar(&p, -3, DOWN), 1e-10);
+    pu_assert_lobe_mean(out, mu);
 }
 
 static void test_slab_mode(void **state)
@@ -357,29 +342,7 @@ static void test_slab_mode(void **state)
     /* Slab mode: R and T are (1 - F(theta_L)) times the plane integrals (the polar quadrature
      * of test_plane_integrals), radiance R cos(theta_L) / pi on S1 (the lobe's bins' mean 1 at
      * n = 1.4). */
-    const double n[] = {1.0, 1.4};
-    for (int i = 0; i < 2; i++) {
-        ppb_config cfg;
-        ppb_err err;
-        assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-        cfg.scene = tu_slab(3.0, 0.95, 0.0, 30.0);
-        cfg.scene.n = n[i];
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "dirpole", &out);
-        double mu = cos(30 * PPB_PI / 180), w[3];
-        double entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
-        ppb_dirpole p;
-        beam(30, n[i], w);
-        ppb_dirpole_init(&p, 1.0, 0.95, 0.0, n[i], w);
-        assert_rel(out.totals.R, entry * plane_polar(&p, 0, UP), 1e-10);
-        assert_rel(out.totals.T, entry * plane_polar(&p, -3, DOWN), 1e-10);
-        double mean = 0;
-        for (int bin = 0; bin < out.layout.nbins; bin++)
-            mean += out.radiance[ppb_cell(&out.layout, PPB_S1, 0, bin)] / out.layout.nbins;
-        assert_rel(mean, out.totals.R * mu / PPB_PI, 1e-12);
-        ppb_result_free(&out);
-    }
+    pu_slab_mode("dirpole", slab_totals);
 }
 
 static void test_sum_with_ss(void **state)

@@ -8,6 +8,7 @@
  * study config, in slab mode and at the extremes. */
 #include "testutil.h"
 #include "study_cases.h"
+#include "profileutil.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -433,6 +434,38 @@ static void test_strip_quadrature(void **state)
     assert_lt(worst12, 1);
 }
 
+/* The study's tube at 32 top and 12 side segments: the suite stays short. */
+static void coarse_segments(ppb_config *cfg)
+{
+    cfg->scene.segments_top = 32;
+    cfg->scene.segments_side = 12;
+}
+
+/* A study config's kept table and its totals against the bounds of test_study_configs. */
+static void study_bounds(const char *name, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    const ppb_scene *sc = &ctx->cfg->scene;
+    assert_non_null(ppb_ctx_state(ctx, "pbd"));
+    double entry = pu_entry(sc);
+    double rmax = 0, tmax = 0;
+    for (int side = 0; side < 2; side++) {
+        double st, al;
+        pu_side_medium(sc, side, &st, &al);
+        ppb_pbd_profile p;
+        ppb_pbd_profile_init(&p, table(sc->g, sc->n), st, al);
+        rmax = fmax(rmax, ppb_pbd_plane(&p, 0));
+        tmax = fmax(tmax, ppb_pbd_plane(&p, sc->height));
+    }
+    double sum = out->totals.R + out->totals.T + out->totals.sides;
+    print_message("%-24s rhoEff %.4f  R %.4f T %.4f sides %.4f  sum %.4f\n", name, rmax,
+                  out->totals.R, out->totals.T, out->totals.sides, sum);
+    assert_le(out->totals.R, entry * rmax * (1 + 1e-9));
+    assert_le(out->totals.T, entry * tmax * (1 + 1e-9));
+    assert_le(out->totals.sides, entry * rmax * (1 + 1e-9));
+    assert_lt(0.1 * entry * rmax, out->totals.R); /* most of it within the lit strip's reach */
+    assert_le(sum, 1 + 1e-3);
+}
+
 static void test_study_configs(void **state)
 {
     (void)state;
@@ -442,44 +475,23 @@ static void test_study_configs(void **state)
      * S2 in the plane at distance H (at most the plane integral beyond H), the two sides in
      * half planes (at most rhoEff together); times the entering 1 - F(theta_L), with the
      * largest over the tube's media. The table is built once per (g, n) and kept. */
-    char names[STUDY_MAX_CASES][64];
-    int ncase = study_cases(names);
-    for (int c = 0; c < ncase; c++) {
-        const char *name = names[c];
-        ppb_config cfg;
-        study_load_config(name, &cfg);
-        cfg.scene.segments_top = 32;
-        cfg.scene.segments_side = 12;
-        const ppb_scene *sc = &cfg.scene;
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out;
-        study_run_id(&ctx, "pbd", &out);
-        assert_non_null(ppb_ctx_state(&ctx, "pbd"));
-        for (size_t i = 0; i < out.layout.ncells; i++) {
-            assert_true(isfinite(out.radiance[i]));
-            assert_true(out.radiance[i] >= 0);
-        }
-        double entry = sc->n > 1 ? 1 - ppb_fresnel(cos(sc->theta_deg * PPB_PI / 180), sc->n) : 1;
-        double rmax = 0, tmax = 0;
-        for (int side = 0; side < 2; side++) {
-            double st = side && sc->step == PPB_STEP_DENSITY ? sc->sigma_t_right : sc->sigma_t;
-            double al = side && sc->step == PPB_STEP_ALBEDO ? sc->albedo_right : sc->albedo;
-            ppb_pbd_profile p;
-            ppb_pbd_profile_init(&p, table(sc->g, sc->n), st, al);
-            rmax = fmax(rmax, ppb_pbd_plane(&p, 0));
-            tmax = fmax(tmax, ppb_pbd_plane(&p, sc->height));
-        }
-        double sum = out.totals.R + out.totals.T + out.totals.sides;
-        print_message("%-24s rhoEff %.4f  R %.4f T %.4f sides %.4f  sum %.4f\n", name, rmax,
-                      out.totals.R, out.totals.T, out.totals.sides, sum);
-        assert_le(out.totals.R, entry * rmax * (1 + 1e-9));
-        assert_le(out.totals.T, entry * tmax * (1 + 1e-9));
-        assert_le(out.totals.sides, entry * rmax * (1 + 1e-9));
-        assert_lt(0.1 * entry * rmax, out.totals.R); /* most of it within the lit strip's reach */
-        assert_le(sum, 1 + 1e-3);
-        ppb_result_free(&out);
-        ppb_ctx_close(&ctx);
-    }
+    pu_study_configs("pbd", coarse_segments, study_bounds);
+}
+
+/* A slab's totals, and a second run in the same context (test_slab_mode). */
+static void slab_totals(ppb_run_ctx *ctx, const ppb_result *out, double mu, double entry)
+{
+    (void)mu;
+    ppb_result again;
+    study_run_id(ctx, "pbd", &again);
+    ppb_pbd_profile p;
+    ppb_pbd_profile_init(&p, table(0.0, ctx->cfg->scene.n), ctx->cfg->scene.sigma_t, 0.95);
+    assert_close(out->totals.R, entry * (p.rho_eff - negative_mass(&p)),
+                 entry * (1e-2 * fabs(negative_mass(&p)) + 1e-14));
+    assert_rel(out->totals.T, entry * ppb_pbd_plane(&p, 3.0), 1e-14);
+    assert_close(again.totals.R, out->totals.R, 0);
+    assert_close(again.totals.T, out->totals.T, 0);
+    ppb_result_free(&again);
 }
 
 static void test_slab_mode(void **state)
@@ -488,29 +500,15 @@ static void test_slab_mode(void **state)
     /* Slab mode: R = (1 - F) (the mixed rhoEff less the clamped negative part), T = (1 - F) the
      * plane integral beyond H, and a second run in the same context reuses the kept table
      * (identical totals). */
-    const double n[] = {1.0, 1.4};
-    for (int i = 0; i < 2; i++) {
-        ppb_config cfg;
-        ppb_err err;
-        assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-        cfg.scene = tu_slab(3.0, 0.95, 0.0, 30.0);
-        cfg.scene.n = n[i];
-        ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-        ppb_result out, again;
-        study_run_id(&ctx, "pbd", &out);
-        study_run_id(&ctx, "pbd", &again);
-        double mu = cos(30 * PPB_PI / 180), entry = n[i] > 1 ? 1 - ppb_fresnel(mu, n[i]) : 1;
-        ppb_pbd_profile p;
-        ppb_pbd_profile_init(&p, table(0.0, n[i]), cfg.scene.sigma_t, 0.95);
-        assert_close(out.totals.R, entry * (p.rho_eff - negative_mass(&p)),
-                     entry * (1e-2 * fabs(negative_mass(&p)) + 1e-14));
-        assert_rel(out.totals.T, entry * ppb_pbd_plane(&p, 3.0), 1e-14);
-        assert_close(again.totals.R, out.totals.R, 0);
-        assert_close(again.totals.T, out.totals.T, 0);
-        ppb_result_free(&out);
-        ppb_result_free(&again);
-        ppb_ctx_close(&ctx);
-    }
+    pu_slab_mode("pbd", slab_totals);
+}
+
+/* Albedo 0 reflects nothing (test_extremes). */
+static void corner_dark(const pu_corner *c, ppb_run_ctx *ctx, const ppb_result *out)
+{
+    (void)ctx;
+    if (c->albedo == 0)
+        assert_close(out->totals.R, 0, 0);
 }
 
 static void test_extremes(void **state)
@@ -520,36 +518,8 @@ static void test_extremes(void **state)
      * and >= 0 and the method's result checks passed; albedo 0 reflects nothing. */
     const double albedo[] = {0, 0.01, 0.5, 0.999, 1}, g[] = {-0.95, 0, 0.95},
                  height[] = {1e-3, 1e3}, n[] = {1, 1.4};
-    int runs = 0;
-    for (int ia = 0; ia < 5; ia++)
-        for (int ig = 0; ig < 3; ig++)
-            for (int ih = 0; ih < 2; ih++)
-                for (int in = 0; in < 2; in++) {
-                    ppb_config cfg;
-                    ppb_err err;
-                    assert_int_equal(ppb_config_defaults(&cfg, &err), 0);
-                    cfg.scene = tu_tube();
-                    cfg.scene.albedo = albedo[ia];
-                    cfg.scene.g = g[ig];
-                    cfg.scene.height = height[ih];
-                    cfg.scene.n = n[in];
-                    cfg.scene.segments_top = 8;
-                    cfg.scene.segments_side = 4;
-                    cfg.samples_seg = 1;
-                    ppb_run_ctx ctx = {.cfg = &cfg, .quiet = 1};
-                    ppb_result out;
-                    study_run_id(&ctx, "pbd", &out);
-                    for (size_t i = 0; i < out.layout.ncells; i++)
-                        if (!(isfinite(out.radiance[i]) && out.radiance[i] >= 0))
-                            fail_msg("albedo %g g %g H %g n %g: cell %zu = %g", albedo[ia], g[ig],
-                                     height[ih], n[in], i, out.radiance[i]);
-                    if (albedo[ia] == 0)
-                        assert_close(out.totals.R, 0, 0);
-                    ppb_result_free(&out);
-                    ppb_ctx_close(&ctx);
-                    runs++;
-                }
-    print_message("%d runs at the extremes\n", runs);
+    pu_grid grid = {0, PU_AXIS(albedo), PU_AXIS(g), PU_AXIS(height), {NULL, 0}, PU_AXIS(n)};
+    pu_extremes("pbd", &grid, NULL, corner_dark);
 }
 
 int main(void)
