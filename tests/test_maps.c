@@ -6,6 +6,7 @@
 #include <math.h>
 
 #include "physics/maps.h"
+#include "physics/totals.h"
 
 /* The map at 16 cells per mfp: every study case's jumps lie on cell edges, so the bilinear
  * lookup must reproduce the closed forms to rounding wherever it is read. */
@@ -226,6 +227,51 @@ static void test_ballistic(void **state)
     assert_close(ppb_beam_depth(&slab, 0.0), 4.0, 1e-14);
 }
 
+/* The ballistic fraction split by exit face (delta-M's totals in rte2d move the scaled beam's
+ * excess through these faces). n = 1, 45 deg: test_ballistic's two parts, S2 and S4. n = 1.5
+ * slab and n = 1.4 tube at normal light, Fresnel F = ((n - 1) / (n + 1))^2 at both faces and at
+ * entry: the beam's series, (1 - F)^2 e^-tau / (1 - F^2 e^-2tau) at S2 and F e^-tau times that at
+ * S1. n = 1.4, 45 deg (the walk off all four faces): the faces sum to ppb_bin_totals' ballistic
+ * and the sides, where the beam is totally reflected, get none. */
+static void test_ballistic_faces(void **state)
+{
+    (void)state;
+    double b[PPB_NSURF];
+    ppb_scene sc = tu_tube();
+    sc.theta_deg = 45;
+    double r2 = sqrt(2.0), e = exp(-3.0 * r2);
+    ppb_ballistic_faces(&sc, b);
+    assert_close(b[PPB_S2], 7.0 * e / 10.0, 1e-10);
+    assert_close(b[PPB_S4], (1.0 - e) / r2 / 10.0, 1e-10);
+    assert_close(b[PPB_S1] + b[PPB_S3], 0.0, 0.0);
+    struct {
+        ppb_scene sc;
+        double n, tau;
+    } cs[] = {{tu_slab(2.0, 0.9, 0.0, 0.0), 1.5, 2.0}, {tu_tube(), 1.4, 3.0}};
+    for (int c = 0; c < 2; c++) {
+        cs[c].sc.n = cs[c].n;
+        double F = pow((cs[c].n - 1.0) / (cs[c].n + 1.0), 2.0), t = exp(-cs[c].tau);
+        double s2 = (1.0 - F) * (1.0 - F) * t / (1.0 - F * F * t * t);
+        ppb_ballistic_faces(&cs[c].sc, b);
+        assert_close(b[PPB_S2], s2, 1e-12);
+        assert_close(b[PPB_S1], s2 * F * t, 1e-12);
+        assert_close(b[PPB_S3] + b[PPB_S4], 0.0, 0.0);
+    }
+    sc.n = 1.4;
+    ppb_layout lo = ppb_scene_layout(&sc);
+    double *zero = calloc(lo.ncells, sizeof *zero);
+    assert_non_null(zero);
+    ppb_totals t;
+    ppb_bin_totals(&sc, &lo, zero, &t);
+    ppb_ballistic_faces(&sc, b);
+    assert_close(b[PPB_S1] + b[PPB_S2] + b[PPB_S3] + b[PPB_S4], t.ballistic, 1e-14);
+    /* the refracted beam (30.3 deg) meets S4 at 59.7 deg from its normal, beyond the critical
+     * 45.6 deg: it leaves through S2 and, reflected, S1 alone */
+    assert_true(b[PPB_S1] > 0.0 && b[PPB_S2] > 0.0);
+    assert_close(b[PPB_S3] + b[PPB_S4], 0.0, 0.0);
+    free(zero);
+}
+
 /* Oblique light across the density step (theta_L = 30 deg, sigma_t 1 -> 0.5 at x = 0), the case
  * where mp's own copy of the beam depth and its 3-point rule were off by 8e-8. The beam's
  * path has length L = H / cos = 2 sqrt 3 and crosses x over H tan = sqrt 3 (sin = 1/2). */
@@ -300,6 +346,7 @@ int main(void)
         cmocka_unit_test(test_average_albedo_oblique),
         cmocka_unit_test(test_slab),
         cmocka_unit_test(test_ballistic),
+        cmocka_unit_test(test_ballistic_faces),
         cmocka_unit_test(test_ballistic_oblique_density),
         cmocka_unit_test(test_lit_midpoint_sum),
     };

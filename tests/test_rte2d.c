@@ -29,6 +29,7 @@
 #include "methods/rte2d/method_rte2d.h"
 #include "model/config.h"
 #include "model/metrics.h"
+#include "physics/totals.h"
 #include "physics/gmres.h"
 
 /* ---- GMRES ---- */
@@ -331,12 +332,13 @@ static void test_energy_balance(void **state)
 }
 
 /* Delta-M (reference: Methods, `rte2d`) keeps the balance: the scaled problem is a transport
- * problem of its own (sigma_a kept, the delta part unscattered, the ballistic total attenuated
- * with sigma_t'), so R + T + sides + absorbed + ballistic + specular = 1 to the solve's
- * residual, as without it (test_energy_balance): the realistic medium (g = 0.9, albedo 0.99)
- * at n = 1.4, with oblique light and a density step, and in the slab. f is g^L, L = sqrt(2 x 32)
- * = 8 (its definition); an albedo step, whose scaled sigma_t would step too, is solved without
- * delta-M (f = 0). */
+ * problem of its own (sigma_a kept, the delta part unscattered, its beam attenuated with
+ * sigma_t'; the totals move what that beam carries beyond the exact one into the faces it
+ * leaves through, and report the exact ballistic), so R + T + sides + absorbed + ballistic +
+ * specular = 1 to the solve's residual, as without it (test_energy_balance): the realistic medium
+ * (g = 0.9, albedo 0.99) at n = 1.4, with oblique light and a density step, and in the slab. f is
+ * g^L, L = sqrt(2 x 32) = 8 (its definition); an albedo step, whose scaled sigma_t would step too,
+ * is solved without delta-M (f = 0). */
 static void test_delta_m_energy_balance(void **state)
 {
     (void)state;
@@ -377,6 +379,11 @@ static void test_delta_m_energy_balance(void **state)
                a.totals.ballistic, res, st.sweeps);
         assert_true(st.converged);
         assert_le(fabs(res), 1e-6);
+        /* ballistic is the exact unscattered light (the unscaled scene's, totals.h), the scaled
+         * beam's excess being counted in the faces it leaves through */
+        ppb_totals exact;
+        ppb_bin_totals(&cfg.scene, &a.layout, a.radiance, &exact);
+        assert_close(a.totals.ballistic, exact.ballistic, 1e-14);
         if (cs[c].step == PPB_STEP_ALBEDO)
             assert_true(st.delta_f == 0.0);
         else

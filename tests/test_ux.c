@@ -84,10 +84,10 @@ static void test_provenance_versions_and_short_reals(void **state)
 
 /* The files of a set that a repeated run must reproduce byte for byte (timings.csv and
  * provenance.txt hold times and paths, docs/reference.md: Outputs). */
-static const char *const result_files[] = {
-    "radiance.csv", "totals.csv",      "angular.csv",   "rms.csv",       "summary.csv",
-    "regions.csv",  "summary_mc1.csv", "images/mc.exr", "images/ss.exr", "config.ini",
-    "mc_totals.csv"};
+static const char *const result_files[] = {"radiance.csv",    "totals.csv",    "angular.csv",
+                                           "rms.csv",         "summary.csv",   "regions.csv",
+                                           "summary_mc1.csv", "images/mc.exr", "images/ss.exr",
+                                           "config.ini",      "mc_totals.csv"};
 
 static void test_config_ini_repeats_run(void **state)
 {

@@ -24,9 +24,15 @@ static double fresnel_unscattered(const ppb_scene *sc, double x_entry, void *arg
  * is below 1e-16. With a density step a leg's optical depth counts its part at x >= step_x with
  * sigma_t_right: a straight leg's x is monotone, so that part is the overlap of its x range with
  * [step_x, W/2], over |dx|. arg: the ppb_fresnel_beam. */
+typedef struct walk_arg {
+    const ppb_fresnel_beam *b;
+    int face; /* -1: every face; else only what leaves through this one */
+} walk_arg;
+
 static double fresnel_walk(const ppb_scene *sc, double x_e, void *arg)
 {
-    const ppb_fresnel_beam *b = arg;
+    const walk_arg *a = arg;
+    const ppb_fresnel_beam *b = a->b;
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
     double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, tau = 0.0, out = 0.0;
     for (int hit = 0; hit < 100000 && w * exp(-tau) > 1e-16; hit++) {
@@ -39,7 +45,8 @@ static double fresnel_walk(const ppb_scene *sc, double x_e, void *arg)
             tau += sc->sigma_t * l + (sc->sigma_t_right - sc->sigma_t) * right / fabs(dx);
         } else
             tau += sc->sigma_t * l;
-        out += w * (1.0 - f) * exp(-tau);
+        if (a->face < 0 || a->face == face)
+            out += w * (1.0 - f) * exp(-tau);
         w *= f;
         ppb_tube_reflect(face, W, H, l, &x, &y, &dx, &dy);
     }
@@ -52,7 +59,8 @@ static double fresnel_ballistic(const ppb_scene *sc, const ppb_fresnel_beam *b)
     if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
         /* The walk's mean over the lit part of S1, by midpoints (maps.h). */
         const int np = PPB_LIT_MIDPOINTS;
-        double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, (void *)b, np, &width);
+        walk_arg a = {b, -1};
+        double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, &a, np, &width);
         return (1.0 - b->specular) * sum / np;
     }
     if (sc->geometry == PPB_GEOM_SLAB) {
@@ -89,4 +97,57 @@ void ppb_bin_totals(const ppb_scene *sc, const ppb_layout *lo, const double *rad
     }
     t->absorbed_tracked = 0;
     ppb_totals_complete(t);
+}
+
+/* At n = 1 the beam leaves at the first face it meets: S2, or S4 for oblique light that reaches
+ * x = W/2 first (ppb_beam_depth); the unscattered part through face *arg, else 0. */
+static double unscattered_on(const ppb_scene *sc, double x_e, void *arg)
+{
+    int face = *(const int *)arg;
+    double xb = x_e + sc->height * ppb_scene_tan_theta_l(sc);
+    int out = xb > ppb_face_line(PPB_S4, sc->width, sc->height) ? PPB_S4 : PPB_S2;
+    return out == face ? exp(-ppb_beam_depth(sc, x_e)) : 0.0;
+}
+
+/* At n > 1, normal incidence (a vertical beam meets S2 and S1 alone): of the series in
+ * fresnel_unscattered, the terms e^{-(2k+1) tau} leave at S2 and e^{-(2k+2) tau} at S1. */
+static double fresnel_unscattered_on(const ppb_scene *sc, double x_entry, void *arg)
+{
+    const double *fa = arg; /* F_b, face */
+    double fb = fa[0], e = exp(-ppb_beam_depth(sc, x_entry));
+    double s2 = (1.0 - fb) * e / (1.0 - fb * fb * e * e);
+    return (int)fa[1] == PPB_S2 ? s2 : (int)fa[1] == PPB_S1 ? s2 * fb * e : 0.0;
+}
+
+void ppb_ballistic_faces(const ppb_scene *sc, double out[PPB_NSURF])
+{
+    double width;
+    for (int face = 0; face < PPB_NSURF; face++) {
+        out[face] = 0.0;
+        if (sc->n <= 1.0) {
+            if (sc->geometry == PPB_GEOM_SLAB)
+                out[face] = face == PPB_S2 ? ppb_ballistic_fraction(sc) : 0.0;
+            else {
+                double sum = ppb_lit_integral(sc, unscattered_on, &face, &width);
+                out[face] = width > 0.0 ? sum / width : 0.0;
+            }
+            continue;
+        }
+        ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
+        if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
+            walk_arg a = {&b, face};
+            double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, &a, PPB_LIT_MIDPOINTS, &width);
+            out[face] = (1.0 - b.specular) * sum / PPB_LIT_MIDPOINTS;
+        } else if (sc->geometry == PPB_GEOM_SLAB) {
+            double fb = b.f_inside, e = exp(-sc->sigma_t * sc->height / b.cos_t);
+            double s2 = (1.0 - fb) * e / (1.0 - fb * fb * e * e);
+            out[face] = (1.0 - b.specular) * (face == PPB_S2   ? s2
+                                              : face == PPB_S1 ? s2 * fb * e
+                                                               : 0.0);
+        } else {
+            double fa[2] = {b.f_inside, face};
+            double sum = ppb_lit_integral(sc, fresnel_unscattered_on, fa, &width);
+            out[face] = width > 0.0 ? (1.0 - b.specular) * sum / width : 0.0;
+        }
+    }
 }

@@ -13,4 +13,9 @@
 void ppb_bin_totals(const ppb_scene *sc, const ppb_layout *lo, const double *radiance,
                     ppb_totals *t);
 
+/* The same ballistic fraction split by the face it leaves through (S1 .. S4, PPB_S*): their
+ * sum is ppb_bin_totals' ballistic. What delta-M's scaled beam carries beyond the exact one
+ * leaves through these faces as scattered light (method_rte2d.c). */
+void ppb_ballistic_faces(const ppb_scene *sc, double out[PPB_NSURF]);
+
 #endif

@@ -718,10 +718,27 @@ static int solve_field(rte_solver *s, const ppb_config *cfg, double *rad, double
     return rc;
 }
 
+/* Under delta-M the scaled beam (sigma_t') carries, besides the unscattered light, the light
+ * scattered only within the truncated peak, which the scaled problem counts as unscattered
+ * (reference: Methods, `rte2d`, delta-M). It leaves through the faces the scaled beam reaches,
+ * scattered: the totals give each face its share, (scaled less exact) ballistic per face, and
+ * `ballistic` is the exact unscattered light, as every other method reports it. The sum, and so
+ * the balance, is unchanged. */
+static void delta_m_totals(const ppb_scene *scaled, const ppb_scene *exact, ppb_totals *t)
+{
+    double bs[PPB_NSURF], be[PPB_NSURF];
+    ppb_ballistic_faces(scaled, bs);
+    ppb_ballistic_faces(exact, be);
+    t->R += bs[PPB_S1] - be[PPB_S1];
+    t->T += bs[PPB_S2] - be[PPB_S2];
+    t->sides += bs[PPB_S3] + bs[PPB_S4] - be[PPB_S3] - be[PPB_S4];
+    t->ballistic = be[PPB_S1] + be[PPB_S2] + be[PPB_S3] + be[PPB_S4];
+}
+
 /* Absorption, the radiance check and the totals of the converged field rad, whose exit march
- * out holds. */
-static int finish_result(rte_solver *s, const ppb_config *cfg, const double *rad, ppb_result *out,
-                         ppb_rte2d_stats *st, ppb_err *err)
+ * out holds; exact is the unscaled scene (delta-M: st->delta_f > 0) or cfg's own. */
+static int finish_result(rte_solver *s, const ppb_config *cfg, const ppb_scene *exact,
+                         const double *rad, ppb_result *out, ppb_rte2d_stats *st, ppb_err *err)
 {
     const ppb_scene *sc = &cfg->scene;
     const ppb_layout *lo = &out->layout;
@@ -740,6 +757,8 @@ static int finish_result(rte_solver *s, const ppb_config *cfg, const double *rad
     out->totals.sides = (fl[PPB_S3] + fl[PPB_S4]) / in;
     out->totals.absorbed = st->absorbed_beam + st->absorbed_scattered;
     out->totals.absorbed_tracked = 1;
+    if (st->delta_f > 0.0)
+        delta_m_totals(sc, exact, &out->totals);
     return ppb_totals_check(cfg->name, out, err);
 }
 
@@ -850,7 +869,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_f
         rc = exit_march(&s, cfg, &ex, rad, lo, out->radiance, err);
     st.t_exit = ppb_now() - te;
     if (!rc)
-        rc = finish_result(&s, cfg, rad, out, &st, err);
+        rc = finish_result(&s, cfg, &ctx->cfg->scene, rad, out, &st, err);
     st.nodes = s.G.nnodes;
     st.cells = s.G.nc;
     st.clipped = s.G.clipped;

@@ -9,8 +9,10 @@
  * every segment point along every direction sample of every bin, the grid source for that
  * exact direction (the cell integrals F_j(w) of phase.h) plus the exact first scattering, as
  * `pp` averages its bins. So K = 1 is the paper's method (one march from I_pp) on the grid.
- * Totals: R, T, sides from the bins (march.h), ballistic exact, and absorbed tracked: the beam's
- * exact and sigma_a times the converged scattered fluence.
+ * Totals: R, T, sides from the converged cell field at the faces (the balance's), ballistic
+ * exact, and absorbed tracked: the beam's exact and sigma_a times the converged scattered
+ * fluence. Under delta-M the light the scaled beam carries beyond the exact one leaves through
+ * the faces as scattered light (finish_result).
  * n > 1 (reference: Medium): I_1 is the refracted beam's with its S2 -> S1 round trips (in
  * the oblique tube, off all four faces by the mirror images, as ss), T includes the walls'
  * reflection (a march reaching a face adds F times the mirror cell's radiance there, so GMRES
