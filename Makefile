@@ -81,7 +81,7 @@ $(BUILD)/burley_fit: scripts/burley_fit.c $(LIB) | $(BUILD)/deps.mk
 $(BUILD)/slab_budget: scripts/slab_budget.c $(LIB) | $(BUILD)/deps.mk
 	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h | $(BUILD)/deps.mk
+$(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h tests/profileutil.h | $(BUILD)/deps.mk
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) -Itests $(PKG_CFLAGS) $(CFLAGS) -o $@ $< $(LIB) $(LDFLAGS) $(PKG_LIBS) \
 	  $(TEST_LIBS)
@@ -104,8 +104,16 @@ run-suites = @mkdir -p $(BUILD)/tmp; fail=0; for t in $(1); do \
 	done; exit $$fail
 unit: $(BIN) $(UNIT_TESTS)
 	$(call run-suites,$(UNIT_TESTS))
-test-long: $(BIN) $(LONG_TESTS) test-newcomer
+test-long: $(BIN) $(LONG_TESTS) test-newcomer test-rte2d-reference
 	$(call run-suites,$(LONG_TESTS))
+
+# rte2d against the shipped Monte Carlo references, chi-square per bin and totals in standard
+# errors (tests/test_rte2d_reference.sh: the cheap version of scripts/rte2d_reference.sh).
+.PHONY: test-rte2d-reference
+test-rte2d-reference: $(BIN)
+	@mkdir -p $(BUILD)/tmp
+	@PPBENCH=$(CURDIR)/$(BIN) PPBENCH_CACHE= TMPDIR=$(CURDIR)/$(BUILD)/tmp \
+	  bash tests/test_rte2d_reference.sh
 
 # The layer check first: it reads includes only and fails in a second. Then the reference's
 # check (docs/reference.md against what a few tiny runs write, a few seconds).

@@ -45,5 +45,23 @@ check all "- - - 0.418 1"
 # Missing ids: exit 2.
 awk -f "$here/scripts/chi2_radiance.awk" "$tmp/a.csv" >/dev/null 2>&1
 [ $? -eq 2 ] || { echo "FAIL: no ids: not exit 2"; fail=1; }
+# scripts/totals_z.awk: R 0.50 +- 0.01 against B's 0.53 (z 3), T 0.2 +- 0.002 against 0.199 (z
+# -0.5), sides with no standard error ("-"); mc1's rows and other methods' rows are ignored.
+cat > "$tmp/mc_totals.csv" <<'CSV'
+tally,total,mean,se
+mc,R,0.50,0.01
+mc,T,0.2,0.002
+mc,sides,0.1,0
+mc1,R,0.9,0.0001
+CSV
+cat > "$tmp/totals.csv" <<'CSV'
+method,R,T,sides,absorbed,ballistic,specular
+mc,0.50,0.2,0.1,0.1,0.1,0
+B,0.53,0.199,0.3,0,0,0
+CSV
+got=$(awk -v m=B -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
+[ "$got" = "3,-0.5,-" ] || { echo "FAIL: totals_z: got '$got', expected '3,-0.5,-'"; fail=1; }
+awk -v m=C -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv" >/dev/null 2>&1
+[ $? -eq 2 ] || { echo "FAIL: totals_z: a method without a row: not exit 2"; fail=1; }
 [ $fail -eq 0 ] && echo "test_chi2_radiance: ok"
 exit $fail
