@@ -48,6 +48,17 @@ int ppb_afile_open(ppb_afile *af, const char *path, ppb_err *err)
     return 0;
 }
 
+int ppb_afile_open_csv(ppb_afile *af, const char *dir, const char *name, const char *header,
+                       ppb_err *err)
+{
+    char path[PPB_PATH_MAX + 256];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (ppb_afile_open(af, path, err))
+        return -1;
+    fprintf(af->f, "%s\n", header);
+    return 0;
+}
+
 /* Why a stream's earlier write failed. errno at the time is long gone (any call since, a sqrt of
  * a negative, may have set it), so the write is tried again: what is still buffered, or one
  * byte more (the temporary is removed anyway), fails with the OS's reason. */

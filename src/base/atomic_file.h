@@ -36,6 +36,10 @@ typedef struct ppb_afile {
 } ppb_afile;
 
 int ppb_afile_open(ppb_afile *af, const char *path, ppb_err *err);
+/* ppb_afile_open of dir/name, with the header line (and its newline) written: a method's own
+ * CSV beside the output set's files. */
+int ppb_afile_open_csv(ppb_afile *af, const char *dir, const char *name, const char *header,
+                       ppb_err *err);
 /* Flushes, checks for write errors, renames; on any failure removes the temporary. */
 int ppb_afile_commit(ppb_afile *af, ppb_err *err);
 void ppb_afile_abort(ppb_afile *af);

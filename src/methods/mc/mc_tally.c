@@ -498,12 +498,9 @@ static void totals_row(FILE *f, const char *tally, const char *name, double mean
 static int write_totals_extra(const void *data, const char *dir, ppb_err *err)
 {
     const totals_extra *x = data;
-    char path[PPB_PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/mc_totals.csv", dir);
     ppb_afile af;
-    if (ppb_afile_open(&af, path, err))
+    if (ppb_afile_open_csv(&af, dir, "mc_totals.csv", "tally,total,mean,se", err))
         return -1;
-    fprintf(af.f, "tally,total,mean,se\n");
     for (int once = 0; once < 2; once++) {
         const ppb_mc_totals_stats *s = &x->st[once];
         const char *id = once ? "mc1" : "mc";

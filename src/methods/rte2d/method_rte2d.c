@@ -671,12 +671,9 @@ int ppb_rte2d_write_refinements(const ppb_rte2d_study *study, const char *dir, p
 {
     if (!study || study->n == 0)
         return 0;
-    char path[PPB_PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/rte2d_refinements.csv", dir);
     ppb_afile af;
-    if (ppb_afile_open(&af, path, err))
+    if (ppb_afile_open_csv(&af, dir, "rte2d_refinements.csv", "K,cell,rms_rel", err))
         return -1;
-    fprintf(af.f, "K,cell,rms_rel\n");
     for (int i = 0; i < study->n; i++)
         for (int cell = 0; cell < PPB_NCELLS; cell++)
             if (!isnan(study->rms[i][cell]))
