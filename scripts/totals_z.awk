@@ -1,11 +1,12 @@
 #!/usr/bin/awk -f
 # totals_z.awk: a method's per-surface totals against the Monte Carlo's, in its standard errors.
 #
-#   awk -F, -v m=rte2d -f scripts/totals_z.awk DIR/mc_totals.csv DIR/totals.csv
+#   awk -F, -v m=rte2d [-v rel=1] -f scripts/totals_z.awk DIR/mc_totals.csv DIR/totals.csv
 #
 # For R, T and sides: z = (m's total in totals.csv - mc's mean) / mc's se (mc_totals.csv,
 # docs/reference.md, Outputs), printed comma-separated in that order; "-" where mc has no
-# standard error. A deterministic method that is exact gives normal deviates (t-distributed on
+# standard error. rel=1: the relative differences (m - mc) / mc in % instead ("-" where mc's
+# total is 0). A deterministic method that is exact gives normal deviates (t-distributed on
 # batches - 1 degrees of freedom).
 BEGIN {
     FS = ",";
@@ -23,7 +24,8 @@ END {
     for (i = 1; i <= n; i++) {
         k = q[i];
         sep = i > 1 ? "," : "";
-        if (se[k] > 0) printf "%s%.3g", sep, (got[k] - mean[k]) / se[k];
+        if (rel && mean[k] != 0) printf "%s%.3g", sep, 100 * (got[k] - mean[k]) / mean[k];
+        else if (!rel && se[k] > 0) printf "%s%.3g", sep, (got[k] - mean[k]) / se[k];
         else printf "%s-", sep;
     }
     printf "\n";

@@ -61,6 +61,9 @@ B,0.53,0.199,0.3,0,0,0
 CSV
 got=$(awk -v m=B -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
 [ "$got" = "3,-0.5,-" ] || { echo "FAIL: totals_z: got '$got', expected '3,-0.5,-'"; fail=1; }
+# rel=1: (0.53 - 0.5) / 0.5 = 6 %, (0.199 - 0.2) / 0.2 = -0.5 %, (0.3 - 0.1) / 0.1 = 200 %.
+got=$(awk -v m=B -v rel=1 -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
+[ "$got" = "6,-0.5,200" ] || { echo "FAIL: totals_z rel: got '$got', expected '6,-0.5,200'"; fail=1; }
 awk -v m=C -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv" >/dev/null 2>&1
 [ $? -eq 2 ] || { echo "FAIL: totals_z: a method without a row: not exit 2"; fail=1; }
 [ $fail -eq 0 ] && echo "test_chi2_radiance: ok"
