@@ -24,6 +24,10 @@
 #   z_R, z_T, z_sides  rte2d's totals less the Monte Carlo's in the Monte Carlo's standard
 #              errors (scripts/totals_z.awk; mc_totals.csv: from its batch means);
 #   d_R, d_T, d_sides  the same differences relative to the Monte Carlo's totals, in %;
+#   b_R, b_T, b_sides  rte2d's exit radiance integrated over S1, S2 and the sides against the
+#              Monte Carlo's, in % (scripts/bins_totals.awk): rte2d's totals come from its cell
+#              field at the faces (the balance's), its bins from the exit march, and the two
+#              differ;
 #   rte2d_s    rte2d's seconds (provenance.txt);
 #   pass       1 when chi2_bin < 1.1 and |z| < 3 for R, T and sides (the bound the project
 #              sets a reference: its error below the noise of such a Monte Carlo).
@@ -58,7 +62,7 @@ mkdir -p "$out" "$cache"
 table=$out/rte2d_reference.csv
 tmp=$(mktemp "$out/.table.XXXXXX")
 trap 'rm -f "$tmp"' EXIT
-echo "case,photons,batches,bins,chi2_exact,chi2_bin,chi2_S1,chi2_S2,chi2_S3,chi2_S4,z_R,z_T,z_sides,d_R,d_T,d_sides,rte2d_s,pass" > "$tmp"
+echo "case,photons,batches,bins,chi2_exact,chi2_bin,chi2_S1,chi2_S2,chi2_S3,chi2_S4,z_R,z_T,z_sides,d_R,d_T,d_sides,b_R,b_T,b_sides,rte2d_s,pass" > "$tmp"
 for c in "${cases[@]}"; do
   d=$out/$c
   mc=()
@@ -77,6 +81,7 @@ for c in "${cases[@]}"; do
   bins=$(awk '$1 == "all" {print $2}' <<< "$chi")
   z=$(awk -v m=rte2d -f "$here/scripts/totals_z.awk" "$d/mc_totals.csv" "$d/totals.csv")
   rel=$(awk -v m=rte2d -v rel=1 -f "$here/scripts/totals_z.awk" "$d/mc_totals.csv" "$d/totals.csv")
+  btot=$(awk -v m=rte2d -f "$here/scripts/bins_totals.awk" "$d/radiance.csv")
   secs=$(awk -F' = ' '$1 == "rte2d.seconds" {printf "%.1f", $2}' "$d/provenance.txt")
   chi_all=$(per all)
   pass=$(awk -F, -v c="$chi_all" -v z="$z" 'BEGIN {
@@ -84,7 +89,7 @@ for c in "${cases[@]}"; do
     n = split(z, a, ",");
     for (i = 1; i <= n; i++) if (a[i] != "-" && (a[i] > 3 || a[i] < -3)) ok = 0;
     print ok ? 1 : 0 }')
-  echo "$c,$used_photons,$used_batches,$bins,$exact,$chi_all,$(per S1),$(per S2),$(per S3),$(per S4),$z,$rel,$secs,$pass" >> "$tmp"
+  echo "$c,$used_photons,$used_batches,$bins,$exact,$chi_all,$(per S1),$(per S2),$(per S3),$(per S4),$z,$rel,$btot,$secs,$pass" >> "$tmp"
   tail -n 1 "$tmp"
 done
 mv "$tmp" "$table"

@@ -64,6 +64,24 @@ got=$(awk -v m=B -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/tota
 # rel=1: (0.53 - 0.5) / 0.5 = 6 %, (0.199 - 0.2) / 0.2 = -0.5 %, (0.3 - 0.1) / 0.1 = 200 %.
 got=$(awk -v m=B -v rel=1 -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
 [ "$got" = "6,-0.5,200" ] || { echo "FAIL: totals_z rel: got '$got', expected '6,-0.5,200'"; fail=1; }
+# scripts/bins_totals.awk: B's radiance summed per surface against mc's: S1 (1.1 + 1.8 - 3) / 3 =
+# -3.33 %, S2 (2 - 1) / 1 = 100 %, sides (0.6 + 0.5 - 1) / 1 = 10 %; A's rows ignored.
+cat > "$tmp/r.csv" <<'CSV'
+method,surface,segment,s,theta_bin,phi_bin,radiance,stderr
+mc,S1,0,0,0,0,1.0,0.1
+mc,S1,0,0,0,1,2.0,0.2
+mc,S2,0,0,0,0,1.0,0.5
+mc,S3,0,0,0,0,0.5,0.1
+mc,S4,0,0,0,0,0.5,0.1
+A,S1,0,0,0,0,9,0
+B,S1,0,0,0,0,1.1,0
+B,S1,0,0,0,1,1.8,0
+B,S2,0,0,0,0,2.0,0
+B,S3,0,0,0,0,0.6,0
+B,S4,0,0,0,0,0.5,0
+CSV
+got=$(awk -v m=B -f "$here/scripts/bins_totals.awk" "$tmp/r.csv")
+[ "$got" = "-3.33,100,10" ] || { echo "FAIL: bins_totals: got '$got', expected '-3.33,100,10'"; fail=1; }
 awk -v m=C -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv" >/dev/null 2>&1
 [ $? -eq 2 ] || { echo "FAIL: totals_z: a method without a row: not exit 2"; fail=1; }
 [ $fail -eq 0 ] && echo "test_chi2_radiance: ok"
