@@ -22,10 +22,10 @@
 #              surface (scripts/chi2_radiance.awk: sum (rte2d - mc)^2 / se_mc^2 over the bins
 #              with signal, over their count), and the same per surface;
 #   z_R, z_T, z_sides  rte2d's totals less the Monte Carlo's in the Monte Carlo's standard
-#              errors (scripts/totals_z.awk; mc_totals.csv: from its batch means);
+#              errors (scripts/surface_totals.awk; mc_totals.csv: from its batch means);
 #   d_R, d_T, d_sides  the same differences relative to the Monte Carlo's totals, in %;
 #   b_R, b_T, b_sides  rte2d's exit radiance integrated over S1, S2 and the sides against the
-#              Monte Carlo's, in % (scripts/bins_totals.awk): rte2d's totals come from its cell
+#              Monte Carlo's, in % (scripts/surface_totals.awk): rte2d's totals come from its cell
 #              field at the faces (the balance's), its bins from the exit march, and the two
 #              differ;
 #   rte2d_s    rte2d's seconds (provenance.txt);
@@ -79,9 +79,9 @@ for c in "${cases[@]}"; do
     awk -v s="$1" '$1 == s && $2 != "-" {printf "%.4g", $3 / $2; f = 1} END {if (!f) printf "-"}' <<< "$chi"
   }
   bins=$(awk '$1 == "all" {print $2}' <<< "$chi")
-  z=$(awk -v m=rte2d -f "$here/scripts/totals_z.awk" "$d/mc_totals.csv" "$d/totals.csv")
-  rel=$(awk -v m=rte2d -v rel=1 -f "$here/scripts/totals_z.awk" "$d/mc_totals.csv" "$d/totals.csv")
-  btot=$(awk -v m=rte2d -f "$here/scripts/bins_totals.awk" "$d/radiance.csv")
+  z=$(awk -v m=rte2d -f "$here/scripts/surface_totals.awk" "$d/mc_totals.csv" "$d/totals.csv")
+  rel=$(awk -v m=rte2d -v rel=1 -f "$here/scripts/surface_totals.awk" "$d/mc_totals.csv" "$d/totals.csv")
+  btot=$(awk -v m=rte2d -v bins=1 -f "$here/scripts/surface_totals.awk" "$d/radiance.csv")
   secs=$(awk -F' = ' '$1 == "rte2d.seconds" {printf "%.1f", $2}' "$d/provenance.txt")
   chi_all=$(per all)
   pass=$(awk -F, -v c="$chi_all" -v z="$z" 'BEGIN {

@@ -45,7 +45,7 @@ check all "- - - 0.418 1"
 # Missing ids: exit 2.
 awk -f "$here/scripts/chi2_radiance.awk" "$tmp/a.csv" >/dev/null 2>&1
 [ $? -eq 2 ] || { echo "FAIL: no ids: not exit 2"; fail=1; }
-# scripts/totals_z.awk: R 0.50 +- 0.01 against B's 0.53 (z 3), T 0.2 +- 0.002 against 0.199 (z
+# scripts/surface_totals.awk: R 0.50 +- 0.01 against B's 0.53 (z 3), T 0.2 +- 0.002 against 0.199 (z
 # -0.5), sides with no standard error ("-"); mc1's rows and other methods' rows are ignored.
 cat > "$tmp/mc_totals.csv" <<'CSV'
 tally,total,mean,se
@@ -59,12 +59,12 @@ method,R,T,sides,absorbed,ballistic,specular
 mc,0.50,0.2,0.1,0.1,0.1,0
 B,0.53,0.199,0.3,0,0,0
 CSV
-got=$(awk -v m=B -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
-[ "$got" = "3,-0.5,-" ] || { echo "FAIL: totals_z: got '$got', expected '3,-0.5,-'"; fail=1; }
+got=$(awk -v m=B -f "$here/scripts/surface_totals.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
+[ "$got" = "3,-0.5,-" ] || { echo "FAIL: surface_totals: got '$got', expected '3,-0.5,-'"; fail=1; }
 # rel=1: (0.53 - 0.5) / 0.5 = 6 %, (0.199 - 0.2) / 0.2 = -0.5 %, (0.3 - 0.1) / 0.1 = 200 %.
-got=$(awk -v m=B -v rel=1 -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
-[ "$got" = "6,-0.5,200" ] || { echo "FAIL: totals_z rel: got '$got', expected '6,-0.5,200'"; fail=1; }
-# scripts/bins_totals.awk: B's radiance summed per surface against mc's: S1 (1.1 + 1.8 - 3) / 3 =
+got=$(awk -v m=B -v rel=1 -f "$here/scripts/surface_totals.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv")
+[ "$got" = "6,-0.5,200" ] || { echo "FAIL: surface_totals rel=1: got '$got', expected '6,-0.5,200'"; fail=1; }
+# scripts/surface_totals.awk: B's radiance summed per surface against mc's: S1 (1.1 + 1.8 - 3) / 3 =
 # -3.33 %, S2 (2 - 1) / 1 = 100 %, sides (0.6 + 0.5 - 1) / 1 = 10 %; A's rows ignored.
 cat > "$tmp/r.csv" <<'CSV'
 method,surface,segment,s,theta_bin,phi_bin,radiance,stderr
@@ -80,9 +80,9 @@ B,S2,0,0,0,0,2.0,0
 B,S3,0,0,0,0,0.6,0
 B,S4,0,0,0,0,0.5,0
 CSV
-got=$(awk -v m=B -f "$here/scripts/bins_totals.awk" "$tmp/r.csv")
-[ "$got" = "-3.33,100,10" ] || { echo "FAIL: bins_totals: got '$got', expected '-3.33,100,10'"; fail=1; }
-awk -v m=C -f "$here/scripts/totals_z.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv" >/dev/null 2>&1
-[ $? -eq 2 ] || { echo "FAIL: totals_z: a method without a row: not exit 2"; fail=1; }
+got=$(awk -v m=B -v bins=1 -f "$here/scripts/surface_totals.awk" "$tmp/r.csv")
+[ "$got" = "-3.33,100,10" ] || { echo "FAIL: surface_totals bins=1: got '$got', expected '-3.33,100,10'"; fail=1; }
+awk -v m=C -f "$here/scripts/surface_totals.awk" "$tmp/mc_totals.csv" "$tmp/totals.csv" >/dev/null 2>&1
+[ $? -eq 2 ] || { echo "FAIL: surface_totals: a method without a row: not exit 2"; fail=1; }
 [ $fail -eq 0 ] && echo "test_chi2_radiance: ok"
 exit $fail
