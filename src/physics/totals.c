@@ -26,12 +26,12 @@ static double fresnel_unscattered(const ppb_scene *sc, double x_entry, void *arg
  * [step_x, W/2], over |dx|. arg: the ppb_fresnel_beam. */
 typedef struct walk_arg {
     const ppb_fresnel_beam *b;
-    int face; /* -1: every face; else only what leaves through this one */
+    double face[PPB_NSURF]; /* what leaves through each face, summed over the walks */
 } walk_arg;
 
 static double fresnel_walk(const ppb_scene *sc, double x_e, void *arg)
 {
-    const walk_arg *a = arg;
+    walk_arg *a = arg;
     const ppb_fresnel_beam *b = a->b;
     double W = sc->width, H = sc->height, fs = ppb_fresnel(b->sin_t, 1.0 / sc->n);
     double x = x_e, y = 0.0, dx = b->sin_t, dy = -b->cos_t, w = 1.0, tau = 0.0, out = 0.0;
@@ -45,8 +45,9 @@ static double fresnel_walk(const ppb_scene *sc, double x_e, void *arg)
             tau += sc->sigma_t * l + (sc->sigma_t_right - sc->sigma_t) * right / fabs(dx);
         } else
             tau += sc->sigma_t * l;
-        if (a->face < 0 || a->face == face)
-            out += w * (1.0 - f) * exp(-tau);
+        double leaves = w * (1.0 - f) * exp(-tau);
+        out += leaves;
+        a->face[face] += leaves;
         w *= f;
         ppb_tube_reflect(face, W, H, l, &x, &y, &dx, &dy);
     }
@@ -59,7 +60,7 @@ static double fresnel_ballistic(const ppb_scene *sc, const ppb_fresnel_beam *b)
     if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
         /* The walk's mean over the lit part of S1, by midpoints (maps.h). */
         const int np = PPB_LIT_MIDPOINTS;
-        walk_arg a = {b, -1};
+        walk_arg a = {b, {0}};
         double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, &a, np, &width);
         return (1.0 - b->specular) * sum / np;
     }
@@ -109,41 +110,42 @@ static double unscattered_on(const ppb_scene *sc, double x_e, void *arg)
     return out == face ? exp(-ppb_beam_depth(sc, x_e)) : 0.0;
 }
 
-/* At n > 1, normal incidence (a vertical beam meets S2 and S1 alone): of the series in
- * fresnel_unscattered, the terms e^{-(2k+1) tau} leave at S2 and e^{-(2k+2) tau} at S1. */
+/* At n > 1, normal incidence (a vertical beam meets S2 and S1 alone), the beam's series of
+ * fresnel_unscattered split by face: the terms e^{-(2k+1) tau} leave at S2, e^{-(2k+2) tau} at
+ * S1; e = e^{-tau}. */
+static double series_on(double fb, double e, int face)
+{
+    double s2 = (1.0 - fb) * e / (1.0 - fb * fb * e * e);
+    return face == PPB_S2 ? s2 : face == PPB_S1 ? s2 * fb * e : 0.0;
+}
+
 static double fresnel_unscattered_on(const ppb_scene *sc, double x_entry, void *arg)
 {
     const double *fa = arg; /* F_b, face */
-    double fb = fa[0], e = exp(-ppb_beam_depth(sc, x_entry));
-    double s2 = (1.0 - fb) * e / (1.0 - fb * fb * e * e);
-    return (int)fa[1] == PPB_S2 ? s2 : (int)fa[1] == PPB_S1 ? s2 * fb * e : 0.0;
+    return series_on(fa[0], exp(-ppb_beam_depth(sc, x_entry)), (int)fa[1]);
 }
 
 void ppb_ballistic_faces(const ppb_scene *sc, double out[PPB_NSURF])
 {
     double width;
+    ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
+    if (sc->n > 1.0 && sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
+        /* one walk per entry point gives every face its share */
+        walk_arg a = {&b, {0}};
+        ppb_lit_midpoint_sum(sc, fresnel_walk, &a, PPB_LIT_MIDPOINTS, &width);
+        for (int face = 0; face < PPB_NSURF; face++)
+            out[face] = (1.0 - b.specular) * a.face[face] / PPB_LIT_MIDPOINTS;
+        return;
+    }
     for (int face = 0; face < PPB_NSURF; face++) {
-        out[face] = 0.0;
-        if (sc->n <= 1.0) {
-            if (sc->geometry == PPB_GEOM_SLAB)
-                out[face] = face == PPB_S2 ? ppb_ballistic_fraction(sc) : 0.0;
-            else {
-                double sum = ppb_lit_integral(sc, unscattered_on, &face, &width);
-                out[face] = width > 0.0 ? sum / width : 0.0;
-            }
-            continue;
-        }
-        ppb_fresnel_beam b = ppb_fresnel_beam_in(ppb_scene_cos_theta_l(sc), sc->n);
-        if (sc->geometry == PPB_GEOM_TUBE && sc->theta_deg != 0.0) {
-            walk_arg a = {&b, face};
-            double sum = ppb_lit_midpoint_sum(sc, fresnel_walk, &a, PPB_LIT_MIDPOINTS, &width);
-            out[face] = (1.0 - b.specular) * sum / PPB_LIT_MIDPOINTS;
+        if (sc->n <= 1.0 && sc->geometry == PPB_GEOM_SLAB) {
+            out[face] = face == PPB_S2 ? ppb_ballistic_fraction(sc) : 0.0;
+        } else if (sc->n <= 1.0) {
+            double sum = ppb_lit_integral(sc, unscattered_on, &face, &width);
+            out[face] = width > 0.0 ? sum / width : 0.0;
         } else if (sc->geometry == PPB_GEOM_SLAB) {
-            double fb = b.f_inside, e = exp(-sc->sigma_t * sc->height / b.cos_t);
-            double s2 = (1.0 - fb) * e / (1.0 - fb * fb * e * e);
-            out[face] = (1.0 - b.specular) * (face == PPB_S2   ? s2
-                                              : face == PPB_S1 ? s2 * fb * e
-                                                               : 0.0);
+            double e = exp(-sc->sigma_t * sc->height / b.cos_t);
+            out[face] = (1.0 - b.specular) * series_on(b.f_inside, e, face);
         } else {
             double fa[2] = {b.f_inside, face};
             double sum = ppb_lit_integral(sc, fresnel_unscattered_on, fa, &width);
