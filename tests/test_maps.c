@@ -264,7 +264,8 @@ static void test_ballistic_faces(void **state)
     ppb_totals t;
     ppb_bin_totals(&sc, &lo, zero, &t);
     ppb_ballistic_faces(&sc, b);
-    assert_close(b[PPB_S1] + b[PPB_S2] + b[PPB_S3] + b[PPB_S4], t.ballistic, 1e-14);
+    /* the walk's 2e4 midpoints summed per face, then added: rounding only */
+    assert_close(b[PPB_S1] + b[PPB_S2] + b[PPB_S3] + b[PPB_S4], t.ballistic, 1e-12);
     /* the refracted beam (30.3 deg) meets S4 at 59.7 deg from its normal, beyond the critical
      * 45.6 deg: it leaves through S2 and, reflected, S1 alone */
     assert_true(b[PPB_S1] > 0.0 && b[PPB_S2] > 0.0);

@@ -383,7 +383,8 @@ static void test_delta_m_energy_balance(void **state)
          * beam's excess being counted in the faces it leaves through */
         ppb_totals exact;
         ppb_bin_totals(&cfg.scene, &a.layout, a.radiance, &exact);
-        assert_close(a.totals.ballistic, exact.ballistic, 1e-14);
+        /* the same 2e4-point midpoint sum in another order at oblique n > 1: rounding only */
+        assert_close(a.totals.ballistic, exact.ballistic, 1e-12);
         if (cs[c].step == PPB_STEP_ALBEDO)
             assert_true(st.delta_f == 0.0);
         else
