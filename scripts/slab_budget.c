@@ -118,9 +118,9 @@ static int cell_ss(const ad_case *c, int N, double *R1, double *T1)
         double m = d.k[i], lo, hi, p0, p1, L0, L1;
         pp_dirs_bounds(&d, i, &lo, &hi, &p0, &p1);
         double Rc = c->n > 1 ? pp_fresnel_ring_mean(lo, hi, c->n) : 0.0;
-        ss_faces(c->tau0, c->albedo, D, U, m, F[i] / d.solid, F[N + i] / d.solid, Rc, &L0, &L1);
-        r += d.solid * m * (1 - Rc) * L0;
-        t += d.solid * m * (1 - Rc) * L1;
+        ss_faces(c->tau0, c->albedo, D, U, m, F[i] / d.area[i], F[N + i] / d.area[i], Rc, &L0, &L1);
+        r += d.area[i] * m * (1 - Rc) * L0;
+        t += d.area[i] * m * (1 - Rc) * L1;
     }
     free(F);
     pp_dirs_free(&d);

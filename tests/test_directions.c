@@ -53,15 +53,53 @@ static double edge_of(const pp_dirs *d, int i, int walk_mu, double fixed, double
     return 0.5 * (a + b);
 }
 
-/* Each cell's solid angle from its boundaries, found by probing the membership function
- * pp_dirs_cell_of (not from the partition's tables): walks from a point of the cell along its
- * meridian and its parallel to where the cell ends (edge_of), checks that the cell is the
- * (mu, phi) rectangle those edges bound (9 points inside belong to it; points 1e-9 beyond each
- * edge, 3 per edge, do not), and integrates dOmega = dmu dphi over it analytically (Archimedes:
- * the area of a zone is 2 pi times its height): |Omega_i| = (mu_hi - mu_lo)(phi_hi - phi_lo).
- * Every cell must have 2 pi / N (directions.h) to 1e-11, the cells must cover 4 pi, and the mean
- * cosine of a (mu, phi) rectangle, (mu_lo + mu_hi) / 2, must be k_i (reference: Corrections). The
- * bisection leaves each edge within 1e-14, so the area within about 1e-13. Both partitions. */
+/* Cell i's (mu, phi) rectangle found by probing the membership function pp_dirs_cell_of (not
+ * from the partition's tables): walks from the cell's centre along its meridian and its parallel
+ * to where the cell ends (edge_of), checks that the cell is the rectangle those edges bound (9
+ * points inside belong to it; points 1e-9 beyond each edge, 3 per edge, do not), and returns
+ * its area by Archimedes (the area of a zone is 2 pi times its height): |Omega_i| = (mu_hi -
+ * mu_lo)(phi_hi - phi_lo). The bisection leaves each edge within 1e-14, so the area within about
+ * 1e-13. */
+static double probed_area(const pp_dirs *d, int i, double *mu_lo_out, double *mu_hi_out)
+{
+    int n = d->n;
+    double hmu = 1.0 / (16.0 * n), hphi = 2.0 * PI / (16.0 * n);
+    const double *c = d->centre + 3 * i;
+    double mu0 = c[1], phi0 = atan2(c[2], c[0]);
+    assert_int_equal(cell_at(d, mu0, phi0), i);
+    int open_hi, open_lo, open_p, open_m;
+    double mu_hi = edge_of(d, i, 1, phi0, mu0, hmu, 1.0, &open_hi);
+    double mu_lo = edge_of(d, i, 1, phi0, mu0, -hmu, -1.0, &open_lo);
+    double phi_hi = edge_of(d, i, 0, mu0, phi0, hphi, phi0 + 2 * PI, &open_p);
+    double phi_lo = edge_of(d, i, 0, mu0, phi0, -hphi, phi0 - 2 * PI, &open_m);
+    int whole = open_p || open_m; /* a polar cap: the whole turn */
+    if (whole)
+        phi_lo = phi0 - PI, phi_hi = phi0 + PI;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            double f[3] = {0.1, 0.5, 0.9};
+            double mu = mu_lo + f[a] * (mu_hi - mu_lo), ph = phi_lo + f[b] * (phi_hi - phi_lo);
+            if (cell_at(d, mu, ph) != i)
+                fail_msg("N = %d cell %d: (mu %.6f, phi %.6f) inside its edges is cell %d", n, i,
+                         mu, ph, cell_at(d, mu, ph));
+            if (!open_hi && mu_hi + 1e-9 <= 1.0 && cell_at(d, mu_hi + 1e-9, ph) == i)
+                fail_msg("N = %d cell %d extends above mu %.15f", n, i, mu_hi);
+            if (!open_lo && mu_lo - 1e-9 >= -1.0 && cell_at(d, mu_lo - 1e-9, ph) == i)
+                fail_msg("N = %d cell %d extends below mu %.15f", n, i, mu_lo);
+            if (!whole &&
+                (cell_at(d, mu, phi_hi + 1e-9) == i || cell_at(d, mu, phi_lo - 1e-9) == i))
+                fail_msg("N = %d cell %d extends beyond phi [%.15f, %.15f]", n, i, phi_lo, phi_hi);
+        }
+    if (fabs(0.5 * (mu_lo + mu_hi) - d->k[i]) > 1e-12)
+        fail_msg("N = %d cell %d: mu [%.15f, %.15f]: mean cosine %.15g, k = %.15g", n, i, mu_lo,
+                 mu_hi, 0.5 * (mu_lo + mu_hi), d->k[i]);
+    *mu_lo_out = mu_lo, *mu_hi_out = mu_hi;
+    return (mu_hi - mu_lo) * (phi_hi - phi_lo);
+}
+
+/* Every cell's probed area must be 2 pi / N (directions.h) to 1e-11, the cells must cover 4 pi,
+ * and the mean cosine of a (mu, phi) rectangle, (mu_lo + mu_hi) / 2, must be k_i (reference:
+ * Corrections). Both equal-area partitions. */
 static void test_cell_areas_from_membership(void **state)
 {
     (void)state;
@@ -70,48 +108,70 @@ static void test_cell_areas_from_membership(void **state)
         ppb_err err;
         int n = sizes[t % (sizeof sizes / sizeof *sizes)], anti = t >= sizeof sizes / sizeof *sizes;
         assert_int_equal(anti ? pp_dirs_make_antipodal(n, &d, &err) : pp_dirs_make(n, &d, &err), 0);
-        double total = 0.0, hmu = 1.0 / (16.0 * n), hphi = 2.0 * PI / (16.0 * n);
+        double total = 0.0, lo, hi;
         for (int i = 0; i < 2 * n; i++) {
-            /* a point of the cell: its centre (checked to be in it) */
-            const double *c = d.centre + 3 * i;
-            double mu0 = c[1], phi0 = atan2(c[2], c[0]);
-            assert_int_equal(cell_at(&d, mu0, phi0), i);
-            int open_hi, open_lo, open_p, open_m;
-            double mu_hi = edge_of(&d, i, 1, phi0, mu0, hmu, 1.0, &open_hi);
-            double mu_lo = edge_of(&d, i, 1, phi0, mu0, -hmu, -1.0, &open_lo);
-            double phi_hi = edge_of(&d, i, 0, mu0, phi0, hphi, phi0 + 2 * PI, &open_p);
-            double phi_lo = edge_of(&d, i, 0, mu0, phi0, -hphi, phi0 - 2 * PI, &open_m);
-            int whole = open_p || open_m; /* a polar cap: the whole turn */
-            if (whole)
-                phi_lo = phi0 - PI, phi_hi = phi0 + PI;
-            for (int a = 0; a < 3; a++)
-                for (int b = 0; b < 3; b++) {
-                    double f[3] = {0.1, 0.5, 0.9};
-                    double mu = mu_lo + f[a] * (mu_hi - mu_lo),
-                           ph = phi_lo + f[b] * (phi_hi - phi_lo);
-                    if (cell_at(&d, mu, ph) != i)
-                        fail_msg("N = %d cell %d: (mu %.6f, phi %.6f) inside its edges is cell %d",
-                                 n, i, mu, ph, cell_at(&d, mu, ph));
-                    double mu_f = mu_lo + f[a] * (mu_hi - mu_lo);
-                    if (!open_hi && mu_hi + 1e-9 <= 1.0 && cell_at(&d, mu_hi + 1e-9, ph) == i)
-                        fail_msg("N = %d cell %d extends above mu %.15f", n, i, mu_hi);
-                    if (!open_lo && mu_lo - 1e-9 >= -1.0 && cell_at(&d, mu_lo - 1e-9, ph) == i)
-                        fail_msg("N = %d cell %d extends below mu %.15f", n, i, mu_lo);
-                    if (!whole && (cell_at(&d, mu_f, phi_hi + 1e-9) == i ||
-                                   cell_at(&d, mu_f, phi_lo - 1e-9) == i))
-                        fail_msg("N = %d cell %d extends beyond phi [%.15f, %.15f]", n, i, phi_lo,
-                                 phi_hi);
-                }
-            double area = (mu_hi - mu_lo) * (phi_hi - phi_lo);
-            if (fabs(area - 2 * PI / n) > 1e-11 || fabs(0.5 * (mu_lo + mu_hi) - d.k[i]) > 1e-12)
-                fail_msg("N = %d%s cell %d: mu [%.15f, %.15f], phi [%.15f, %.15f]: area %.15g "
-                         "(2 pi / N = %.15g), mean cosine %.15g (k = %.15g)",
-                         n, anti ? " antipodal" : "", i, mu_lo, mu_hi, phi_lo, phi_hi, area,
-                         2 * PI / n, 0.5 * (mu_lo + mu_hi), d.k[i]);
+            double area = probed_area(&d, i, &lo, &hi);
+            if (fabs(area - 2 * PI / n) > 1e-11 || d.area[i % n] != d.solid)
+                fail_msg("N = %d%s cell %d: area %.15g (2 pi / N = %.15g, stored %.15g)", n,
+                         anti ? " antipodal" : "", i, area, 2 * PI / n, d.area[i % n]);
             total += area;
         }
         assert_close(total, 4 * PI, 1e-10);
         assert_close(d.solid, 2 * PI / n, 1e-15);
+        assert_false(d.polar);
+        pp_dirs_free(&d);
+    }
+}
+
+/* The polar-ring partition (pp_dirs_make_collars, collars > 0), probed as above: the stored
+ * areas are the probed rectangles' to 1e-11 and cover 4 pi; collars + 1 rings of equal polar
+ * width pi / 2 / (collars + 1) without a snap (the cap one of them, one cell; every other ring
+ * two at least); with the snap at n = 1.5's critical cosine, that cosine is a ring edge (to
+ * 1e-14) and the rings on either side of it are of equal width each, four of them split in
+ * four; below the cap each ring's cell count is its share of the N - 1 cells by area to within
+ * two (the rounding in steps of two) above the floors (three cells for an odd first collar). */
+static void test_polar_partition(void **state)
+{
+    (void)state;
+    const int ns[] = {334, 334, 201, 60};
+    const int collars[] = {79, 55, 30, 20};
+    const double snaps[] = {0.0, 0.74535599249992989880, 0.5, 0.0};
+    for (int t = 0; t < 4; t++) {
+        pp_dirs d;
+        ppb_err err;
+        int n = ns[t];
+        assert_int_equal(pp_dirs_make_collars(n, t == 3, snaps[t], collars[t], &d, &err), 0);
+        assert_true(d.polar);
+        double total = 0.0, lo, hi;
+        for (int i = 0; i < 2 * n; i++) {
+            double area = probed_area(&d, i, &lo, &hi);
+            if (fabs(area - d.area[i % n]) > 1e-11)
+                fail_msg("N = %d, %d collars, cell %d: probed area %.15g, stored %.15g", n,
+                         collars[t], i, area, d.area[i % n]);
+            total += area;
+        }
+        assert_close(total, 4 * PI, 1e-10);
+        assert_int_equal(d.ring_first[1], t == 3 ? 4 : 1); /* the cap (four wedges: antipodal) */
+        int snapped = snaps[t] > 0.0, found = 0;
+        if (!snapped)
+            assert_int_equal(d.nrings, collars[t] + 1);
+        else
+            assert_int_equal(d.nrings, collars[t] + 1 + 6);
+        double width = 0.5 * PI / (collars[t] + 1);
+        for (int r = 0; r < d.nrings; r++) {
+            int count = d.ring_first[r + 1] - d.ring_first[r];
+            double t0 = acos(d.mu_edge[r]), t1 = acos(d.mu_edge[r + 1]);
+            if (r > 0)
+                assert_true(count >= 2);
+            if (!snapped)
+                assert_close(t1 - t0, width, 1e-12);
+            if (fabs(d.mu_edge[r] - snaps[t]) < 1e-14)
+                found = 1;
+            double share = (n - 1) * (d.mu_edge[r] - d.mu_edge[r + 1]) / d.mu_edge[1];
+            if (r > 0 && count > 3 && fabs(count - share) > 2.0)
+                fail_msg("N = %d ring %d: %d cells for a share of %.2f", n, r, count, share);
+        }
+        assert_true(found == snapped);
         pp_dirs_free(&d);
     }
 }
@@ -289,6 +349,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cell_areas_from_membership),
+        cmocka_unit_test(test_polar_partition),
         cmocka_unit_test(test_cells_by_monte_carlo),
         cmocka_unit_test(test_mean_cosines_exact),
         cmocka_unit_test(test_mirror_symmetries),

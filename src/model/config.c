@@ -170,8 +170,8 @@ static const key_def keys[] = {
     {"pp", "delta_m", K_ENUM, PPB_NOT_MC_KEY, F(pp.delta_m), 0, 0, "auto", delta_m_names,
      "slab solver's delta-M for forward-peaked HG: off, on, auto = on where g >= 0.6"},
     {"pp", "collars", K_INT, PPB_NOT_MC_KEY, F(pp.collars), 0, 4000, "0", NULL,
-     "slab solver's polar collars per hemisphere, 0 = near-square cells; at most (directions - "
-     "4) / 2"},
+     "slab solver's polar-ring partition: collars + 1 rings of equal polar width per "
+     "hemisphere, 0 = near-square cells; at most (directions - 4) / 2"},
     {"mp", "pairs", K_INT, PPB_NOT_MC_KEY, F(mp.pairs), 0, 200, "10", NULL,
      "dipole pairs beyond the first (0 = dipole)"},
     {"mp", "samples", K_INT, PPB_NOT_MC_KEY, F(mp.samples), 1, 256, "16", NULL,

@@ -48,6 +48,28 @@ static double fine_theta(int f, int collars, int r_snap, int split, double theta
     return a + (b - a) * ((piece - 1) % split + 1) / split;
 }
 
+/* The most rings per hemisphere with at least two cells each below a polar ring of `pole`. */
+static int most_rings(int n, int pole)
+{
+    int first_min = pole % 2 != n % 2 ? 1 : 2;
+    return 1 + (n - pole - first_min) / 2;
+}
+
+/* Cumulative cell count above a collar edge, rounded in steps of two from the target x (so it
+ * keeps the parity of n) and clamped so that every ring keeps its minimum (ring_counts). */
+static int cumulative(int n, int r, int rings, int done, int first_min, double x)
+{
+    int base = n % 2, left = rings - 1 - r; /* later collars need at least two cells each */
+    int cum = r == rings - 1 ? n : base + 2 * (int)lround(0.5 * (x - base));
+    if (cum > n - 2 * left)
+        cum = n - 2 * left;
+    if (cum < done + (r == 1 ? first_min : 2))
+        cum = done + (r == 1 ? first_min : 2);
+    return cum;
+}
+
+/* The equal-area partition: a polar ring of `pole` cells, then collars whose cell counts are
+ * rounded from the equal-area cells above each edge (the edges are moved afterwards, make()). */
 static int ring_counts(int n, int pole, double theta_snap, int want, int *count)
 {
     count[0] = pole;
@@ -55,31 +77,58 @@ static int ring_counts(int n, int pole, double theta_snap, int want, int *count)
         return 1;
     double theta_cap = acos(1.0 - (double)pole / n), side = sqrt(2.0 * PPB_PI / n);
     int collars = want > 0 ? want : (int)lround((0.5 * PPB_PI - acos(1.0 - 1.0 / n)) / side);
-    int base = n % 2, first_min = pole % 2 != base ? 1 : 2;
+    int first_min = pole % 2 != n % 2 ? 1 : 2, most = most_rings(n, pole);
     if (collars < 1)
         collars = 1;
-    if (collars > 1 + (n - pole - first_min) / 2)
-        collars = 1 + (n - pole - first_min) / 2;
+    if (collars > most)
+        collars = most;
     int done = pole, r_snap = 0, split = 1, coarse = collars;
     if (theta_snap > theta_cap && theta_snap < 0.5 * PPB_PI && collars >= 2) {
         r_snap = (int)lround((theta_snap - theta_cap) / (0.5 * PPB_PI - theta_cap) * collars);
         r_snap = r_snap < 1 ? 1 : (r_snap > collars - 1 ? collars - 1 : r_snap);
-        if (collars + 2 * (SNAP_SPLIT - 1) <= 1 + (n - pole - first_min) / 2)
+        if (collars + 2 * (SNAP_SPLIT - 1) <= most)
             split = SNAP_SPLIT, collars += 2 * (SNAP_SPLIT - 1);
     }
     for (int r = 1; r <= collars; r++) {
         double theta = r_snap > 0 ? fine_theta(r, coarse, r_snap, split, theta_cap, theta_snap)
                                   : theta_cap + (0.5 * PPB_PI - theta_cap) * r / collars;
-        int cum = r == collars ? n : base + 2 * (int)lround(0.5 * (n * (1.0 - cos(theta)) - base));
-        int left = collars - r; /* later collars need at least two cells each */
-        if (cum > n - 2 * left)
-            cum = n - 2 * left;
-        if (cum < done + (r == 1 ? first_min : 2))
-            cum = done + (r == 1 ? first_min : 2);
+        int cum = cumulative(n, r, collars + 1, done, first_min, n * (1.0 - cos(theta)));
         count[r] = cum - done;
         done = cum;
     }
     return collars + 1;
+}
+
+/* The polar-ring partition (directions.h, pp_dirs_make_collars): `want` + 1 rings of equal
+ * polar-angle width from the pole, the cap (`pole` cells) the first of them, snapped and split
+ * at theta_snap as above; theta[r] is ring r's upper edge (theta[0] = 0, theta[rings] = pi / 2).
+ * Below the cap the cells follow the rings' areas, rounded cumulatively in steps of two, two
+ * at least a ring. */
+static int polar_counts(int n, int pole, double theta_snap, int want, int *count, double *theta)
+{
+    /* the first collar odd where the cap's parity differs from N's: three cells, not one, so
+     * that no ring but the cap is a whole annulus */
+    int most = most_rings(n, pole) - 1, first_min = pole % 2 != n % 2 ? 3 : 2;
+    int coarse = want + 1 > most ? most : want + 1, rings = coarse, r_snap = 0, split = 1;
+    if (theta_snap > 0.0 && theta_snap < 0.5 * PPB_PI && coarse >= 2) {
+        r_snap = (int)lround(theta_snap / (0.5 * PPB_PI) * coarse);
+        r_snap = r_snap < 1 ? 1 : (r_snap > coarse - 1 ? coarse - 1 : r_snap);
+        if (coarse + 2 * (SNAP_SPLIT - 1) <= most)
+            split = SNAP_SPLIT, rings += 2 * (SNAP_SPLIT - 1);
+    }
+    for (int r = 0; r <= rings; r++)
+        theta[r] = r == rings   ? 0.5 * PPB_PI
+                   : r_snap > 0 ? fine_theta(r, coarse, r_snap, split, 0.0, theta_snap)
+                                : 0.5 * PPB_PI * r / coarse;
+    count[0] = pole;
+    double below_cap = cos(theta[1]);
+    for (int r = 1, done = pole; r < rings; r++) {
+        double x = pole + (n - pole) * (below_cap - cos(theta[r + 1])) / below_cap;
+        int cum = cumulative(n, r, rings, done, first_min, x);
+        count[r] = cum - done;
+        done = cum;
+    }
+    return rings;
 }
 
 static int alloc_all(pp_dirs *d, int n, int nrings)
@@ -93,8 +142,9 @@ static int alloc_all(pp_dirs *d, int n, int nrings)
     d->centre = calloc(6 * (size_t)n, sizeof(double));
     d->radius = calloc((size_t)n, sizeof(double));
     d->half = calloc((size_t)n, sizeof(double));
-    return (d->ring_first && d->mu_edge && d->ring && d->phi_lo && d->phi_hi && d->k && d->centre &&
-            d->radius && d->half)
+    d->area = calloc((size_t)n, sizeof(double));
+    return (d->area && d->ring_first && d->mu_edge && d->ring && d->phi_lo && d->phi_hi && d->k &&
+            d->centre && d->radius && d->half)
                ? 0
                : -1;
 }
@@ -166,15 +216,20 @@ static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d
         return ppb_fail(err, "pp directions: %d collars, need 0..%d for %d cells per hemisphere",
                         collars, pp_dirs_max_collars(n), n);
     int *count = calloc((size_t)n + 1, sizeof(int));
-    if (!count)
+    double *theta = calloc((size_t)n + 1, sizeof(double));
+    if (!count || !theta) {
+        free(count), free(theta);
         return ppb_fail(err, "pp directions: out of memory");
-    int nrings =
-        ring_counts(n, antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, theta_snap, collars, count);
+    }
+    int pole = antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1;
+    int nrings = collars > 0 ? polar_counts(n, pole, theta_snap, collars, count, theta)
+                             : ring_counts(n, pole, theta_snap, collars, count);
     d->n = n;
     d->nrings = nrings;
+    d->polar = collars > 0;
     d->solid = 2.0 * PPB_PI / n;
     if (alloc_all(d, n, nrings) != 0) {
-        free(count);
+        free(count), free(theta);
         pp_dirs_free(d);
         return ppb_fail(err, "pp directions: out of memory");
     }
@@ -188,10 +243,16 @@ static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d
             d->phi_hi[cell] = (j + 0.5) * dphi;
         }
         d->ring_first[r + 1] = cell + 0;
-        /* mu = 1 - C/N makes each ring's area exactly count * 2 pi / N */
-        d->mu_edge[r + 1] = r + 1 == nrings ? 0.0 : 1.0 - (double)(cell) / n;
+        /* equal areas: mu = 1 - C/N makes each ring's area exactly count * 2 pi / N; polar
+         * rings keep their edges, and their cells' areas follow */
+        d->mu_edge[r + 1] = r + 1 == nrings ? 0.0
+                            : collars > 0   ? cos(theta[r + 1])
+                                            : 1.0 - (double)(cell) / n;
+        for (int j = d->ring_first[r]; j < cell; j++)
+            d->area[j] = collars > 0 ? 2.0 * PPB_PI * (d->mu_edge[r] - d->mu_edge[r + 1]) / count[r]
+                                     : d->solid;
     }
-    free(count);
+    free(count), free(theta);
     for (int i = 0; i < n; i++)
         cell_geometry(d, i);
     return 0;
@@ -230,6 +291,7 @@ void pp_dirs_free(pp_dirs *d)
     free(d->centre);
     free(d->radius);
     free(d->half);
+    free(d->area);
     for (int q = 0; q <= PP_QMAX; q++)
         free(d->nodes[q]);
     memset(d, 0, sizeof *d);
@@ -318,7 +380,7 @@ static int build_nodes(pp_dirs *d, int q)
             }
         }
         for (int m = 0; m < nq; m++) {
-            row[4 * m + 3] *= d->solid / sum;
+            row[4 * m + 3] *= d->area[i] / sum;
             mir[4 * m] = row[4 * m], mir[4 * m + 1] = -row[4 * m + 1];
             mir[4 * m + 2] = row[4 * m + 2], mir[4 * m + 3] = row[4 * m + 3];
         }

@@ -21,6 +21,8 @@
  * (tests/test_march.c: stepped against telescoped 1.4e-8 at N = 32, over its 1e-9 tolerance;
  * every tried partition with a one-cell cap passes, every one with two or four polar cells
  * fails; the cause is not found).
+ * pp_dirs_make_collars with collars > 0 builds the polar-ring partition instead (below): rings
+ * of equal polar width, cells of unequal area (area[]), for the slab's totals.
  * Sector 0 of every ring is centred on phi = 0 (the beam's azimuth +x), so the partition is
  * mirror symmetric in z (phi -> -phi); cell N + i is the mirror (y -> -y) of cell i.
  *
@@ -41,7 +43,9 @@ typedef struct pp_dirs {
     double *mu_edge;         /* [nrings + 1]: 1 = mu_edge[0] > ... > mu_edge[nrings] = 0 */
     int *ring;               /* [N]: ring of up cell i */
     double *phi_lo, *phi_hi; /* [N]: azimuth range of up cell i (radians) */
-    double solid;            /* |Omega_i| = 2 pi / N for every cell */
+    double solid;            /* 2 pi / N, the mean |Omega_i| (every cell's but in polar rings) */
+    double *area;            /* [N]: |Omega_i| of up cell i and of its mirror N + i */
+    int polar;               /* the polar-ring partition (pp_dirs_make_collars, collars > 0) */
     double *k;               /* [2N]: mean cosine, k[N + i] = -k[i] */
     double *centre;          /* [2N x 3]: unit vector at the cell's (mu, phi) centre */
     double *radius; /* [N]: angle from the centre to the farthest corner (both hemispheres) */
@@ -60,10 +64,14 @@ int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err);
  * (0, 1) up to the rounding of the cell counts (|mu error| <= 1/n): the solver's Fresnel
  * boundaries put it at the critical cosine, where the radiance is discontinuous (ppsolver.h). */
 int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err *err);
-/* The general form: collars > 0 sets the number of collars below the polar ring (before the
- * snap's split), 0 the near-square cells above; mu_snap outside (0, 1) snaps nothing. More
- * collars than square cells trade azimuthal for polar resolution, which is what a slab's totals
- * depend on (ppsolver.h: [pp] collars). Fails beyond pp_dirs_max_collars(n). */
+/* The general form: collars > 0 gives the polar-ring partition, 0 the near-square cells above;
+ * mu_snap outside (0, 1) snaps nothing. Polar rings: collars + 1 rings per hemisphere of equal
+ * polar-angle width, the cap one of them (up to the snap and its split), each cut into sectors
+ * in proportion to its area (the cap one cell, every other ring two at least), so the cells'
+ * areas differ (area[]). More rings than square cells trade azimuthal for polar resolution,
+ * which is what a slab's totals depend on (ppsolver.h: [pp] collars); a cap as narrow as the
+ * collars resolves the forward peak round the normal, where an equal-area cap (0.077 rad
+ * across at 334 cells) blurs it. Fails beyond pp_dirs_max_collars(n). */
 int pp_dirs_make_collars(int n, int antipodal, double mu_snap, int collars, pp_dirs *d,
                          ppb_err *err);
 /* The most collars n cells per hemisphere allow (two cells each at least): (n - 4) / 2. */

@@ -1,6 +1,7 @@
 /* phase.c: HG and truncated-series cell-pair and point-cell integrals by product Gauss
  * (phase.h). */
 #include "physics/phase.h"
+#include "physics/phase_rings.h"
 
 #include "kernels/ppb_conventions.h"
 
@@ -227,6 +228,10 @@ static int pair_integral(pp_dirs *d, const pp_phase_fn *ph, int a, int b, const 
         return 0;
     }
     double g = ph->g;
+    if (d->polar) { /* long, thin cells: phase_rings.h */
+        *out = pp_phase_pair_rings(d, g, a, b);
+        return 0;
+    }
     double cos_r = cr[ua] * cr[ub] - sr[ua] * sr[ub], sin_r = sr[ua] * cr[ub] + cr[ua] * sr[ub];
     double cmin = cos_gap(g, d->centre + 3 * a, d->centre + 3 * b, cos_r, sin_r);
     int q = gauss_order(g, cmin, fmax(cell_half(d, a), cell_half(d, b)));
@@ -307,7 +312,7 @@ static void conserve_rows(const pp_dirs *d, double *Sa, const double *Sb)
             comp += fabs(rest) >= fabs(v) ? (rest - t) + v : (v - t) + rest;
             rest = t;
         }
-        Sa[i * n + i] = d->solid - (rest + comp);
+        Sa[i * n + i] = d->area[i] - (rest + comp);
     }
 }
 
@@ -335,7 +340,7 @@ static void clip_negative(const pp_dirs *d, double *Sa, double *Sb, double *clip
             if (Sb[i * n + j] < 0.0)
                 row -= Sb[i * n + j], Sb[i * n + j] = 0.0;
         }
-        most = fmax(most, row / d->solid);
+        most = fmax(most, row / d->area[i]);
     }
     if (clipped)
         *clipped = most;
@@ -434,8 +439,8 @@ int pp_phase_matrix_fn(pp_dirs *d, const pp_phase_fn *ph, double *P, double *cli
                         : ppb_fail(err, "phase matrix: out of memory");
     for (size_t i = 0; rc == 0 && i < n; i++) {
         for (size_t j = 0; j < n; j++) {
-            P[i * m + j] = P[(n + i) * m + n + j] = Sa[i * n + j] / d->solid;
-            P[i * m + n + j] = P[(n + i) * m + j] = Sb[i * n + j] / d->solid;
+            P[i * m + j] = P[(n + i) * m + n + j] = Sa[i * n + j] / d->area[i];
+            P[i * m + n + j] = P[(n + i) * m + j] = Sb[i * n + j] / d->area[i];
         }
     }
     free(Sa);

@@ -134,12 +134,13 @@ static int solution_alloc(pp_solution *s, ppb_err *err)
 static void build_h(const pp_solution *s, pp_work *w)
 {
     size_t n = (size_t)s->n;
-    double a = s->p.albedo, solid = s->dirs.solid;
+    double a = s->p.albedo;
+    const double *area = s->dirs.area;
     for (size_t i = 0; i < n; i++)
-        w->t[i] = 1.0 / sqrt(solid * s->dirs.k[i]);
+        w->t[i] = 1.0 / sqrt(area[i] * s->dirs.k[i]);
     for (size_t j = 0; j < n; j++) {
         for (size_t i = 0; i < n; i++) {
-            double e = i == j ? solid : 0.0, tt = w->t[i] * w->t[j];
+            double e = i == j ? area[i] : 0.0, tt = w->t[i] * w->t[j];
             w->Hp[j * n + i] = (e - a * (s->Sa[j * n + i] + s->Sb[j * n + i])) * tt;
             w->Hm[j * n + i] = (e - a * (s->Sa[j * n + i] - s->Sb[j * n + i])) * tt;
         }
@@ -308,7 +309,7 @@ static void diffusion_mode(const pp_solution *s, pp_work *w)
 {
     int n = s->n;
     for (int i = 0; i < n; i++)
-        w->h[i] = w->t[i] * s->dirs.solid * s->dirs.k[i];
+        w->h[i] = w->t[i] * s->dirs.area[i] * s->dirs.k[i];
     cblas_dtrsv(CblasColMajor, CblasLower, CblasNoTrans, CblasNonUnit, n, w->L, n, w->h, 1);
     cblas_dtrsv(CblasColMajor, CblasLower, CblasTrans, CblasNonUnit, n, w->L, n, w->h, 1);
     for (int i = 0; i < n; i++)
@@ -601,22 +602,23 @@ static double depth_integral(double lambda, double tref, double tau0)
 static void compute_totals(pp_solution *s)
 {
     int n = s->n, m = s->m;
-    double *field = dalloc(m), mu0 = s->p.mu0, solid = s->dirs.solid, up = 0.0, down = 0.0;
+    double *field = dalloc(m), mu0 = s->p.mu0, up = 0.0, down = 0.0;
+    const double *area = s->dirs.area;
     pp_cell_field(s, 0.0, field);
     for (int i = 0; i < n; i++)
-        up += solid * s->dirs.k[i] * field[i] * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
+        up += area[i] * s->dirs.k[i] * field[i] * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
     pp_cell_field(s, s->p.tau0, field);
     for (int i = 0; i < n; i++)
-        down += solid * s->dirs.k[i] * field[n + i] * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
+        down += area[i] * s->dirs.k[i] * field[n + i] * (s->fresnel ? 1.0 - s->Rc[i] : 1.0);
     if (s->fresnel) { /* fractions of the power mu_air incident from air (ppsolver.h) */
         double e = exp(-s->p.tau0 / mu0), depth = mu0 * -expm1(-s->p.tau0 / mu0);
         double fluence = (s->D + s->U) * depth;
         for (int i = 0; i < m; i++)
-            fluence += solid * (s->Z[i] + s->Zu[i]) * depth;
+            fluence += area[i % n] * (s->Z[i] + s->Zu[i]) * depth;
         for (int k = 0; k < s->nmodes; k++) {
             double sum = 0.0;
             for (int i = 0; i < m; i++)
-                sum += solid * s->V[(size_t)k * m + i];
+                sum += area[i % n] * s->V[(size_t)k * m + i];
             fluence += sum * depth_integral(s->lambda[k], s->tau_ref[k], s->p.tau0);
         }
         double out = (1.0 - s->Fb) * mu0 / s->mu_air;
@@ -630,11 +632,11 @@ static void compute_totals(pp_solution *s)
     s->ballistic = exp(-s->p.tau0 / mu0);
     double fluence = mu0 * -expm1(-s->p.tau0 / mu0); /* direct beam */
     for (int i = 0; i < m; i++)
-        fluence += solid * s->Z[i] * mu0 * -expm1(-s->p.tau0 / mu0);
+        fluence += area[i % n] * s->Z[i] * mu0 * -expm1(-s->p.tau0 / mu0);
     for (int k = 0; k < s->nmodes; k++) {
         double sum = 0.0;
         for (int i = 0; i < m; i++)
-            sum += solid * s->V[(size_t)k * m + i];
+            sum += area[i % n] * s->V[(size_t)k * m + i];
         fluence += sum * depth_integral(s->lambda[k], s->tau_ref[k], s->p.tau0);
     }
     s->R = up / mu0, s->T = down / mu0;
@@ -652,17 +654,18 @@ static void compute_totals(pp_solution *s)
 static double discrete_diffusion(const pp_solution *s)
 {
     size_t n = (size_t)s->n;
-    double *G = dalloc(n * n), *h = dalloc(n), solid = s->dirs.solid, D = 0.0;
+    double *G = dalloc(n * n), *h = dalloc(n), D = 0.0;
+    const double *area = s->dirs.area;
     if (G && h) {
         for (size_t j = 0; j < n; j++) {
             for (size_t i = 0; i < n; i++)
-                G[j * n + i] = (i == j ? solid : 0.0) - (s->Sa[j * n + i] - s->Sb[j * n + i]);
-            h[j] = solid * s->dirs.k[j];
+                G[j * n + i] = (i == j ? area[i] : 0.0) - (s->Sa[j * n + i] - s->Sb[j * n + i]);
+            h[j] = area[j] * s->dirs.k[j];
         }
         if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'L', (lapack_int)n, 1, G, (lapack_int)n, h,
                           (lapack_int)n) == 0)
             for (size_t i = 0; i < n; i++)
-                D += 2.0 * solid * s->dirs.k[i] * h[i] / (4.0 * M_PI);
+                D += 2.0 * area[i] * s->dirs.k[i] * h[i] / (4.0 * M_PI);
     }
     free(G), free(h);
     return D;
@@ -673,7 +676,7 @@ static double isotropic_diffusion(const pp_solution *s)
 {
     double D = 0.0;
     for (int i = 0; i < s->n; i++)
-        D += 2.0 * s->dirs.solid * s->dirs.k[i] * s->dirs.k[i] / (4.0 * M_PI);
+        D += 2.0 * s->dirs.area[i] * s->dirs.k[i] * s->dirs.k[i] / (4.0 * M_PI);
     return D;
 }
 
@@ -709,7 +712,7 @@ static void delta_m_blocks(pp_solution *s)
     for (size_t k = 0; k < n * n; k++)
         s->Sa[k] *= 1.0 - F, s->Sb[k] *= 1.0 - F;
     for (size_t i = 0; i < n; i++)
-        s->Sa[i * n + i] += F * s->dirs.solid;
+        s->Sa[i * n + i] += F * s->dirs.area[i];
     s->fwd = F;
 }
 

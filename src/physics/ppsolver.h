@@ -75,8 +75,9 @@
  *   the 108 cases of g 0.7-0.95 are within 1.4e-3 at 334 cells (8.9e-3 without), 6.6e-4 at
  *   1000 (3.7e-3). What bounds the rest is the polar resolution (docs/methods.md, the slab
  *   solver's error budget): the default partition's 12 rings per hemisphere at 334 cells are a
- *   midpoint rule in mu (sum |Omega| k^2 3.1e-3 short of 2 pi / 3); pp_solve_collars with 55
- *   collars brings the same 334 cells within 9.9e-5 for g <= 0.9 and 4.3e-4 at g 0.95. */
+ *   midpoint rule in mu (sum |Omega| k^2 3.1e-3 short of 2 pi / 3); pp_solve_collars on the
+ *   polar rings (directions.h) with 79 collars brings the same 334 cells within 9.9e-5 on
+ *   the whole table. |Omega_i| is per cell (dirs.area): the polar rings' cells differ. */
 #ifndef PPB_PPSOLVER_H
 #define PPB_PPSOLVER_H
 
@@ -127,11 +128,11 @@ double pp_fresnel_ring_mean(double lo, double hi, double n);
 /* pp_solve_fresnel with delta-M mode delta_m (PP_DELTA_M_*). */
 int pp_solve_delta_m(const pp_params *p, double n, int delta_m, const pp_solution *share,
                      pp_solution **out, pp_timing *t, ppb_err *err);
-/* pp_solve_delta_m on the partition with `collars` collars per hemisphere below the cap
- * ([pp] collars; 0: the near-square cells every other entry point uses, bit for bit;
- * directions.h: pp_dirs_make_collars). Polar resolution is what the slab's totals need: at 334
- * cells the default partition has 12 polar rings per hemisphere (docs/methods.md, the slab
- * solver's error budget). share is used only when it has the same collars. */
+/* pp_solve_delta_m on the polar-ring partition with `collars` + 1 rings per hemisphere ([pp]
+ * collars; 0: the near-square cells every other entry point uses, bit for bit; directions.h:
+ * pp_dirs_make_collars). Polar resolution is what the slab's totals need: at 334 cells the
+ * default partition has 12 polar rings per hemisphere (docs/methods.md, the slab solver's error
+ * budget). share is used only when it has the same collars. */
 int pp_solve_collars(const pp_params *p, double n, int delta_m, int collars,
                      const pp_solution *share, pp_solution **out, pp_timing *t, ppb_err *err);
 /* [pp] collars against [pp] directions (ppslab's and pp's checks, before any work): a clear

@@ -63,6 +63,12 @@ static void grid_y(const ppb_scene *sc, double spacing, ppb_rte_params *P)
     P->ny = 2 * P->nyl + P->nym + 1;
 }
 
+/* |Omega| of class a's representative cell (the cells of a class are images of one another). */
+static double cell_area(const ppb_rte_grid *G, int a)
+{
+    return G->dirs.area[G->rep[a] % G->dirs.n];
+}
+
 /* The tube's transported x components scaled by one factor, so that the cells' centres
  * integrate w_x^2 over the sphere exactly (4 pi / 3). The lateral spread of light, what carries
  * it from the lit part to a shadowed wall, goes with that moment (the diffusion coefficient of
@@ -75,7 +81,7 @@ static void lateral_scale(ppb_rte_grid *G)
 {
     double s2 = 0.0;
     for (int a = 0; a < G->nc; a++)
-        s2 += G->mult[a] * G->dirs.solid * G->dir4[4 * a] * G->dir4[4 * a];
+        s2 += G->mult[a] * cell_area(G, a) * G->dir4[4 * a] * G->dir4[4 * a];
     double f = sqrt(4.0 * PPB_PI / 3.0 / s2);
     for (int a = 0; a < G->nc; a++)
         G->dir4[4 * a] *= f;
@@ -126,7 +132,7 @@ static int grid_walls(ppb_rte_grid *G, const ppb_scene *sc, const double *Fl, pp
         }
         b[4 + PPB_S3] = b[4 + PPB_S4] = den > 0.0 ? num / den : 1.0;
         for (int k = 0; k < 3; k++)
-            b[8 + k] = Fu[(size_t)k * m + i] / G->dirs.solid;
+            b[8 + k] = Fu[(size_t)k * m + i] / cell_area(G, a);
     }
     free(Fu);
     return 0;
@@ -561,7 +567,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
             int i = G->rep[a];
             memcpy(G->dir4 + 4 * a, G->dirs.centre + 3 * i, 3 * sizeof(double));
             /* Cell average of p(w.w_L): the integral over the cell of p(w'.w_L) by symmetry. */
-            G->dir4[4 * a + 3] = F[i] / G->dirs.solid;
+            G->dir4[4 * a + 3] = F[i] / cell_area(G, a);
             for (int j = 0; j < m; j++)
                 G->Pf[(size_t)a * G->nc + G->slot[j]] += Pfull[(size_t)i * m + j];
         }
@@ -679,7 +685,7 @@ void ppb_rte_boundary_flux(const ppb_rte_grid *G, const double *x, double flux[4
     for (int a = 0; a < G->nc; a++) {
         const double *bout = x + a * stride + G->nf;
         const double *bc = G->bnd ? G->bnd + PPB_RTE_BND * a : NULL;
-        double w = G->mult[a] * G->dirs.solid;
+        double w = G->mult[a] * cell_area(G, a);
         for (int face = 0; face < 4; face++) {
             int e0 = ppb_moc_edge0(nfx, ny, face), ne = ppb_moc_nedge(nfx, ny, face);
             double sum = 0.0;
@@ -702,7 +708,7 @@ double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *x)
             int k = f % G->nfx;
             s += (1.0 - G->falb[k]) * G->fsig[k] * G->farea[f] * psi[f];
         }
-        sum += G->mult[a] * G->dirs.solid * s;
+        sum += G->mult[a] * cell_area(G, a) * s;
     }
     return sum;
 }
