@@ -135,9 +135,10 @@ int pp_solve_delta_m(const pp_params *p, double n, int delta_m, const pp_solutio
  * budget). share is used only when it has the same collars. */
 int pp_solve_collars(const pp_params *p, double n, int delta_m, int collars,
                      const pp_solution *share, pp_solution **out, pp_timing *t, ppb_err *err);
-/* [pp] collars against [pp] directions (ppslab's and pp's checks, before any work): a clear
- * error naming the key (in `section`, the methods' settings section) where it exceeds
- * pp_dirs_max_collars. */
+/* [pp] collars against [pp] directions and the light (ppslab's and pp's checks, before any
+ * work): a clear error naming the key (in `section`, the methods' settings section) where it
+ * exceeds pp_dirs_max_collars, or where collars > 0 meets oblique light (the polar rings
+ * resolve a field symmetric about the normal only). */
 struct ppb_config;
 int pp_collars_check(const struct ppb_config *cfg, const char *section, ppb_err *err);
 /* Whether mode delta_m applies delta-M at asymmetry g. */
