@@ -9,34 +9,15 @@
  * at n = 1.5's critical cosine): thin rings whose cells reach a radian in azimuth. */
 #include "testutil.h"
 
+#include "legendre_rings.h"
+
 #include <math.h>
 #include <stdlib.h>
 
 #include "physics/directions.h"
 #include "physics/phase.h"
 
-#define PI   3.14159265358979323846
-#define LMAX 2000
-
-static void legendre(double x, int lmax, double *P)
-{
-    P[0] = 1.0;
-    if (lmax > 0)
-        P[1] = x;
-    for (int l = 1; l < lmax; l++)
-        P[l + 1] = ((2.0 * l + 1.0) * x * P[l] - l * P[l - 1]) / (l + 1.0);
-}
-
-/* I_l = integral of P_l over [a, b], l < L. */
-static void ring_integrals(double a, double b, int L, double *I)
-{
-    static double Pa[LMAX + 2], Pb[LMAX + 2];
-    legendre(a, L, Pa);
-    legendre(b, L, Pb);
-    I[0] = b - a;
-    for (int l = 1; l < L; l++)
-        I[l] = ((Pb[l + 1] - Pb[l - 1]) - (Pa[l + 1] - Pa[l - 1])) / (2.0 * l + 1.0);
-}
+#define PI 3.14159265358979323846
 
 /* Largest ring-pair difference of the blocks against the addition theorem, relative (HG is
  * positive everywhere). */
@@ -50,12 +31,13 @@ static double ring_sum_error(int n, int collars, double mu_snap, double g)
     assert_true(Sa && Sb);
     assert_int_equal(pp_phase_blocks(&d, g, Sa, Sb, &err), 0);
     int L = (int)ceil(log(1e-18) / log(fabs(g))), R = d.nrings;
-    assert_true(L < LMAX);
     double *Iu = malloc(sizeof(double) * R * L), *Id = malloc(sizeof(double) * R * L);
     assert_true(Iu && Id);
     for (int r = 0; r < R; r++) {
-        ring_integrals(d.mu_edge[r + 1], d.mu_edge[r], L, Iu + (size_t)r * L);
-        ring_integrals(-d.mu_edge[r], -d.mu_edge[r + 1], L, Id + (size_t)r * L);
+        assert_int_equal(lr_ring_integrals(d.mu_edge[r + 1], d.mu_edge[r], L, Iu + (size_t)r * L),
+                         0);
+        assert_int_equal(lr_ring_integrals(-d.mu_edge[r], -d.mu_edge[r + 1], L, Id + (size_t)r * L),
+                         0);
     }
     double worst = 0.0;
     for (int r = 0; r < R; r++)
