@@ -114,8 +114,8 @@ static void test_deltam_vs_adding_doubling(void **state)
  * resolution (docs/methods.md, the slab solver's error budget): at normal light the slab's
  * totals depend on the polar angle alone, and the ring system is what the cells solve (their
  * azimuthal cuts do not matter where the pair integrals are exact, phase_rings.h). Expected
- * values: adding-doubling (tests/data/adding_doubling_ref.csv), within the 2e-4 the issue of
- * this table asks for at every g (the reference's own quadrature orders agree within 9e-5).
+ * values: adding-doubling (tests/data/adding_doubling_ref.csv), within the 2e-4 that
+ * this table is held to at every g (the reference's own quadrature orders agree within 9e-5).
  * Measured 9.9e-5 (g 0.95, tau0 10, albedo 0.99, n 1.5); an independent ring solver
  * (scripts/ring_slab.py: the m = 0 system on the same rings, HG's pair integrals from its Legendre
  * series) gives the same to three digits. Energy stays conserved to rounding on this partition. */
