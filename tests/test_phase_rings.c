@@ -21,11 +21,11 @@
 
 /* Largest ring-pair difference of the blocks against the addition theorem, relative (HG is
  * positive everywhere). */
-static double ring_sum_error(int n, int collars, double mu_snap, double g)
+static double ring_sum_error(int n, int collars, double mu_snap, double g, int antipodal)
 {
     ppb_err err;
     pp_dirs d;
-    assert_int_equal(pp_dirs_make_collars(n, g < 0, mu_snap, collars, &d, &err), 0);
+    assert_int_equal(pp_dirs_make_collars(n, antipodal, mu_snap, collars, &d, &err), 0);
     assert_true(d.polar);
     double *Sa = malloc(sizeof(double) * n * n), *Sb = malloc(sizeof(double) * n * n);
     assert_true(Sa && Sb);
@@ -70,7 +70,7 @@ static void test_ring_sums_match_addition_theorem(void **state)
     const double gs[] = {0.95, 0.7};
     for (int c = 0; c < 2; c++)
         for (int k = 0; k < 2; k++) {
-            double e = ring_sum_error(334, collars[c], mu_c, gs[k]);
+            double e = ring_sum_error(334, collars[c], mu_c, gs[k], 0);
             print_message("334 cells, %d collars, g %.2f: largest relative ring-pair error %.2e\n",
                           collars[c], gs[k], e);
             assert_true(e < 1e-8);
@@ -78,14 +78,19 @@ static void test_ring_sums_match_addition_theorem(void **state)
 }
 
 /* A backward peak (g -0.9) on the antipodal polar partition (phase.h: a column permutation of
- * the |g| blocks), and no snap, odd N. */
+ * the |g| blocks) and integrated directly on the partition without antipodes (N even, so the
+ * first collar is odd), and no snap, odd N. */
 static void test_ring_sums_backward_and_odd(void **state)
 {
     (void)state;
-    double e1 = ring_sum_error(334, 40, 0.0, -0.9), e2 = ring_sum_error(201, 30, 0.5, 0.9);
-    print_message("g -0.9: %.2e; 201 cells, 30 collars, g 0.9: %.2e\n", e1, e2);
+    double e1 = ring_sum_error(334, 40, 0.0, -0.9, 1), e2 = ring_sum_error(334, 40, 0.0, -0.7, 0);
+    double e3 = ring_sum_error(201, 30, 0.5, 0.9, 0);
+    print_message("g -0.9 antipodal: %.2e; g -0.7 direct: %.2e; 201 cells, 30 collars, g 0.9: "
+                  "%.2e\n",
+                  e1, e2, e3);
     assert_true(e1 < 1e-8);
     assert_true(e2 < 1e-8);
+    assert_true(e3 < 1e-8);
 }
 
 int main(void)

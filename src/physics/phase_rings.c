@@ -59,7 +59,9 @@ static double linear_piece(const conv *c, double u, double v)
         return 0.5 * (v - u) * (trapezoid(c, u) + trapezoid(c, v)) / den;
     }
     double off = c->B > 0.0 ? 0.0 : PPB_PI; /* the peaks: off + 2 pi k */
-    double w = sqrt(2.0 * (c->A - fabs(c->B)) / fabs(c->B));
+    /* the peak's half-width: A - |B| >= (1 - |g|)^2 > 0, floored where rounding takes it (g
+     * within 1e-8 of 1), so that the grading always advances */
+    double w = fmax(sqrt(2.0 * (c->A - fabs(c->B)) / fabs(c->B)), 1e-9);
     double sum = 0.0;
     /* between consecutive multiples off + pi k one end is a peak (k even), the other not */
     for (double k = 2.0 * floor((u - off) / (2.0 * PPB_PI)); off + PPB_PI * k < v; k += 1.0) {
@@ -108,8 +110,9 @@ static int theta_order(const pp_dirs *d, double g, int a, int b)
     polar_range(d, a, &ta0, &ta1);
     polar_range(d, b, &tb0, &tb1);
     double gap = fmax(0.0, fmax(ta0 - tb1, tb0 - ta1)), h = 0.5 * fmax(ta1 - ta0, tb1 - tb0);
-    double ag = fabs(g),
-           gap_peak = g >= 0.0 ? gap : fmax(0.0, PPB_PI - (fmax(ta1, tb1) - fmin(ta0, tb0)));
+    /* a backward peak (g < 0, integrated directly only off the antipodal partitions) gets no
+     * such bound: the order as if the peak were inside */
+    double ag = fabs(g), gap_peak = g >= 0.0 ? gap : 0.0;
     double ratio = sqrt(ppb_hg_base(ag, cos(gap_peak)) / ag) / h;
     double rho = ratio + sqrt(ratio * ratio + 1.0),
            q = ceil(log(1.0 / RINGS_TOL) / (2.0 * log(rho)));
