@@ -221,12 +221,12 @@ static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d
         free(count), free(theta);
         return ppb_fail(err, "pp directions: out of memory");
     }
-    int pole = antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1;
-    int nrings = collars > 0 ? polar_counts(n, pole, theta_snap, collars, count, theta)
-                             : ring_counts(n, pole, theta_snap, collars, count);
+    int pole = antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, polar = collars > 0;
+    int nrings = polar ? polar_counts(n, pole, theta_snap, collars, count, theta)
+                       : ring_counts(n, pole, theta_snap, collars, count);
     d->n = n;
     d->nrings = nrings;
-    d->polar = collars > 0;
+    d->polar = polar;
     d->solid = 2.0 * PPB_PI / n;
     if (alloc_all(d, n, nrings) != 0) {
         free(count), free(theta);
@@ -246,11 +246,11 @@ static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d
         /* equal areas: mu = 1 - C/N makes each ring's area exactly count * 2 pi / N; polar
          * rings keep their edges, and their cells' areas follow */
         d->mu_edge[r + 1] = r + 1 == nrings ? 0.0
-                            : collars > 0   ? cos(theta[r + 1])
+                            : polar         ? cos(theta[r + 1])
                                             : 1.0 - (double)(cell) / n;
         for (int j = d->ring_first[r]; j < cell; j++)
-            d->area[j] = collars > 0 ? 2.0 * PPB_PI * (d->mu_edge[r] - d->mu_edge[r + 1]) / count[r]
-                                     : d->solid;
+            d->area[j] =
+                polar ? 2.0 * PPB_PI * (d->mu_edge[r] - d->mu_edge[r + 1]) / count[r] : d->solid;
     }
     free(count), free(theta);
     for (int i = 0; i < n; i++)
