@@ -207,6 +207,9 @@ static const key_def keys[] = {
     {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
      "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
      "truncates nothing"},
+    {"rte2d", "ims", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.ims), 0, 0, "on", on_off_names,
+     "rte2d: under delta-M, the exit radiance corrected for the light scattered only within the "
+     "truncated peak (Nakajima and Tanaka's IMS, every order in the small-angle limit)"},
     /* [object]: `ppbench object` only (docs/reference.md, Objects); the tube's Monte Carlo
      * never reads them, so none is part of its reference cache's key. */
     {"object", "shape", K_ENUM, PPB_NOT_MC_KEY, F(object.shape), 0, 0, "box", shape_names,

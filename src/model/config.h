@@ -99,6 +99,7 @@ typedef struct ppb_rte2d_settings {
     int delta_m;       /* PPB_RTE_DELTA_M_*: delta-M with the single-scattering correction (TMS) */
     int delta_m_order; /* delta-M's truncation order L (f = g^L); 0 = sqrt(2 directions) */
     int moment;        /* 1: the cells' phase matrix corrected to HG's first moment */
+    int ims;           /* 1: delta-M's intensity correction of the exit (Nakajima-Tanaka IMS) */
 } ppb_rte2d_settings;
 
 /* A three-dimensional object's settings ([object]; docs/reference.md, Objects). Material 1 is

@@ -18,6 +18,7 @@
 #include "physics/gmres.h"
 #include "physics/totals.h"
 #include "methods/rte2d/rte2d_grid.h"
+#include "methods/rte2d/rte2d_ims.h"
 
 _Static_assert(sizeof(ppb_rte_params) ==
                    sizeof(ppb_medium) + sizeof(ppb_lit) + 15 * sizeof(double) + 22 * sizeof(int),
@@ -33,6 +34,7 @@ typedef struct rte_exit {
     double *Fx; /* [ndir][nc] */
     double *bx; /* n > 1: [ndir][4] slots of the samples' mirrors (PPB_RTE_ARG_BND); else NULL */
     double *wd; /* [ndir][3]: each sample's direction (air side; ppb_bin_sample_dir) */
+    ppb_rte_ims ims; /* delta-M's intensity correction of the sources (m = 0: none) */
 } rte_exit;
 
 typedef struct rte_solver {
@@ -49,6 +51,9 @@ typedef struct rte_solver {
     double absorbed_beam;       /* the beam's collisions times 1 - alpha (ppb_rte_beam_sources) */
     int sweeps;
     double t_sweeps;
+    /* Delta-M's intensity correction (rte2d_ims.h): the exact medium's g and albedo and the
+     * truncation f; f = 0: none. */
+    double ims_g, ims_albedo, ims_f;
 } rte_solver;
 
 static void solver_free(rte_solver *s)
@@ -287,6 +292,8 @@ static int exit_setup(rte_solver *s, const ppb_config *cfg, const ppb_layout *lo
                     }
                 }
     int rc = ppb_rte_exit_coeffs(&s->G, w, ex->ndir, ex->Fx, err);
+    if (!rc && s->ims_f > 0.0)
+        rc = ppb_rte_ims_make(&s->G, s->ims_g, s->ims_albedo, s->ims_f, w, ex->ndir, &ex->ims, err);
     free(w);
     return rc;
 }
@@ -306,6 +313,7 @@ static int exit_march(rte_solver *s, const ppb_config *cfg, const rte_exit *ex, 
     if (!rc) {
         cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, ndir, nn, nc, 1.0, ex->Fx, nc, rad,
                     nn, 0.0, Jx, nn);
+        ppb_rte_ims_add(&ex->ims, ndir, nn, Jx);
         rc = ppb_cl_check(clEnqueueWriteBuffer(s->ocl->queue, s->src, CL_TRUE, 0,
                                                sizeof(double) * (size_t)ndir * nn, Jx, 0, NULL,
                                                NULL),
@@ -615,7 +623,7 @@ static int record_refinements(rte_solver *s, const ppb_config *cfg, const ppb_la
     int npts = cfg->samples_seg < 1 ? 1 : cfg->samples_seg;
     nsamp = nsamp < RTE_LADDER_SAMPLES ? nsamp : RTE_LADDER_SAMPLES;
     npts = npts < RTE_LADDER_SAMPLES ? npts : RTE_LADDER_SAMPLES;
-    rte_exit ex = {0, 0, 0, NULL, NULL, NULL};
+    rte_exit ex = {0, 0, 0, NULL, NULL, NULL, {0, NULL, NULL}};
     rte_plain pl = {0};
     ppb_result r, rc_conv;
     int ok_r = 0, ok_c = 0;
@@ -656,6 +664,7 @@ static int record_refinements(rte_solver *s, const ppb_config *cfg, const ppb_la
     free(ex.Fx);
     free(ex.bx);
     free(ex.wd);
+    ppb_rte_ims_free(&ex.ims);
     free(rad);
     free(pts);
     return rc;
@@ -836,7 +845,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_f
     int nsamp = cfg->samples_dir < 1 ? 1 : cfg->samples_dir;
     size_t planes = (size_t)ppb_bin_sample_count(lo->nsurf, lo->nbins, nsamp);
     rte_solver s;
-    rte_exit ex = {0, 0, 0, NULL, NULL, NULL};
+    rte_exit ex = {0, 0, 0, NULL, NULL, NULL, {0, NULL, NULL}};
     ppb_gmres_basis kb = {0, 0.0, NULL, NULL};
     /* The first-moment correction (ppb_rte_moment_fix, rte2d_grid.h) where the peak the cells
      * cannot resolve, delta-M's f = g^L of the solved medium (ppb_rte_delta_m), is under 1e-3 (g
@@ -846,11 +855,18 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_f
     double g = cfg->scene.g;
     int moment =
         cfg->rte2d.moment && !(g > 0.0 && pow(g, sqrt(2.0 * cfg->rte2d.directions)) >= 1e-3);
-    if (solver_init(&s, ocl, cfg, moment, ph, planes, lo->ncells, err) ||
+    int rc0 = solver_init(&s, ocl, cfg, moment, ph, planes, lo->ncells, err);
+    if (!rc0 && cfg->rte2d.ims && st.delta_f > 0.0) {
+        s.ims_g = g_ss;
+        s.ims_albedo = ctx->cfg->scene.albedo;
+        s.ims_f = st.delta_f;
+    }
+    if (rc0 ||
         exit_setup(&s, cfg, lo, nsamp, cfg->samples_seg < 1 ? 1 : cfg->samples_seg, &ex, err)) {
         free(ex.Fx);
         free(ex.bx);
         free(ex.wd);
+        ppb_rte_ims_free(&ex.ims);
         solver_free(&s);
         return -1;
     }
@@ -890,6 +906,7 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_f
     free(ex.Fx);
     free(ex.bx);
     free(ex.wd);
+    ppb_rte_ims_free(&ex.ims);
     free(rad);
     free(b);
     solver_free(&s);
