@@ -176,6 +176,78 @@ static void test_polar_partition(void **state)
     }
 }
 
+/* The graded polar rings (pp_dirs_make_spec, h_pole), probed through cell_of as above: the
+ * stored areas are the probed rectangles and cover the sphere; the cap has radius
+ * h_pole / sqrt(pi) (a near-square cell of side h_pole); the widths of the rings below it grow
+ * monotonically from about h_pole toward the square cell's side sqrt(2 pi / N) (geometric
+ * growth, up to the snap's rescaling); the snap edge lies at the critical cosine exactly; the
+ * cells follow the rings' areas within the rounding. The cases: g 0.9's retained peak on the
+ * study's 128 cells (h 0.123, n 1.4's snap), the same without the snap, on 256 cells, and the
+ * antipodal variant (four wedges). And the tube's whole snap: the near-square cells with the
+ * edge at the critical cosine but without the split's six extra rings. */
+static void test_graded_partition(void **state)
+{
+    (void)state;
+    const int ns[] = {128, 128, 256, 128};
+    const double hs[] = {0.1227, 0.1227, 0.110, 0.15};
+    const double snaps[] = {0.69985421222376, 0.0, 0.69985421222376, 0.0};
+    for (int t = 0; t < 4; t++) {
+        pp_dirs d;
+        ppb_err err;
+        int n = ns[t];
+        pp_dirs_spec spec = {.antipodal = t == 3, .mu_snap = snaps[t], .h_pole = hs[t]};
+        assert_int_equal(pp_dirs_make_spec(n, &spec, &d, &err), 0);
+        assert_true(d.polar);
+        double total = 0.0, lo, hi;
+        for (int i = 0; i < 2 * n; i++) {
+            double area = probed_area(&d, i, &lo, &hi);
+            if (fabs(area - d.area[i % n]) > 1e-11)
+                fail_msg("N = %d, h %g, cell %d: probed area %.15g, stored %.15g", n, hs[t], i,
+                         area, d.area[i % n]);
+            total += area;
+        }
+        assert_close(total, 4 * PI, 1e-10);
+        assert_int_equal(d.ring_first[1], t == 3 ? 4 : 1);
+        assert_close(acos(d.mu_edge[1]), hs[t] / sqrt(PI), 1e-12);
+        double side = sqrt(2.0 * PI / n), prev = 0.0;
+        int found = 0;
+        for (int r = 1; r < d.nrings; r++) {
+            double w = acos(d.mu_edge[r + 1]) - acos(d.mu_edge[r]);
+            int count = d.ring_first[r + 1] - d.ring_first[r];
+            assert_true(count >= 2);
+            if (snaps[t] == 0.0) {
+                if (r == 1)
+                    assert_rel(w, hs[t], 0.15);
+                assert_true(w >= prev - 1e-12);
+                assert_true(w <= 1.15 * side);
+            }
+            prev = w;
+            if (fabs(d.mu_edge[r] - snaps[t]) < 1e-14)
+                found = 1;
+            double share = (n - d.ring_first[1]) * (d.mu_edge[r] - d.mu_edge[r + 1]) / d.mu_edge[1];
+            if (count > 3 && fabs(count - share) > 2.0)
+                fail_msg("N = %d ring %d: %d cells for a share of %.2f", n, r, count, share);
+        }
+        assert_true(found == (snaps[t] > 0.0));
+        pp_dirs_free(&d);
+    }
+    /* the whole snap: the edge at the critical cosine within the counts' rounding (1/N in mu,
+     * pp_dirs_make_snap), and six rings fewer than with the split */
+    pp_dirs a, b;
+    ppb_err err;
+    pp_dirs_spec whole = {.mu_snap = snaps[0], .whole_snap = 1};
+    assert_int_equal(pp_dirs_make_spec(128, &whole, &a, &err), 0);
+    assert_int_equal(pp_dirs_make_snap(128, 0, snaps[0], &b, &err), 0);
+    assert_false(a.polar);
+    assert_int_equal(a.nrings + 6, b.nrings);
+    double near = 1.0;
+    for (int r = 0; r <= a.nrings; r++)
+        near = fmin(near, fabs(a.mu_edge[r] - snaps[0]));
+    assert_true(near <= 1.0 / 128);
+    pp_dirs_free(&a);
+    pp_dirs_free(&b);
+}
+
 /* splitmix64 (Steele, Lea & Flood 2014): the test's own uniform stream, to (0, 1). */
 static double uniform01(uint64_t *s)
 {
@@ -350,6 +422,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cell_areas_from_membership),
         cmocka_unit_test(test_polar_partition),
+        cmocka_unit_test(test_graded_partition),
         cmocka_unit_test(test_cells_by_monte_carlo),
         cmocka_unit_test(test_mean_cosines_exact),
         cmocka_unit_test(test_mirror_symmetries),

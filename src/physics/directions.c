@@ -70,7 +70,7 @@ static int cumulative(int n, int r, int rings, int done, int first_min, double x
 
 /* The equal-area partition: a polar ring of `pole` cells, then collars whose cell counts are
  * rounded from the equal-area cells above each edge (the edges are moved afterwards, make()). */
-static int ring_counts(int n, int pole, double theta_snap, int want, int *count)
+static int ring_counts(int n, int pole, double theta_snap, int want, int whole, int *count)
 {
     count[0] = pole;
     if (n == pole)
@@ -86,7 +86,7 @@ static int ring_counts(int n, int pole, double theta_snap, int want, int *count)
     if (theta_snap > theta_cap && theta_snap < 0.5 * PPB_PI && collars >= 2) {
         r_snap = (int)lround((theta_snap - theta_cap) / (0.5 * PPB_PI - theta_cap) * collars);
         r_snap = r_snap < 1 ? 1 : (r_snap > collars - 1 ? collars - 1 : r_snap);
-        if (collars + 2 * (SNAP_SPLIT - 1) <= most)
+        if (!whole && collars + 2 * (SNAP_SPLIT - 1) <= most)
             split = SNAP_SPLIT, collars += 2 * (SNAP_SPLIT - 1);
     }
     for (int r = 1; r <= collars; r++) {
@@ -97,6 +97,21 @@ static int ring_counts(int n, int pole, double theta_snap, int want, int *count)
         done = cum;
     }
     return collars + 1;
+}
+
+/* Cells per ring for ring edges theta [rings + 1]: the cap `pole`, below it in proportion to
+ * the rings' areas, rounded cumulatively in steps of two (cumulative), first_min in the first
+ * ring and two at least in every other. */
+static void area_counts(int n, int pole, int rings, int first_min, const double *theta, int *count)
+{
+    count[0] = pole;
+    double below_cap = cos(theta[1]);
+    for (int r = 1, done = pole; r < rings; r++) {
+        double x = pole + (n - pole) * (below_cap - cos(theta[r + 1])) / below_cap;
+        int cum = cumulative(n, r, rings, done, first_min, x);
+        count[r] = cum - done;
+        done = cum;
+    }
 }
 
 /* The polar-ring partition (directions.h, pp_dirs_make_collars): `want` + 1 rings of equal
@@ -120,14 +135,38 @@ static int polar_counts(int n, int pole, double theta_snap, int want, int *count
         theta[r] = r == rings   ? 0.5 * PPB_PI
                    : r_snap > 0 ? fine_theta(r, coarse, r_snap, split, 0.0, theta_snap)
                                 : 0.5 * PPB_PI * r / coarse;
-    count[0] = pole;
-    double below_cap = cos(theta[1]);
-    for (int r = 1, done = pole; r < rings; r++) {
-        double x = pole + (n - pole) * (below_cap - cos(theta[r + 1])) / below_cap;
-        int cum = cumulative(n, r, rings, done, first_min, x);
-        count[r] = cum - done;
-        done = cum;
+    area_counts(n, pole, rings, first_min, theta, count);
+    return rings;
+}
+
+/* The graded polar rings (directions.h, pp_dirs_spec.h_pole): a cap of `pole` cells and of
+ * radius h / sqrt(pi) (one near-square cell of side h), then rings whose polar widths grow
+ * geometrically from h at the cap to the square cell's side sqrt(2 pi / N) at the equator;
+ * theta_snap, if any, moves the edge nearest it onto it, the edges on either side rescaled
+ * (nothing split). The cells follow the rings' areas (area_counts). */
+static int graded_counts(int n, int pole, double theta_snap, double h, int *count, double *theta)
+{
+    int most = most_rings(n, pole) - 1, first_min = pole % 2 != n % 2 ? 3 : 2;
+    double side = sqrt(2.0 * PPB_PI / n), t1 = h / sqrt(PPB_PI), span = 0.5 * PPB_PI - t1;
+    double k = (side - h) / span; /* width growth per radian of polar angle */
+    int rings = 1 + (int)lround(k > 1e-9 ? log(side / h) / k : span / h);
+    rings = rings < 2 ? 2 : (rings > most ? most : rings);
+    theta[0] = 0.0;
+    for (int r = 1; r <= rings; r++)
+        theta[r] = t1 + span * (k > 1e-9 ? expm1(k * (r - 1)) / expm1(k * (rings - 1))
+                                         : (double)(r - 1) / (rings - 1));
+    if (theta_snap > t1 && theta_snap < 0.5 * PPB_PI && rings > 2) {
+        int b = 2;
+        for (int r = 2; r < rings; r++)
+            if (fabs(theta[r] - theta_snap) < fabs(theta[b] - theta_snap))
+                b = r;
+        double tb = theta[b];
+        for (int r = 2; r < rings; r++)
+            theta[r] = r <= b ? t1 + (theta[r] - t1) * (theta_snap - t1) / (tb - t1)
+                              : theta_snap + (theta[r] - tb) * (0.5 * PPB_PI - theta_snap) /
+                                                 (0.5 * PPB_PI - tb);
     }
+    area_counts(n, pole, rings, first_min, theta, count);
     return rings;
 }
 
@@ -207,9 +246,19 @@ int pp_dirs_max_collars(int n)
     return n < 6 ? 0 : (n - 4) / 2; /* below every partition's own limit (ring_counts) */
 }
 
-static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d, ppb_err *err)
+/* Whether spec asks for the graded rings: h_pole below the square cell's side and rings to
+ * spare (two cells each below the cap). */
+static int graded(int n, const pp_dirs_spec *spec)
+{
+    return spec->collars == 0 && spec->h_pole > 0.0 && spec->h_pole < sqrt(2.0 * PPB_PI / n) &&
+           n >= 8;
+}
+
+int pp_dirs_make_spec(int n, const pp_dirs_spec *spec, pp_dirs *d, ppb_err *err)
 {
     memset(d, 0, sizeof *d);
+    int collars = spec->collars, antipodal = spec->antipodal;
+    double theta_snap = spec->mu_snap > 0.0 && spec->mu_snap < 1.0 ? acos(spec->mu_snap) : 0.0;
     if (n < 1 || n > PP_DIRS_MAX)
         return ppb_fail(err, "pp directions: %d cells per hemisphere, need 1..%d", n, PP_DIRS_MAX);
     if (collars < 0 || collars > pp_dirs_max_collars(n))
@@ -221,9 +270,11 @@ static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d
         free(count), free(theta);
         return ppb_fail(err, "pp directions: out of memory");
     }
-    int pole = antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, polar = collars > 0;
-    int nrings = polar ? polar_counts(n, pole, theta_snap, collars, count, theta)
-                       : ring_counts(n, pole, theta_snap, collars, count);
+    int pole = antipodal && n % 2 == 0 ? (n < 4 ? n : 4) : 1, grade = graded(n, spec);
+    int polar = collars > 0 || grade;
+    int nrings = grade   ? graded_counts(n, pole, theta_snap, spec->h_pole, count, theta)
+                 : polar ? polar_counts(n, pole, theta_snap, collars, count, theta)
+                         : ring_counts(n, pole, theta_snap, collars, spec->whole_snap, count);
     d->n = n;
     d->nrings = nrings;
     d->polar = polar;
@@ -260,24 +311,25 @@ static int make(int n, int antipodal, double theta_snap, int collars, pp_dirs *d
 
 int pp_dirs_make(int n, pp_dirs *d, ppb_err *err)
 {
-    return make(n, 0, 0.0, 0, d, err);
+    return pp_dirs_make_spec(n, &(pp_dirs_spec){0}, d, err);
 }
 
 int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err *err)
 {
-    return make(n, antipodal, acos(mu_snap), 0, d, err);
+    return pp_dirs_make_spec(n, &(pp_dirs_spec){.antipodal = antipodal, .mu_snap = mu_snap}, d,
+                             err);
 }
 
 int pp_dirs_make_antipodal(int n, pp_dirs *d, ppb_err *err)
 {
-    return make(n, 1, 0.0, 0, d, err);
+    return pp_dirs_make_spec(n, &(pp_dirs_spec){.antipodal = 1}, d, err);
 }
 
 int pp_dirs_make_collars(int n, int antipodal, double mu_snap, int collars, pp_dirs *d,
                          ppb_err *err)
 {
-    return make(n, antipodal, mu_snap > 0.0 && mu_snap < 1.0 ? acos(mu_snap) : 0.0, collars, d,
-                err);
+    pp_dirs_spec spec = {.antipodal = antipodal, .mu_snap = mu_snap, .collars = collars};
+    return pp_dirs_make_spec(n, &spec, d, err);
 }
 
 void pp_dirs_free(pp_dirs *d)

@@ -45,7 +45,7 @@ typedef struct pp_dirs {
     double *phi_lo, *phi_hi; /* [N]: azimuth range of up cell i (radians) */
     double solid;            /* 2 pi / N, the mean |Omega_i| (every cell's but in polar rings) */
     double *area;            /* [N]: |Omega_i| of up cell i and of its mirror N + i */
-    int polar;               /* the polar-ring partition (pp_dirs_make_collars, collars > 0) */
+    int polar;               /* polar rings (collars > 0, or graded: pp_dirs_make_spec) */
     double *k;               /* [2N]: mean cosine, k[N + i] = -k[i] */
     double *centre;          /* [2N x 3]: unit vector at the cell's (mu, phi) centre */
     double *radius; /* [N]: angle from the centre to the farthest corner (both hemispheres) */
@@ -74,6 +74,24 @@ int pp_dirs_make_snap(int n, int antipodal, double mu_snap, pp_dirs *d, ppb_err 
  * across at 334 cells) blurs it. Fails beyond pp_dirs_max_collars(n). */
 int pp_dirs_make_collars(int n, int antipodal, double mu_snap, int collars, pp_dirs *d,
                          ppb_err *err);
+/* How a partition is built; zero in every field is pp_dirs_make's. */
+typedef struct pp_dirs_spec {
+    int antipodal;  /* closed under w -> -w (pp_dirs_make_antipodal) */
+    double mu_snap; /* in (0, 1): a ring edge at this cosine (pp_dirs_make_snap) */
+    int whole_snap; /* the near-square cells: the rings beside mu_snap not split in four */
+    int collars;    /* > 0: the polar rings of equal width (pp_dirs_make_collars) */
+    double h_pole;  /* in (0, sqrt(2 pi / N)) and collars = 0: the graded polar rings */
+} pp_dirs_spec;
+/* The partition spec asks for. The graded polar rings (h_pole): a cap of radius
+ * h_pole / sqrt(pi) (one near-square cell of that side), then rings whose polar widths grow
+ * geometrically from h_pole to the square cell's side at the equator, each cut into cells in
+ * proportion to its area (area[]); mu_snap moves the edge nearest it onto it and rescales the
+ * others on either side. Fine near the pole for a forward peak narrower than the square cells
+ * round the normal (rte2d_grid.c chooses h_pole), the near-square cells' azimuthal resolution
+ * kept toward the equator. whole_snap: the split beside the snap (ppsolver.h: it pays in a slab,
+ * where the radiance has no azimuth) is left out; in the tube the split's thin rings cost the
+ * azimuth the walls need (reference: Methods, `rte2d`). */
+int pp_dirs_make_spec(int n, const pp_dirs_spec *spec, pp_dirs *d, ppb_err *err);
 /* The most collars n cells per hemisphere allow (two cells each at least): (n - 4) / 2. */
 int pp_dirs_max_collars(int n);
 void pp_dirs_free(pp_dirs *d);

@@ -483,6 +483,21 @@ double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_pha
     return f;
 }
 
+pp_dirs_spec ppb_rte_partition(const ppb_scene *sc, const pp_phase_fn *ph, int directions)
+{
+    pp_dirs_spec spec = {0};
+    spec.antipodal = sc->g < 0;
+    if (sc->n > 1.0) {
+        spec.mu_snap = sqrt(1.0 - 1.0 / (sc->n * sc->n));
+        spec.whole_snap = sc->geometry == PPB_GEOM_TUBE;
+    }
+    /* the retained function's first moment: g* of the HG, chi*_1 of a series */
+    double gs = ph->nmom > 1 ? ph->chi[1] : ph->g;
+    if (sc->theta_deg == 0.0 && gs > 0.0 && 1.0 - gs < sqrt(2.0 * PPB_PI / directions))
+        spec.h_pole = 1.0 - gs;
+    return spec;
+}
+
 int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, double hstep, int moment,
                       const pp_phase_fn *ph, ppb_rte_grid *G, ppb_err *err)
 {
@@ -524,11 +539,8 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     grid_y(sc, spacing, P);
     G->nnodes = P->nx * P->ny;
 
-    int rc = sc->n > 1.0 ? pp_dirs_make_snap(directions, sc->g < 0,
-                                             sqrt(1.0 - 1.0 / (sc->n * sc->n)), &G->dirs, err)
-             : sc->g < 0 ? pp_dirs_make_antipodal(directions, &G->dirs, err)
-                         : pp_dirs_make(directions, &G->dirs, err);
-    if (rc)
+    pp_dirs_spec spec = ppb_rte_partition(sc, &G->phase, directions);
+    if (pp_dirs_make_spec(directions, &spec, &G->dirs, err))
         return -1;
     int m = 2 * G->dirs.n;
     G->slot = malloc(sizeof(int) * m);
@@ -555,7 +567,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     G->dir4 = malloc(sizeof(double) * 4 * G->nc);
     G->Pf = calloc((size_t)G->nc * G->nc, sizeof(double));
     double wl[3] = {P->sin_theta_l, -P->cos_theta_l, 0.0};
-    rc = (G->dir4 && G->Pf) ? 0 : ppb_fail(err, "rte2d: out of memory");
+    int rc = (G->dir4 && G->Pf) ? 0 : ppb_fail(err, "rte2d: out of memory");
     if (!rc)
         rc = pp_phase_matrix_fn(&G->dirs, &G->phase, Pfull, &G->clipped, err);
     if (!rc)

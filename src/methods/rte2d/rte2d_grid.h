@@ -117,6 +117,14 @@ double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_pha
  * `[rte2d] moment` (reference: Methods, `rte2d`). */
 double ppb_rte_moment_fix(const pp_dirs *d, double g, double *P);
 
+/* The direction cells of a grid (reference: Methods, `rte2d`, the cells): at n > 1 a ring edge
+ * at the critical cosine, in the tube without the split of the rings beside it (directions.h);
+ * at normal light where the retained phase function ph (HG g*, or a series of first moment
+ * chi*_1) has its forward peak's angular scale 1 - g* below the square cell's side
+ * sqrt(2 pi / N), the graded polar rings with h_pole = 1 - g* (the peak sits round the normal
+ * there; at oblique light it does not, and the rings' long cells would only cost azimuth). */
+pp_dirs_spec ppb_rte_partition(const ppb_scene *sc, const pp_phase_fn *ph, int directions);
+
 /* Nodes of the grid ppb_rte_grid_make builds at `spacing` (G->nnodes), before building. */
 double ppb_rte_nodes(const ppb_scene *sc, double spacing);
 
