@@ -123,6 +123,21 @@ static void test_cell_areas_from_membership(void **state)
     }
 }
 
+/* The stored areas of a partition with polar rings against the rectangles probed through
+ * cell_of (to 1e-11), and their sum 4 pi. */
+static void assert_probed_areas(const pp_dirs *d, const char *what)
+{
+    double total = 0.0, lo, hi;
+    for (int i = 0; i < 2 * d->n; i++) {
+        double area = probed_area(d, i, &lo, &hi);
+        if (fabs(area - d->area[i % d->n]) > 1e-11)
+            fail_msg("%s, N = %d, cell %d: probed area %.15g, stored %.15g", what, d->n, i, area,
+                     d->area[i % d->n]);
+        total += area;
+    }
+    assert_close(total, 4 * PI, 1e-10);
+}
+
 /* The polar-ring partition (pp_dirs_make_collars, collars > 0), probed as above: the stored
  * areas are the probed rectangles' to 1e-11 and cover 4 pi; collars + 1 rings of equal polar
  * width pi / 2 / (collars + 1) without a snap (the cap one of them, one cell; every other ring
@@ -142,15 +157,7 @@ static void test_polar_partition(void **state)
         int n = ns[t];
         assert_int_equal(pp_dirs_make_collars(n, t == 3, snaps[t], collars[t], &d, &err), 0);
         assert_true(d.polar);
-        double total = 0.0, lo, hi;
-        for (int i = 0; i < 2 * n; i++) {
-            double area = probed_area(&d, i, &lo, &hi);
-            if (fabs(area - d.area[i % n]) > 1e-11)
-                fail_msg("N = %d, %d collars, cell %d: probed area %.15g, stored %.15g", n,
-                         collars[t], i, area, d.area[i % n]);
-            total += area;
-        }
-        assert_close(total, 4 * PI, 1e-10);
+        assert_probed_areas(&d, "collars");
         assert_int_equal(d.ring_first[1], t == 3 ? 4 : 1); /* the cap (four wedges: antipodal) */
         int snapped = snaps[t] > 0.0, found = 0;
         if (!snapped)
@@ -198,15 +205,7 @@ static void test_graded_partition(void **state)
         pp_dirs_spec spec = {.antipodal = t == 3, .mu_snap = snaps[t], .h_pole = hs[t]};
         assert_int_equal(pp_dirs_make_spec(n, &spec, &d, &err), 0);
         assert_true(d.polar);
-        double total = 0.0, lo, hi;
-        for (int i = 0; i < 2 * n; i++) {
-            double area = probed_area(&d, i, &lo, &hi);
-            if (fabs(area - d.area[i % n]) > 1e-11)
-                fail_msg("N = %d, h %g, cell %d: probed area %.15g, stored %.15g", n, hs[t], i,
-                         area, d.area[i % n]);
-            total += area;
-        }
-        assert_close(total, 4 * PI, 1e-10);
+        assert_probed_areas(&d, "graded");
         assert_int_equal(d.ring_first[1], t == 3 ? 4 : 1);
         assert_close(acos(d.mu_edge[1]), hs[t] / sqrt(PI), 1e-12);
         double side = sqrt(2.0 * PI / n), prev = 0.0;
