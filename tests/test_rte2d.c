@@ -206,6 +206,7 @@ static void slab_matches_ppslab(double n)
         cfg.pp.directions = cfg.rte2d.directions = 48;
         cfg.rte2d.spacing = cfg.rte2d.step = 0.02;
         cfg.rte2d.delta_m = 0; /* the same discrete-ordinates system as ppslab's */
+        cfg.rte2d.moment = PPB_RTE_MOMENT_OFF;
         ppb_result a, b;
         ppb_rte2d_stats st;
         run(&cfg, "rte2d", &a, &st);

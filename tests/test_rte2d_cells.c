@@ -6,11 +6,14 @@
  *   square cell's side sqrt(2 pi / N), g* the retained function's first moment (delta-M's
  *   (g - f) / (1 - f), f = g^sqrt(2N)); none at oblique light or where the peak is resolved.
  * Of the study's cases only realistic_g09_normal_n14 gets the rings (1 - g* = 0.123 against a
- * side of 0.222 at 128 cells). The grids are then built and their partitions checked. */
+ * side of 0.222 at 128 cells). The grids are then built and their partitions checked, and
+ * where the default first-moment correction applies (g* > 0 on near-square cells: the
+ * uniform g = 0.5 cases and realistic_g08_step_oblique_n14). */
 #include "testutil.h"
 #include "study_cases.h"
 
 #include "methods/rte2d/rte2d_grid.h"
+#include "model/config.h"
 
 /* The scaled scene and retained function rte2d solves cfg's case with (method_rte2d.c). */
 static pp_phase_fn retained(const ppb_config *cfg, ppb_scene *scaled)
@@ -52,6 +55,10 @@ static void test_study_cases(void **state)
         if (ppb_rte_grid_make(&sc, 0.5, N, 0.5, 0, &ph, &G, &err))
             fail_msg("%s: %s", names[c], err.msg);
         assert_int_equal(G.dirs.polar, want);
+        /* the first-moment correction by default: g* > 0 on the near-square cells */
+        assert_int_equal(ppb_rte_moment_applies(PPB_RTE_MOMENT_AUTO, sc.g, &G.dirs),
+                         sc.g > 0.0 && !want);
+        assert_true(G.moment_b == 0.0); /* built with moment off */
         ppb_rte_grid_free(&G);
     }
     assert_int_equal(graded, 1);

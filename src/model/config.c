@@ -57,6 +57,10 @@ static const enum_name channel_names[] = {
 static const enum_name delta_m_names[] = {
     {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 static const enum_name on_off_names[] = {{0, "off"}, {1, "on"}, {0, NULL}};
+static const enum_name rte_moment_names[] = {{PPB_RTE_MOMENT_OFF, "off"},
+                                             {PPB_RTE_MOMENT_ON, "on"},
+                                             {PPB_RTE_MOMENT_AUTO, "auto"},
+                                             {0, NULL}};
 static const enum_name rte_delta_m_names[] = {{PPB_RTE_DELTA_M_OFF, "off"},
                                               {PPB_RTE_DELTA_M_HG, "on"},
                                               {PPB_RTE_DELTA_M_LEGENDRE, "legendre"},
@@ -204,9 +208,9 @@ static const key_def keys[] = {
     {"rte2d", "delta_m_order", K_INT, PPB_NOT_MC_KEY, F(rte2d.delta_m_order), 0, 64, "0", NULL,
      "rte2d: delta-M's truncation order L (f = g^L; legendre: the series' length); 0 = "
      "sqrt(2 directions)"},
-    {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "off", on_off_names,
-     "rte2d: the direction cells' phase matrix corrected to HG's mean cosine g where delta-M "
-     "truncates nothing"},
+    {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "auto", rte_moment_names,
+     "rte2d: the direction cells' phase matrix corrected to the mean cosine of the function "
+     "they carry; auto = where g > 0 on the near-square cells (not the graded polar rings)"},
     {"rte2d", "ims", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.ims), 0, 0, "on", on_off_names,
      "rte2d: under delta-M, the exit radiance corrected for the light scattered only within the "
      "truncated peak (Nakajima and Tanaka's IMS, every order in the small-angle limit)"},

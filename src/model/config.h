@@ -90,6 +90,13 @@ typedef enum {
     PPB_RTE_DELTA_M_LEGENDRE = 2
 } ppb_rte_delta_m_kind;
 
+/* [rte2d] moment: the cells' first-moment correction off, on, or where g > 0 (auto). */
+typedef enum {
+    PPB_RTE_MOMENT_OFF = 0,
+    PPB_RTE_MOMENT_ON = 1,
+    PPB_RTE_MOMENT_AUTO = 2
+} ppb_rte_moment;
+
 typedef struct ppb_rte2d_settings {
     double spacing;    /* grid node spacing over the cross-section, mfp */
     int directions;    /* direction cells per hemisphere */
@@ -98,7 +105,7 @@ typedef struct ppb_rte2d_settings {
     int refinements;   /* K: stop after K steps of Eq. 5 from I_pp; 0 = converge */
     int delta_m;       /* PPB_RTE_DELTA_M_*: delta-M with the single-scattering correction (TMS) */
     int delta_m_order; /* delta-M's truncation order L (f = g^L); 0 = sqrt(2 directions) */
-    int moment;        /* 1: the cells' phase matrix corrected to HG's first moment */
+    int moment;        /* PPB_RTE_MOMENT_*: the cells' phase matrix corrected to HG's g */
     int ims;           /* 1: delta-M's intensity correction of the exit (Nakajima-Tanaka IMS) */
 } ppb_rte2d_settings;
 

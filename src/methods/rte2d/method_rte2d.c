@@ -847,14 +847,8 @@ static int rte2d_solve(ppb_run_ctx *ctx, const ppb_config *cfg, const pp_phase_f
     rte_solver s;
     rte_exit ex = {0, 0, 0, NULL, NULL, NULL, {0, NULL, NULL}};
     ppb_gmres_basis kb = {0, 0.0, NULL, NULL};
-    /* The first-moment correction (ppb_rte_moment_fix, rte2d_grid.h) where the peak the cells
-     * cannot resolve, delta-M's f = g^L of the solved medium (ppb_rte_delta_m), is under 1e-3 (g
-     * below 0.65 at 128 cells, whether delta-M is on or off): with a truncated peak (the realistic
-     * g = 0.9 and 0.8 cases) it moved S1 and the walls away from the Monte Carlo (reference:
-     * Methods, `rte2d`). */
-    double g = cfg->scene.g;
-    int moment =
-        cfg->rte2d.moment && !(g > 0.0 && pow(g, sqrt(2.0 * cfg->rte2d.directions)) >= 1e-3);
+    /* The first-moment correction: `[rte2d] moment`, decided with the cells (ppb_rte_grid_make). */
+    int moment = cfg->rte2d.moment;
     int rc0 = solver_init(&s, ocl, cfg, moment, ph, planes, lo->ncells, err);
     if (!rc0 && cfg->rte2d.ims && st.delta_f > 0.0) {
         s.ims_g = g_ss;

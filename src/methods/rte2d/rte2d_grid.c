@@ -1,5 +1,6 @@
 /* rte2d_grid.c: grid, folded cells, scattering, I_pp and absorption of `rte2d` (rte2d_grid.h). */
 #include "methods/rte2d/rte2d_grid.h"
+#include "model/config.h"
 
 #include <cblas.h>
 #include <math.h>
@@ -400,6 +401,11 @@ int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, pp
  * b = (g - gd) / (1 - gd) or (gd - g) / (1 + gd): rows and columns still sum to 1, the
  * symmetries stay, and the mean cosine is g. b A is light scattered into its own cell (or its
  * antipode), as a delta-M truncation counts light unscattered. Returns b (0: nothing done). */
+int ppb_rte_moment_applies(int mode, double g, const pp_dirs *d)
+{
+    return mode == PPB_RTE_MOMENT_ON || (mode == PPB_RTE_MOMENT_AUTO && g > 0.0 && !d->polar);
+}
+
 double ppb_rte_moment_fix(const pp_dirs *d, double g, double *P)
 {
     int m = 2 * d->n;
@@ -572,7 +578,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
         rc = pp_phase_matrix_fn(&G->dirs, &G->phase, Pfull, &G->clipped, err);
     if (!rc)
         rc = pp_phase_row_fn(&G->dirs, &G->phase, wl, F, NULL, err);
-    if (!rc && moment)
+    if (!rc && ppb_rte_moment_applies(moment, sc->g, &G->dirs))
         G->moment_b = ppb_rte_moment_fix(&G->dirs, sc->g, Pfull);
     if (!rc) {
         for (int a = 0; a < G->nc; a++) {
