@@ -2,7 +2,9 @@
  * cross-section, the direction cells it transports, the scattering that turns the cells' radiance
  * into the grid source, the starting field I_pp, and the energy the medium absorbs.
  *
- * Angles: the direction cells of the plane-parallel solver (directions.h, N per hemisphere) and
+ * Angles: the direction cells of the plane-parallel solver (directions.h, N per hemisphere; in
+ * the tube at n > 1 without the split beside the critical angle, and graded polar rings round
+ * the normal for a forward peak narrower than a cell: ppb_rte_partition) and
  * their cell-averaged HG phase matrix (phase.h, rows summing to 1, so scattering conserves
  * energy exactly and the slab limit is ppslab's own discrete-ordinates system). Why cells and not
  * Legendre moments: they are what ppslab and pp already use (slab mode then differs from
