@@ -7,8 +7,8 @@
  *   (g - f) / (1 - f), f = g^sqrt(2N)); none at oblique light or where the peak is resolved.
  * Of the study's cases only realistic_g09_normal_n14 gets the rings (1 - g* = 0.123 against a
  * side of 0.222 at 128 cells). The grids are then built and their partitions checked, and
- * where the default first-moment correction applies (g* > 0 on near-square cells: the
- * uniform g = 0.5 cases and realistic_g08_step_oblique_n14). */
+ * where the default first-moment correction applies (in the tube, g* > 0 on near-square
+ * cells: the uniform g = 0.5 cases and realistic_g08_step_oblique_n14; not in the slab). */
 #include "testutil.h"
 #include "study_cases.h"
 
@@ -56,8 +56,8 @@ static void test_study_cases(void **state)
             fail_msg("%s: %s", names[c], err.msg);
         assert_int_equal(G.dirs.polar, want);
         /* the first-moment correction by default: g* > 0 on the near-square cells */
-        assert_int_equal(ppb_rte_moment_applies(PPB_RTE_MOMENT_AUTO, sc.g, &G.dirs),
-                         sc.g > 0.0 && !want);
+        assert_int_equal(ppb_rte_moment_applies(PPB_RTE_MOMENT_AUTO, &sc, &G.dirs),
+                         sc.g > 0.0 && !want && tube);
         assert_true(G.moment_b == 0.0); /* built with moment off */
         ppb_rte_grid_free(&G);
     }
@@ -82,6 +82,15 @@ static void test_oblique_and_slab(void **state)
     spec = ppb_rte_partition(&sc, &ph, cfg.rte2d.directions);
     assert_int_equal(spec.whole_snap, 0);
     assert_true(spec.h_pole > 0.0);
+    /* the slab's near-square cells get no first-moment correction by default */
+    pp_dirs d;
+    ppb_err err;
+    if (pp_dirs_make(cfg.rte2d.directions, &d, &err))
+        fail_msg("%s", err.msg);
+    assert_false(ppb_rte_moment_applies(PPB_RTE_MOMENT_AUTO, &sc, &d));
+    sc.geometry = PPB_GEOM_TUBE;
+    assert_true(ppb_rte_moment_applies(PPB_RTE_MOMENT_AUTO, &sc, &d));
+    pp_dirs_free(&d);
 }
 
 int main(void)

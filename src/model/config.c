@@ -210,7 +210,7 @@ static const key_def keys[] = {
      "sqrt(2 directions)"},
     {"rte2d", "moment", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.moment), 0, 0, "auto", rte_moment_names,
      "rte2d: the direction cells' phase matrix corrected to the mean cosine of the function "
-     "they carry; auto = where g > 0 on the near-square cells (not the graded polar rings)"},
+     "they carry; auto = in the tube where g > 0 on the near-square cells"},
     {"rte2d", "ims", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.ims), 0, 0, "on", on_off_names,
      "rte2d: under delta-M, the exit radiance corrected for the light scattered only within the "
      "truncated peak (Nakajima and Tanaka's IMS, every order in the small-angle limit)"},

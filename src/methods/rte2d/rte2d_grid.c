@@ -401,9 +401,10 @@ int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, pp
  * b = (g - gd) / (1 - gd) or (gd - g) / (1 + gd): rows and columns still sum to 1, the
  * symmetries stay, and the mean cosine is g. b A is light scattered into its own cell (or its
  * antipode), as a delta-M truncation counts light unscattered. Returns b (0: nothing done). */
-int ppb_rte_moment_applies(int mode, double g, const pp_dirs *d)
+int ppb_rte_moment_applies(int mode, const ppb_scene *sc, const pp_dirs *d)
 {
-    return mode == PPB_RTE_MOMENT_ON || (mode == PPB_RTE_MOMENT_AUTO && g > 0.0 && !d->polar);
+    return mode == PPB_RTE_MOMENT_ON || (mode == PPB_RTE_MOMENT_AUTO && sc->g > 0.0 && !d->polar &&
+                                         sc->geometry == PPB_GEOM_TUBE);
 }
 
 double ppb_rte_moment_fix(const pp_dirs *d, double g, double *P)
@@ -578,7 +579,7 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
         rc = pp_phase_matrix_fn(&G->dirs, &G->phase, Pfull, &G->clipped, err);
     if (!rc)
         rc = pp_phase_row_fn(&G->dirs, &G->phase, wl, F, NULL, err);
-    if (!rc && ppb_rte_moment_applies(moment, sc->g, &G->dirs))
+    if (!rc && ppb_rte_moment_applies(moment, sc, &G->dirs))
         G->moment_b = ppb_rte_moment_fix(&G->dirs, sc->g, Pfull);
     if (!rc) {
         for (int a = 0; a < G->nc; a++) {

@@ -119,13 +119,15 @@ double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_pha
  * `[rte2d] moment` (reference: Methods, `rte2d`). */
 double ppb_rte_moment_fix(const pp_dirs *d, double g, double *P);
 
-/* Whether the grid's matrix gets that correction (`[rte2d] moment`, PPB_RTE_MOMENT_*, of the
- * solved medium's g, on the cells d): always (on), never (off), or (auto) where g > 0 on the
- * near-square cells. Its measure, the mean cosine between the cells' unit centres, is the
- * transport's there; on the polar rings' long cells the centre lies far from the cell's mean
- * direction, and on realistic_g09 it took S1 from 1.5 % high to 1.8 % low (reference: Methods,
+/* Whether the grid's matrix gets that correction (`[rte2d] moment`, PPB_RTE_MOMENT_*, for the
+ * solved medium sc, on the cells d): always (on), never (off), or (auto) in the tube where
+ * g > 0 on the near-square cells. Its measure, the mean cosine between the cells' unit
+ * centres, is the transport's there, where light spreads in x and y; in the slab only mu
+ * transports (ppslab's diffusion match is the measure there: on a g 0.9 slab it took R from
+ * 1.8 % high to 6.2 % low), and on the polar rings' long cells the centre lies far from the
+ * cell's mean direction (realistic_g09's S1 from 1.5 % high to 1.8 % low; reference: Methods,
  * `rte2d`). At g < 0 the antipodal mix made every measured case worse. */
-int ppb_rte_moment_applies(int mode, double g, const pp_dirs *d);
+int ppb_rte_moment_applies(int mode, const ppb_scene *sc, const pp_dirs *d);
 
 /* The direction cells of a grid (reference: Methods, `rte2d`, the cells): at n > 1 a ring edge
  * at the critical cosine, in the tube without the split of the rings beside it (directions.h);
