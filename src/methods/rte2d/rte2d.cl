@@ -124,7 +124,7 @@ inline double rte_ray_side(const ppb_rte_params *P, __global const double *plane
         double xm = px + 0.5 * (la + lb) * mx, ym = py + 0.5 * (la + lb) * my, sigma_t, alpha;
         ppb_piece_medium(&P->med, px, mx, la, lb, &sigma_t, &alpha);
         double sum = 0.0;
-        if (P->beam && P->med.n > 1.0 && P->med.tube && P->tan_theta_l > 0.0) {
+        if (P->beam && ppb_rte_beam_images(P)) {
             sum += rte_beam_images(P, cb, px, py, mx, my, la, lb, sigma_t, d);
         } else if (P->beam && C != 0.0) {
             double Dm, Da, Db;

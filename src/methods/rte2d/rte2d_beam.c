@@ -337,7 +337,7 @@ void ppb_rte_beam_rect(const ppb_rte_params *P, double x0, double x1, double y0,
         out[0] = sigma_t * term_integral(P, &t, &rect);
         return;
     }
-    if (P->med.tube && P->tan_theta_l > 0.0) {
+    if (ppb_rte_beam_images(P)) {
         sum_images(P, sigma_t, &rect, out);
         return;
     }

@@ -401,12 +401,6 @@ int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, pp
  * b = (g - gd) / (1 - gd) or (gd - g) / (1 + gd): rows and columns still sum to 1, the
  * symmetries stay, and the mean cosine is g. b A is light scattered into its own cell (or its
  * antipode), as a delta-M truncation counts light unscattered. Returns b (0: nothing done). */
-int ppb_rte_moment_applies(int mode, const ppb_scene *sc, const pp_dirs *d)
-{
-    return mode == PPB_RTE_MOMENT_ON || (mode == PPB_RTE_MOMENT_AUTO && sc->g > 0.0 && !d->polar &&
-                                         sc->geometry == PPB_GEOM_TUBE);
-}
-
 double ppb_rte_moment_fix(const pp_dirs *d, double g, double *P)
 {
     int m = 2 * d->n;
@@ -488,6 +482,12 @@ double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_pha
     ph->chi[0] = 1.0;
     out->g = ph->chi[1];
     return f;
+}
+
+int ppb_rte_moment_applies(int mode, const ppb_scene *sc, const pp_dirs *d)
+{
+    return mode == PPB_RTE_MOMENT_ON || (mode == PPB_RTE_MOMENT_AUTO && sc->g > 0.0 && !d->polar &&
+                                         sc->geometry == PPB_GEOM_TUBE);
 }
 
 pp_dirs_spec ppb_rte_partition(const ppb_scene *sc, const pp_phase_fn *ph, int directions)

@@ -38,9 +38,9 @@ static int series_terms(double xmax)
 }
 
 /* The beam's passes at a node: unscaled optical path s[p] from S1 and amplitude amp[p] (the
- * irradiance, 0 where unlit). Returns the passes used (rte2d_ims.h). */
-static int node_passes(const ppb_rte_params *P, double a, int reflect, double x, double y,
-                       double *s, double *amp)
+ * irradiance, 0 where unlit, or where the scaled beam e^-(1 - a) s is below IMS_EXP_FLOOR). */
+static void node_passes(const ppb_rte_params *P, double a, int reflect, double x, double y,
+                        double *s, double *amp)
 {
     double D, DH = 0.0;
     int lit, litH;
@@ -52,11 +52,29 @@ static int node_passes(const ppb_rte_params *P, double a, int reflect, double x,
     }
     s[0] = D / (1.0 - a);
     amp[0] = lit ? e0 : 0.0;
-    if (!reflect)
-        return 1;
     s[1] = (2.0 * DH - D) / (1.0 - a);
-    amp[1] = lit ? e0 * P->beam_fb : 0.0;
-    return 2;
+    amp[1] = lit && reflect ? e0 * P->beam_fb : 0.0;
+    for (int p = 0; p < 2; p++)
+        if (!(exp(-(1.0 - a) * s[p]) > IMS_EXP_FLOOR))
+            amp[p] = 0.0;
+}
+
+/* Every node's passes, [nnodes][4] = s0, amp0, s1, amp1; *xmax the largest x = a s a pass with
+ * light reaches. */
+static void all_passes(const ppb_rte_grid *G, double a, int reflect, double *paths, double *xmax)
+{
+    const ppb_rte_params *P = &G->P;
+    *xmax = 0.0;
+    for (int j = 0; j < P->ny; j++)
+        for (int i = 0; i < P->nx; i++) {
+            double *q = paths + 4 * (size_t)(j * P->nx + i), s[2], amp[2];
+            node_passes(P, a, reflect, ppb_rte_node_x(P, i), ppb_rte_node_y(P, j), s, amp);
+            for (int p = 0; p < 2; p++) {
+                q[2 * p] = s[p], q[2 * p + 1] = amp[p];
+                if (amp[p] > 0.0)
+                    *xmax = fmax(*xmax, a * s[p]);
+            }
+        }
 }
 
 /* B [m][nnodes], per unit scattering coefficient (the march multiplies by sigma_s'; sigma_s' =
@@ -64,51 +82,29 @@ static int node_passes(const ppb_rte_params *P, double a, int reflect, double x,
  * (x^k / k!) e^-s amp f / (1 - f); block 2 (the reflection), the down pass's peak light at S2,
  * amp e^-s_H (x_H^k / k!), spread along the up pass as e^-(1 - a)(s - s_H) / s_H so that it
  * reaches S1 as that light attenuated over the pass (rte2d_ims.h). */
-static void depth_factors(const ppb_rte_grid *G, double albedo, double f, int reflect, int K,
+static void depth_factors(const double *paths, int nn, double albedo, double f, int reflect, int K,
                           double *B)
 {
-    const ppb_rte_params *P = &G->P;
     double a = f * albedo;
-    int nn = G->nnodes, npass = reflect ? 2 : 1;
-    for (int j = 0; j < P->ny; j++)
-        for (int i = 0; i < P->nx; i++) {
-            int node = j * P->nx + i;
-            double s[2], amp[2];
-            node_passes(P, a, reflect, ppb_rte_node_x(P, i), ppb_rte_node_y(P, j), s, amp);
-            for (int p = 0; p < npass; p++) {
-                double x = a * s[p], live = exp(-(1.0 - a) * s[p]) > IMS_EXP_FLOOR;
-                double t = amp[p] * f / (1.0 - f) * exp(-s[p]);
-                for (int k = 1; k <= K; k++) {
-                    t *= x / k;
-                    B[(size_t)(p * K + k - 1) * nn + node] = live ? t : 0.0;
-                }
-            }
-            if (!reflect)
-                continue;
-            double sH = 0.5 * (s[0] + s[1]), xH = a * sH; /* S2: s[1] = 2 s_H - s[0] */
-            double t = amp[1] * exp(-sH - (1.0 - a) * (s[1] - sH)) / (sH * albedo * (1.0 - f));
-            int live = exp(-(1.0 - a) * s[1]) > IMS_EXP_FLOOR;
+    int npass = reflect ? 2 : 1;
+    for (int node = 0; node < nn; node++) {
+        const double *q = paths + 4 * (size_t)node;
+        for (int p = 0; p < npass; p++) {
+            double s = q[2 * p], x = a * s, t = q[2 * p + 1] * f / (1.0 - f) * exp(-s);
             for (int k = 1; k <= K; k++) {
-                t *= xH / k;
-                B[(size_t)(2 * K + k - 1) * nn + node] = live ? t : 0.0;
+                t *= x / k;
+                B[(size_t)(p * K + k - 1) * nn + node] = t;
             }
         }
-}
-
-/* The largest x a node reaches, over the passes. */
-static double max_x(const ppb_rte_grid *G, double a, int reflect)
-{
-    const ppb_rte_params *P = &G->P;
-    double xmax = 0.0;
-    for (int j = 0; j < P->ny; j++)
-        for (int i = 0; i < P->nx; i++) {
-            double s[2], amp[2];
-            int np = node_passes(P, a, reflect, ppb_rte_node_x(P, i), ppb_rte_node_y(P, j), s, amp);
-            for (int p = 0; p < np; p++)
-                if (exp(-(1.0 - a) * s[p]) > IMS_EXP_FLOOR)
-                    xmax = fmax(xmax, a * s[p]);
+        if (!reflect)
+            continue;
+        double sH = 0.5 * (q[0] + q[2]), xH = a * sH; /* S2: s1 = 2 s_H - s0 */
+        double t = q[3] * exp(-sH - (1.0 - a) * (q[2] - sH)) / (sH * albedo * (1.0 - f));
+        for (int k = 1; k <= K; k++) {
+            t *= xH / k;
+            B[(size_t)(2 * K + k - 1) * nn + node] = t;
         }
-    return xmax;
+    }
 }
 
 /* A's row of one exit direction w: for each block (its beam direction b and its coefficient
@@ -140,8 +136,12 @@ int ppb_rte_ims_make(const ppb_rte_grid *G, double g, double albedo, double f, c
         return 0;
     const ppb_rte_params *P = &G->P;
     double a = f * albedo;
-    int reflect = P->med.n > 1.0 && !(P->med.tube && P->tan_theta_l > 0.0);
-    int K = series_terms(max_x(G, a, reflect));
+    int reflect = P->med.n > 1.0 && !ppb_rte_beam_images(P), nn = G->nnodes;
+    double *paths = malloc(sizeof(double) * 4 * (size_t)nn), xmax;
+    if (!paths)
+        return ppb_fail(err, "rte2d: out of memory (the intensity correction)");
+    all_passes(G, a, reflect, paths, &xmax);
+    int K = series_terms(xmax);
     /* The residual's moments count while (2l + 1) g^l / f does (and through the retained
      * series' length). */
     int L = G->phase.nmom;
@@ -155,6 +155,7 @@ int ppb_rte_ims_make(const ppb_rte_grid *G, double g, double albedo, double f, c
     if (reflect)
         cp = malloc(sizeof(double) * (size_t)(L + 1) * K);
     if (!m->A || !m->B || !c || (reflect && !cp)) {
+        free(paths);
         free(c);
         free(cp);
         ppb_rte_ims_free(m);
@@ -176,7 +177,8 @@ int ppb_rte_ims_make(const ppb_rte_grid *G, double g, double albedo, double f, c
                           {P->sin_theta_l, P->cos_theta_l, 0.0}};
     for (int d = 0; d < ndir; d++)
         angular_row(tables, L, K, nblock, w + 3 * d, beams, m->A + (size_t)d * m->m);
-    depth_factors(G, albedo, f, reflect, K, m->B);
+    depth_factors(paths, nn, albedo, f, reflect, K, m->B);
+    free(paths);
     free(c);
     free(cp);
     return 0;

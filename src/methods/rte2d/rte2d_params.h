@@ -228,6 +228,14 @@ PPB_RTE_HOT double ppb_rte_lookup(const ppb_rte_params *P, const PPB_RTE_GMEM do
     return top + ty * (bot - top);
 }
 
+/* Whether the refracted beam (n > 1) meets the side walls: in the tube at oblique light, where
+ * it is unfolded over the cross-section's mirror images (ppb_beam_images.h); elsewhere it stays
+ * in its column, with only its S2 -> S1 round trips (the slab, or the tube at normal light). */
+PPB_FN int ppb_rte_beam_images(const ppb_rte_params *P)
+{
+    return P->med.n > 1.0 && P->med.tube && P->tan_theta_l > 0.0;
+}
+
 /* The exact direct beam at (x, y), y <= 0 (reference: Light): the ray toward the light meets
  * S1's plane at x' = x + y tan(theta_L); the point is lit when x' lies on S1's lit part
  * (ppb_lit_at: >= -W/2, left of a shadow step, or in a searchlight's strip). D = optical depth
