@@ -96,7 +96,7 @@ $(BUILD)/tests/%: tests/%.c $(LIB) tests/testutil.h tests/profileutil.h | $(BUIL
 # the Monte Carlo, Chandrasekhar's H-function, the multipole's closed forms), the robustness
 # grid with its thin, grazing, n = 2.5 corner, and the newcomer's path from a fresh clone.
 LONG_TESTS := $(patsubst %,$(BUILD)/tests/%,test_fresnel test_deltam test_rte2d test_rte2d_beam \
-                test_burley test_dirpole test_multipole test_robust test_pbd)
+                test_rte2d_ls test_burley test_dirpole test_multipole test_robust test_pbd)
 UNIT_TESTS := $(filter-out $(LONG_TESTS),$(TESTS))
 run-suites = @mkdir -p $(BUILD)/tmp; fail=0; for t in $(1); do \
 	  echo "== $$t"; PPBENCH=$(CURDIR)/$(BIN) PPB_VERSION_FILE=$(CURDIR)/$(BUILD)/version.txt \

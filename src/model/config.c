@@ -57,6 +57,8 @@ static const enum_name channel_names[] = {
 static const enum_name delta_m_names[] = {
     {PPB_DELTA_M_OFF, "off"}, {PPB_DELTA_M_ON, "on"}, {PPB_DELTA_M_AUTO, "auto"}, {0, NULL}};
 static const enum_name on_off_names[] = {{0, "off"}, {1, "on"}, {0, NULL}};
+static const enum_name rte_source_names[] = {
+    {PPB_RTE_SOURCE_FLAT, "flat"}, {PPB_RTE_SOURCE_LINEAR, "linear"}, {0, NULL}};
 static const enum_name rte_moment_names[] = {{PPB_RTE_MOMENT_OFF, "off"},
                                              {PPB_RTE_MOMENT_ON, "on"},
                                              {PPB_RTE_MOMENT_AUTO, "auto"},
@@ -214,6 +216,9 @@ static const key_def keys[] = {
     {"rte2d", "ims", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.ims), 0, 0, "on", on_off_names,
      "rte2d: under delta-M, the exit radiance corrected for the light scattered only within the "
      "truncated peak (Nakajima and Tanaka's IMS, every order in the small-angle limit)"},
+    {"rte2d", "source", K_ENUM, PPB_NOT_MC_KEY, F(rte2d.source), 0, 0, "flat", rte_source_names,
+     "rte2d: the scattered light's emission in each region of the sweep, flat or linear in x and "
+     "y (the tube; the slab stays flat, ppslab's system)"},
     /* [object]: `ppbench object` only (docs/reference.md, Objects); the tube's Monte Carlo
      * never reads them, so none is part of its reference cache's key. */
     {"object", "shape", K_ENUM, PPB_NOT_MC_KEY, F(object.shape), 0, 0, "box", shape_names,

@@ -97,6 +97,9 @@ typedef enum {
     PPB_RTE_MOMENT_AUTO = 2
 } ppb_rte_moment;
 
+/* [rte2d] source: the emission in each of the sweep's regions flat, or linear in x and y. */
+typedef enum { PPB_RTE_SOURCE_FLAT = 0, PPB_RTE_SOURCE_LINEAR = 1 } ppb_rte_source;
+
 typedef struct ppb_rte2d_settings {
     double spacing;    /* grid node spacing over the cross-section, mfp */
     int directions;    /* direction cells per hemisphere */
@@ -107,6 +110,7 @@ typedef struct ppb_rte2d_settings {
     int delta_m_order; /* delta-M's truncation order L (f = g^L); 0 = sqrt(2 directions) */
     int moment;        /* PPB_RTE_MOMENT_*: the cells' phase matrix corrected to HG's g */
     int ims;           /* 1: delta-M's intensity correction of the exit (Nakajima-Tanaka IMS) */
+    int source;        /* ppb_rte_source: the sweep's emission in each region */
 } ppb_rte2d_settings;
 
 /* A three-dimensional object's settings ([object]; docs/reference.md, Objects). Material 1 is

@@ -21,7 +21,7 @@
 #include "methods/rte2d/rte2d_ims.h"
 
 _Static_assert(sizeof(ppb_rte_params) ==
-                   sizeof(ppb_medium) + sizeof(ppb_lit) + 15 * sizeof(double) + 22 * sizeof(int),
+                   sizeof(ppb_medium) + sizeof(ppb_lit) + 15 * sizeof(double) + 24 * sizeof(int),
                "ppb_rte_params: the medium, doubles, an even number of ints, no padding");
 
 /* Krylov vectors per GMRES cycle. */
@@ -44,9 +44,11 @@ typedef struct rte_solver {
     cl_kernel moc, exitk;
     /* The sweep's buffers (rte2d_params.h, PPB_MOC_ARG_*) and the exit march's. */
     cl_mem dirs, edges, sig, q, bin, xo, scr; /* xo: the sweep's result, the unknown's layout */
+    cl_mem qg, lsc;                           /* linear source: gradients, the tracks' sums */
     cl_mem src, out, radb, bnd; /* exit: sources, radiance, n > 1: node field and walls */
     size_t nvec;                /* the unknown: nc (nf + nb) (rte2d_grid.h) */
     double *Q, *Qb, *J, *B;     /* [nc][nf] emission, beam emission, scatter; [nc][nb] inflow */
+    double *Qg, *Qbg, *Jg;      /* linear source: their gradients [nc][nf][2] */
     double *rn;                 /* [nc][nnodes]: a field at the nodes, for the exit march */
     double absorbed_beam;       /* the beam's collisions times 1 - alpha (ppb_rte_beam_sources) */
     int sweeps;
@@ -58,8 +60,8 @@ typedef struct rte_solver {
 
 static void solver_free(rte_solver *s)
 {
-    cl_mem bufs[] = {s->dirs, s->edges, s->sig, s->q,    s->bin, s->xo,
-                     s->scr,  s->src,   s->out, s->radb, s->bnd};
+    cl_mem bufs[] = {s->dirs, s->edges, s->sig,  s->q,   s->bin, s->xo, s->scr,
+                     s->src,  s->out,   s->radb, s->bnd, s->qg,  s->lsc};
     for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; i++)
         if (bufs[i])
             clReleaseMemObject(bufs[i]);
@@ -74,6 +76,9 @@ static void solver_free(rte_solver *s)
     free(s->J);
     free(s->B);
     free(s->rn);
+    free(s->Qg);
+    free(s->Qbg);
+    free(s->Jg);
     ppb_rte_grid_free(&s->G);
     memset(s, 0, sizeof *s);
 }
@@ -152,10 +157,13 @@ static int sweep(rte_solver *s, const double *x, int beam, double *y, ppb_err *e
     P.refl = P.refl && x != NULL;
     size_t nq = (size_t)G->nc * G->nf, nb = (size_t)G->nc * G->nb;
     if (x)
-        ppb_rte_scatter(G, x, s->J);
+        ppb_rte_scatter(G, x, s->J, P.ls ? s->Jg : NULL);
     for (size_t i = 0; i < nq; i++) {
         double al_st = G->falb[(i % G->nf) % G->nfx] * G->fsig[(i % G->nf) % G->nfx];
         s->Q[i] = (x ? al_st * s->J[i] : 0.0) + (beam ? s->Qb[i] : 0.0);
+        for (int d = 0; P.ls && d < 2; d++)
+            s->Qg[2 * i + d] =
+                (x ? al_st * s->Jg[2 * i + d] : 0.0) + (beam ? s->Qbg[2 * i + d] : 0.0);
     }
     if (P.refl)
         reflect_inflow(G, x, s->B);
@@ -166,17 +174,24 @@ static int sweep(rte_solver *s, const double *x, int beam, double *y, ppb_err *e
     int nfx = G->nfx;
     cl_double2 dmin = {{G->dmin[0], G->dmin[1]}};
     cl_mem args[] = {s->dirs, s->edges, s->sig, s->q, s->bin, s->xo, s->scr};
-    int rc = ppb_cl_check(clEnqueueWriteBuffer(qu, s->q, CL_TRUE, 0, nq * sizeof(double), s->Q, 0,
-                                               NULL, NULL),
-                          "clEnqueueWriteBuffer(rte2d source)", err) ||
-             ppb_cl_check(clEnqueueWriteBuffer(qu, s->bin, CL_TRUE, 0, nb * sizeof(double), s->B, 0,
-                                               NULL, NULL),
-                          "clEnqueueWriteBuffer(rte2d inflow)", err) ||
-             set_arg(s->moc, PPB_MOC_ARG_PARAMS, sizeof P, &P, err) ||
-             set_arg(s->moc, PPB_MOC_ARG_NFX, sizeof nfx, &nfx, err) ||
-             set_arg(s->moc, PPB_MOC_ARG_DMIN, sizeof dmin, &dmin, err);
+    cl_mem ls_args[] = {s->qg, s->lsc};
+    int rc =
+        ppb_cl_check(
+            clEnqueueWriteBuffer(qu, s->q, CL_TRUE, 0, nq * sizeof(double), s->Q, 0, NULL, NULL),
+            "clEnqueueWriteBuffer(rte2d source)", err) ||
+        ppb_cl_check(
+            clEnqueueWriteBuffer(qu, s->bin, CL_TRUE, 0, nb * sizeof(double), s->B, 0, NULL, NULL),
+            "clEnqueueWriteBuffer(rte2d inflow)", err) ||
+        (P.ls && ppb_cl_check(clEnqueueWriteBuffer(qu, s->qg, CL_TRUE, 0, 2 * nq * sizeof(double),
+                                                   s->Qg, 0, NULL, NULL),
+                              "clEnqueueWriteBuffer(rte2d source gradients)", err)) ||
+        set_arg(s->moc, PPB_MOC_ARG_PARAMS, sizeof P, &P, err) ||
+        set_arg(s->moc, PPB_MOC_ARG_NFX, sizeof nfx, &nfx, err) ||
+        set_arg(s->moc, PPB_MOC_ARG_DMIN, sizeof dmin, &dmin, err);
     for (cl_uint i = 0; !rc && i < sizeof args / sizeof args[0]; i++)
         rc = set_arg(s->moc, PPB_MOC_ARG_DIRS + i, sizeof(cl_mem), &args[i], err);
+    for (cl_uint i = 0; !rc && i < sizeof ls_args / sizeof ls_args[0]; i++)
+        rc = set_arg(s->moc, PPB_MOC_ARG_SRCG + i, sizeof(cl_mem), &ls_args[i], err);
     if (rc ||
         ppb_cl_check(clEnqueueNDRangeKernel(qu, s->moc, 1, NULL, &global, NULL, 0, NULL, NULL),
                      "clEnqueueNDRangeKernel(rte2d sweep)", err))
@@ -211,6 +226,7 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, int m
     ppb_rte_grid *G = &s->G;
     if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, moment, ph, G, err))
         return -1;
+    G->P.ls = r->source == PPB_RTE_SOURCE_LINEAR && G->P.med.tube;
     s->nvec = ppb_rte_nvec(G);
     size_t nq = (size_t)G->nc * G->nf, nb = (size_t)G->nc * G->nb;
     size_t nodes = (size_t)G->nc * G->nnodes;
@@ -220,9 +236,15 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, int m
     s->J = malloc(sizeof(double) * nq);
     s->B = malloc(sizeof(double) * nb);
     s->rn = malloc(sizeof(double) * nodes);
-    if (!s->Q || !s->Qb || !s->J || !s->B || !s->rn)
+    size_t nls = G->P.ls ? 2 * nq : 0;
+    if (nls) {
+        s->Qg = malloc(sizeof(double) * nls);
+        s->Qbg = malloc(sizeof(double) * nls);
+        s->Jg = malloc(sizeof(double) * nls);
+    }
+    if (!s->Q || !s->Qb || !s->J || !s->B || !s->rn || (nls && (!s->Qg || !s->Qbg || !s->Jg)))
         return ppb_fail(err, "rte2d: out of memory");
-    if (ppb_rte_beam_sources(G, s->Qb, &s->absorbed_beam, err) ||
+    if (ppb_rte_beam_sources(G, s->Qb, s->Qbg, &s->absorbed_beam, err) ||
         ppb_ocl_build(ocl, "src/methods/rte2d/rte2d.cl", "", &s->prog, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_moc", &s->moc, err) ||
         ppb_ocl_kernel(s->prog, "ppb_rte_exit", &s->exitk, err))
@@ -246,6 +268,8 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, int m
         {&s->out, CL_MEM_WRITE_ONLY, out_cells, NULL, "rte2d exit output"},
         {&s->radb, ro, G->bnd ? nodes : 0, NULL, "rte2d field"},
         {&s->bnd, ro, G->bnd ? PPB_RTE_BND * (size_t)G->nc : 0, G->bnd, "rte2d walls"},
+        {&s->qg, ro, nls ? nls : 1, NULL, "rte2d source gradients"},
+        {&s->lsc, rw, nls ? PPB_MOC_LS_ACC * nq : 1, NULL, "rte2d linear-source sums"},
     };
     for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
         if (!(*want[i].m = buffer(ocl, want[i].fl, want[i].n, want[i].host, want[i].what, err)))
@@ -396,8 +420,9 @@ static rte_sizes rte_sizes_of(const ppb_config *cfg, int study)
     z.source = 8.0 * z.planes * z.nodes;
     /* The field buffers: cells x regions and edges, the regions at most twice the nodes (a
      * column split at the step). */
-    z.largest = fmax(z.source, 8.0 * cells * 2.0 * z.nodes);
-    z.total = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, RTE_RESTART + 4 * study) +
+    int ls = r->source == PPB_RTE_SOURCE_LINEAR;
+    z.largest = fmax(z.source, 8.0 * cells * 2.0 * z.nodes * (ls ? PPB_MOC_LS_ACC : 1));
+    z.total = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, RTE_RESTART + 4 * study, ls) +
               2.0 * z.source + 8.0 * z.planes * cells + 16.0 * (double)lo.ncells;
     return z;
 }

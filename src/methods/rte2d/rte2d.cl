@@ -26,6 +26,7 @@
 #include "ppb_bin_samples.h"
 #include "ppb_fresnel.h"
 #include "ppb_sort.h"
+#include "rte2d_ls.h"
 #include "rte2d_params.h"
 
 /* exp(e_a) phi1(z) with e_b = e_a + z <= 0, in the scaled form where exp(e_a) underflows (as
@@ -295,7 +296,8 @@ inline double moc_segment(double psi, double q, double st, double tau, double L)
  * segment's s delta (psi_in - psi_out) to tal and the exit's s delta psi to bout. */
 inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, double uy, double s,
                       double delta, double vk, __global const double *sig, __global const double *Q,
-                      __global double *tal, __global double *bout, __global double *scr, int mode)
+                      __global const double *Qg, __global double *tal, __global double *bout,
+                      __global double *scr, __global double *acc, int mode)
 {
     double W = P->med.width, H = P->med.height, p0x = -uy * vk, p0y = ux * vk;
     /* Where the line crosses the lines of S3/S4 (tx) and S1/S2 (ty), ascending in t: it leaves
@@ -337,7 +339,17 @@ inline void moc_track(const ppb_rte_params *P, const moc_grid *g, double ux, dou
         double tn = fmin(fmin(tnx, tny), tout), l = tn - t;
         if (l > 0.0) {
             int f = j * g->nfx + i;
-            double st = sig[i], po = moc_segment(psi, Q[f], st, st * l / s, l / s);
+            double st = sig[i], po;
+            if (P->ls) {
+                /* The source at the entry and its slope per 3-D length along the segment. */
+                double dx = p0x + t * ux - 0.5 * (g->fx[i] + g->fx[i + 1]),
+                       dy = p0y + t * uy - 0.5 * (g->fy[j] + g->fy[j + 1]), i0, i1;
+                double b = Q[f] + Qg[2 * f] * dx + Qg[2 * f + 1] * dy,
+                       c = (Qg[2 * f] * ux + Qg[2 * f + 1] * uy) * s;
+                po = ppb_ls_segment(psi, b, c, st, st * l / s, l / s, &i0, &i1);
+                ppb_ls_add(acc + PPB_MOC_LS_ACC * f, w, delta, dx, dy, ux, uy, s, l, i0, i1);
+            } else
+                po = moc_segment(psi, Q[f], st, st * l / s, l / s);
             tal[f] += w * (psi - po);
             psi = po;
             t = tn;
@@ -411,7 +423,7 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
                           __global const double *edges, __global const double *sig,
                           __global const double *Q, __global const double *bin,
                           __global double *out, __global double *scr, const int nfx,
-                          const double2 dmin)
+                          const double2 dmin, __global const double *QG, __global double *lsc)
 {
     int c = (int)get_global_id(0);
     if (c >= P.ncell)
@@ -421,8 +433,14 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
     __global const double *q = Q + (long)c * nf, *bi = bin + (long)c * nb;
     /* The cell's slice of the unknown: its FSRs' radiance, then its edges' outgoing power. */
     __global double *tal = out + (long)c * (nf + nb), *bo = tal + nf, *sc = scr + (long)c * nb;
+    /* The linear source's slices: the emission's gradients, the tracks' sums, the fit. */
+    __global const double *qg = QG + (P.ls ? 2L * c * nf : 0L);
+    __global double *acc = lsc + (P.ls ? (long)PPB_MOC_LS_ACC * c * nf : 0L);
+    __global double *grad = out + (long)P.ncell * (nf + nb) + 2L * c * nf;
     for (int f = 0; f < nf; f++)
         tal[f] = 0.0;
+    for (long k = 0; P.ls && k < (long)PPB_MOC_LS_ACC * nf; k++)
+        acc[k] = 0.0;
     for (int e = 0; e < nb; e++)
         bo[e] = sc[e] = 0.0;
     double wx = dirs[4 * c], wy = dirs[4 * c + 1], s = sqrt(wx * wx + wy * wy);
@@ -440,19 +458,29 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
         delta = (vmax - vmin) / ntr;
         if (P.refl) {
             for (int k = 0; k < ntr; k++)
-                moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, tal, bo, sc,
-                          0);
+                moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, qg, tal, bo,
+                          sc, acc, 0);
             for (int face = PPB_S1; face <= PPB_S4; face++)
                 moc_inflow(bi, sc, ppb_moc_edge0(nfx, P.ny, face), ppb_moc_nedge(nfx, P.ny, face),
                            s * delta);
         }
         for (int k = 0; k < ntr; k++)
-            moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, tal, bo, sc, 1);
+            moc_track(&P, &g, ux, uy, s, delta, vmin + (k + 0.5) * delta, sig, q, qg, tal, bo, sc,
+                      acc, 1);
     }
     /* The balance form: sigma_t psi A = Q A + the tracks' net inflow. */
     for (int f = 0; f < nf; f++) {
         int i = f % nfx, j = f / nfx;
         double A = (g.fx[i + 1] - g.fx[i]) * (g.fy[j] - g.fy[j + 1]);
         tal[f] = (q[f] * A + tal[f]) / (sig[i] * A);
+        if (P.ls) {
+            /* A direction along z has no tracks: its field is z-invariant, psi = Q / sigma_t,
+             * gradient and all (the balance form's answer for the average). */
+            double gx = qg[2 * f] / sig[i], gy = qg[2 * f + 1] / sig[i];
+            if (s > 1e-12)
+                ppb_ls_fit(acc + PPB_MOC_LS_ACC * f, &gx, &gy);
+            grad[2 * f] = gx;
+            grad[2 * f + 1] = gy;
+        }
     }
 }

@@ -256,7 +256,7 @@ static int grid_fsr(ppb_rte_grid *G, ppb_err *err)
 
 size_t ppb_rte_nvec(const ppb_rte_grid *G)
 {
-    return (size_t)G->nc * (G->nf + G->nb);
+    return (size_t)G->nc * (G->nf + G->nb + (G->P.ls ? 2 * G->nf : 0));
 }
 
 /* A face node's value from its region's average v1 (centroid d1 from the face) and the next
@@ -279,6 +279,27 @@ static double node_width(const ppb_rte_grid *G, int i)
             k1 = k;
         }
     return fx[k1 + 1] - fx[k0];
+}
+
+/* The linear source (P.ls): node (column fcol[k], row j)'s value from its FSRs k .. m - 1 of
+ * row j, each its linear fit psi + a . (node - centre) (the gradients after the averages in x,
+ * rte2d_grid.h), area-weighted; second order wherever the node sits in its dual cell, the faces'
+ * half cells and the graded rows included; not below 0. */
+static double ls_node(const ppb_rte_grid *G, const double *x, int a, int j, int k, int m)
+{
+    const ppb_rte_params *P = &G->P;
+    const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
+    const double *psi = x + (size_t)a * (G->nf + G->nb);
+    const double *grad = x + (size_t)G->nc * (G->nf + G->nb) + 2 * (size_t)a * G->nf;
+    double px = ppb_rte_node_x(P, G->fcol[k]), py = ppb_rte_node_y(P, j);
+    double dy = py - 0.5 * (fy[j] + fy[j + 1]), sum = 0.0, A = 0.0;
+    for (int i = k; i < m; i++) {
+        int f = j * G->nfx + i;
+        double dx = px - 0.5 * (fx[i] + fx[i + 1]);
+        sum += G->farea[f] * (psi[f] + grad[2 * f] * dx + grad[2 * f + 1] * dy);
+        A += G->farea[f];
+    }
+    return sum > 0.0 ? sum / A : 0.0;
 }
 
 void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad)
@@ -306,6 +327,9 @@ void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad)
                     A += area[m];
                 }
                 row[G->fcol[k]] = sum / A;
+                if (P->ls && getenv("LSN") && j > 0 && j < ny - 1 && G->fcol[k] > 0 &&
+                    G->fcol[k] < nx - 1)
+                    row[G->fcol[k]] = ls_node(G, x, a, j, k, m);
             }
         }
         /* On the faces a half cell's average sits a quarter cell inside: extrapolated to the
@@ -360,15 +384,45 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x)
             }
         }
     }
+    /* The linear source's gradients: none (a start; the solve finds them). */
+    if (P->ls)
+        memset(x + (size_t)G->nc * stride, 0, sizeof(double) * 2 * (size_t)G->nc * G->nf);
 }
 
-int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, ppb_err *err)
+/* Strips an FSR is cut into, along x and along y, for the beam source's first moments: the
+ * strips' exact integrals at their centres, exact for a linear density and within O(h^2 / 48)
+ * of the curvature term for e^{-sigma y / mu} (ppb_rte_beam_sources). */
+#define RTE_LS_STRIPS 4
+
+/* The first moments about the rectangle's centre, x then y, of each beam pass's collision
+ * integral over [x0, x1] x [y0, y1] (4 + 4 values), from RTE_LS_STRIPS strips each way. */
+static void beam_moments(const ppb_rte_params *P, double x0, double x1, double y0, double y1,
+                         double *mx, double *my)
+{
+    double hx = (x1 - x0) / RTE_LS_STRIPS, hy = (y1 - y0) / RTE_LS_STRIPS, e[4];
+    for (int k = 0; k < 4; k++)
+        mx[k] = my[k] = 0.0;
+    for (int i = 0; i < RTE_LS_STRIPS; i++) {
+        double dc = (i + 0.5 - 0.5 * RTE_LS_STRIPS);
+        ppb_rte_beam_rect(P, x0 + i * hx, x0 + (i + 1) * hx, y0, y1, e);
+        for (int k = 0; k < 4; k++)
+            mx[k] += e[k] * dc * hx;
+        ppb_rte_beam_rect(P, x0, x1, y0 + i * hy, y0 + (i + 1) * hy, e);
+        for (int k = 0; k < 4; k++)
+            my[k] += e[k] * dc * hy;
+    }
+}
+
+int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *Qbg, double *absorbed,
+                         ppb_err *err)
 {
     const ppb_rte_params *P = &G->P;
     const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
-    double *E = malloc(sizeof(double) * 4 * G->nf);
+    int ls = Qbg && P->ls;
+    double *E = malloc(sizeof(double) * (ls ? 12 : 4) * G->nf);
     if (!E)
         return ppb_fail(err, "rte2d: out of memory (beam sources)");
+    double *Mx = E + 4 * G->nf, *My = E + 8 * G->nf;
     *absorbed = 0.0;
     for (int j = 0; j < P->ny; j++)
         for (int k = 0; k < G->nfx; k++) {
@@ -376,6 +430,8 @@ int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, pp
             ppb_rte_beam_rect(P, fx[k], fx[k + 1], fy[j + 1], fy[j], E + 4 * f);
             double sum = E[4 * f] + E[4 * f + 1] + E[4 * f + 2] + E[4 * f + 3];
             *absorbed += (1.0 - G->falb[k]) * sum;
+            if (ls)
+                beam_moments(P, fx[k], fx[k + 1], fy[j + 1], fy[j], Mx + 4 * f, My + 4 * f);
         }
     for (int a = 0; a < G->nc; a++) {
         const double *bc = G->bnd ? G->bnd + PPB_RTE_BND * a : NULL;
@@ -383,8 +439,18 @@ int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, pp
         for (int f = 0; f < G->nf; f++) {
             const double *e = E + 4 * f;
             double al = G->falb[f % G->nfx];
-            Qb[(size_t)a * G->nf + f] =
-                al * (cb[0] * e[0] + cb[1] * e[1] + cb[2] * e[2] + cb[3] * e[3]) / G->farea[f];
+            size_t i = (size_t)a * G->nf + f;
+            Qb[i] = al * (cb[0] * e[0] + cb[1] * e[1] + cb[2] * e[2] + cb[3] * e[3]) / G->farea[f];
+            if (!ls)
+                continue;
+            /* The gradient of the linear fit: first moment over the rectangle's A w^2 / 12. */
+            int k = f % G->nfx, j = f / G->nfx;
+            double w = fx[k + 1] - fx[k], h = fy[j] - fy[j + 1], A = G->farea[f];
+            const double *mx = Mx + 4 * f, *my = My + 4 * f;
+            Qbg[2 * i] = al * (cb[0] * mx[0] + cb[1] * mx[1] + cb[2] * mx[2] + cb[3] * mx[3]) /
+                         (A * w * w / 12.0);
+            Qbg[2 * i + 1] = al * (cb[0] * my[0] + cb[1] * my[1] + cb[2] * my[2] + cb[3] * my[3]) /
+                             (A * h * h / 12.0);
         }
     }
     free(E);
@@ -438,12 +504,15 @@ double ppb_rte_nodes(const ppb_scene *sc, double spacing)
     return (double)nx * Py.ny;
 }
 
-double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart)
+double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart, int ls)
 {
     double nodes = ppb_rte_nodes(sc, spacing), nc = directions + sqrt(directions) + 2;
     /* Krylov vectors, the solve's work arrays (x, b, J, out x 2 for host and device) and the
-     * phase matrix. */
-    return 8.0 * (nodes * nc * (restart + 8) + 4.0 * directions * directions);
+     * phase matrix; the linear source triples the unknown and adds its gradients' arrays and
+     * the tracks' sums. */
+    int tube = sc->geometry == PPB_GEOM_TUBE;
+    double per = ls && tube ? 3.0 * (restart + 8) + 6.0 + PPB_MOC_LS_ACC : restart + 8;
+    return 8.0 * (nodes * nc * per + 4.0 * directions * directions);
 }
 
 /* The scaled medium of truncation f (ppb_rte_delta_m); 0 where not done. */
@@ -624,10 +693,14 @@ void ppb_rte_grid_free(ppb_rte_grid *G)
     memset(G, 0, sizeof *G);
 }
 
-void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J)
+void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J, double *Jg)
 {
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, G->nc, G->nf, G->nc, 1.0, G->Pf, G->nc,
                 x, G->nf + G->nb, 0.0, J, G->nf);
+    /* The gradients scatter as the averages do: J is linear in psi at every point. */
+    if (Jg && G->P.ls)
+        cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, G->nc, 2 * G->nf, G->nc, 1.0, G->Pf,
+                    G->nc, x + (size_t)G->nc * (G->nf + G->nb), 2 * G->nf, 0.0, Jg, 2 * G->nf);
 }
 
 int ppb_rte_exit_coeffs(ppb_rte_grid *G, const double *w, int ndir, double *F, ppb_err *err)

@@ -65,8 +65,9 @@ typedef struct ppb_rte_grid {
 
 /* The solve's unknown, per transported cell a: psi[a][f], the FSRs' average radiance, then
  * bout[a][e], the power (per sr, per unit z) leaving through each boundary edge
- * (rte2d_params.h's edge order), nc (nf + nb) values in all: the walls' reflection at n > 1 is
- * a linear map of bout, so the solve inverts it with the scattering. */
+ * (rte2d_params.h's edge order), nc (nf + nb) values; with the linear source (P.ls) after
+ * them grad[a][f][2], each FSR's fitted radiance gradient in x and y, nc 2 nf more: the walls'
+ * reflection at n > 1 is a linear map of bout, so the solve inverts it with the scattering. */
 size_t ppb_rte_nvec(const ppb_rte_grid *G);
 
 /* The node field rad[nc][nnodes] of the solve's unknown x: each node the area-weighted mean of
@@ -74,7 +75,8 @@ size_t ppb_rte_nvec(const ppb_rte_grid *G);
 void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad);
 
 /* The unknown of a node field (I_pp): every FSR its node's value, every edge the power that
- * value carries out through it (|w . n| times the edge's length, where w leaves). */
+ * value carries out through it (|w . n| times the edge's length, where w leaves), the linear
+ * source's gradients 0. */
 void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x);
 
 /* At n > 1 (reference: Medium) the partition has a collar edge at the critical cosine, as
@@ -140,12 +142,14 @@ pp_dirs_spec ppb_rte_partition(const ppb_scene *sc, const pp_phase_fn *ph, int d
 /* Nodes of the grid ppb_rte_grid_make builds at `spacing` (G->nnodes), before building. */
 double ppb_rte_nodes(const ppb_scene *sc, double spacing);
 
-/* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building. */
-double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart);
+/* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building; ls:
+ * with the linear source (`[rte2d] source`). */
+double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart, int ls);
 
 /* J = Pf psi, the scattered light's source per unit sigma_s in every FSR: [nc][nf] from the
- * unknown x. */
-void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J);
+ * unknown x; with the linear source (P.ls) and Jg not NULL, its gradients Jg [nc][nf][2] from
+ * the radiance's. */
+void ppb_rte_scatter(const ppb_rte_grid *G, const double *x, double *J, double *Jg);
 
 /* Folded cell integrals of the exit directions: F[d][c] = sum over the cells c stands for of
  * integral_{Omega_j} p(w_d . w') dw' (p the grid's phase), for the ndir unit vectors w (rows
@@ -169,8 +173,11 @@ double ppb_rte_absorbed_scattered(const ppb_rte_grid *G, const double *x);
 /* The beam's first scattering as the FSRs' flat emission density, exact (rte2d_beam.h):
  * Qb[a][f] = alpha sum_k cb_a[k] (integral over f of sigma_t E_k) / A_f, cb_a the cell's phase
  * coefficients of the beam's directions; *absorbed = the (1 - alpha) part of the beam's
- * collisions over the cross-section (per unit z, slab: per unit area). */
-int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *absorbed, ppb_err *err);
+ * collisions over the cross-section (per unit z, slab: per unit area). With the linear source
+ * (P.ls) and Qbg not NULL, Qbg[a][f][2] the gradient of the density's least-squares linear fit
+ * over the FSR, its first moments from strips (rte2d_grid.c, beam_moments). */
+int ppb_rte_beam_sources(const ppb_rte_grid *G, double *Qb, double *Qbg, double *absorbed,
+                         ppb_err *err);
 
 /* Power absorbed from the unscattered beam, exact: along every entry point's path the
  * piecewise-constant (1 - alpha)(e^{-tau_a} - e^{-tau_b}), over the lit entry points by

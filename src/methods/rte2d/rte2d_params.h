@@ -66,8 +66,17 @@ enum {
     PPB_MOC_ARG_SCR = 7,    /* scratch [ncell][nb] */
     PPB_MOC_ARG_NFX = 8,    /* int: FSR columns */
     PPB_MOC_ARG_DMIN = 9,   /* double2: the least FSR width and height (track spacing) */
-    PPB_MOC_NARGS = 10
+    PPB_MOC_ARG_SRCG = 10,  /* linear source (P.ls): the emission's gradient in x and y about
+                               each FSR's centre [ncell][nfsr][2]; the radiance's, fitted, goes
+                               to OUT after the [ncell][nfsr + nb] block, [ncell][nfsr][2] */
+    PPB_MOC_ARG_LSC = 11,   /* linear source: scratch [ncell][nfsr][PPB_MOC_LS_ACC] */
+    PPB_MOC_NARGS = 12
 };
+
+/* Linear source (P.ls): the sums each FSR's tracks accumulate, per direction, for the fit of the
+ * radiance's gradient (rte2d.cl, moc_fit): its integral, its two first moments, the tracks' area,
+ * their two first moments and their three second moments about the FSR's centre. */
+#define PPB_MOC_LS_ACC 9
 
 /* Tracks a direction lays across its thinnest FSR (its projected width, perpendicular). */
 #define PPB_MOC_TRACKS_PER_CELL 2
@@ -118,6 +127,8 @@ typedef struct ppb_rte_params {
     int row0;      /* exit: first segment row of this launch */
     int nyl, nym;  /* y: rows per boundary layer (0: uniform), rows between the layers */
     int refl;      /* 1: a ray reaching a wall adds F x the mirror cell's radiance there (n > 1) */
+    int ls;        /* sweep: 1 the source linear in each FSR (the tube), 0 flat */
+    int ls_pad;    /* unused: keeps the count of ints even */
     int nseg[4];   /* exit: segments per surface (slab: 1, 1, 0, 0) */
     int offset[4]; /* exit: first row of each surface */
 } ppb_rte_params;
