@@ -281,37 +281,58 @@ static double node_width(const ppb_rte_grid *G, int i)
     return fx[k1 + 1] - fx[k0];
 }
 
-/* The linear source (P.ls): node (column fcol[k], row j)'s value from its FSRs k .. m - 1 of
- * row j, each its linear fit psi + a . (node - centre) (the gradients after the averages in x,
- * rte2d_grid.h), area-weighted; second order wherever the node sits in its dual cell, the faces'
- * half cells and the graded rows included; not below 0. */
-static double ls_node(const ppb_rte_grid *G, const double *x, int a, int j, int k, int m)
+/* The rows' mean-preserving solve (ppb_rte_to_nodes): node values v in y such that the
+ * linear interpolant's average over each node's dual cell (edges halfway between node rows, S1
+ * and S2 the outer ones) is that cell's average; per row k, with d_k = |y_k - y_(k-1)| (0 past a
+ * face) and len_k = (d_k + d_(k+1)) / 2 the dual cell's height, the tridiagonal system
+ *     (d_k / 8) v_(k-1) + (3 (d_k + d_(k+1)) / 8) v_k + (d_(k+1) / 8) v_(k+1) = len_k avg_k
+ * (diagonally dominant). The rows are the same in every column, so its elimination is done once
+ * here: ymp = [a_k, len_k, 1 / den_k, c'_k] per row, Thomas's factors. */
+static int rows_mean_preserving(ppb_rte_grid *G)
 {
     const ppb_rte_params *P = &G->P;
-    const double *fx = G->fedge, *fy = G->fedge + G->nfx + 1;
-    const double *psi = x + (size_t)a * (G->nf + G->nb);
-    const double *grad = x + (size_t)G->nc * (G->nf + G->nb) + 2 * (size_t)a * G->nf;
-    double px = ppb_rte_node_x(P, G->fcol[k]), py = ppb_rte_node_y(P, j);
-    double dy = py - 0.5 * (fy[j] + fy[j + 1]), sum = 0.0, A = 0.0;
-    for (int i = k; i < m; i++) {
-        int f = j * G->nfx + i;
-        double dx = px - 0.5 * (fx[i] + fx[i + 1]);
-        sum += G->farea[f] * (psi[f] + grad[2 * f] * dx + grad[2 * f + 1] * dy);
-        A += G->farea[f];
+    int ny = P->ny;
+    G->ymp = malloc(sizeof(double) * 4 * (size_t)ny);
+    if (!G->ymp)
+        return -1;
+    double cprev = 0.0;
+    for (int k = 0; k < ny; k++) {
+        double y = ppb_rte_node_y(P, k);
+        double dl = k > 0 ? ppb_rte_node_y(P, k - 1) - y : 0.0;
+        double dr = k < ny - 1 ? y - ppb_rte_node_y(P, k + 1) : 0.0;
+        double *m = G->ymp + 4 * k, a = dl / 8.0, den = 3.0 * (dl + dr) / 8.0 - a * cprev;
+        m[0] = a;
+        m[1] = 0.5 * (dl + dr);
+        m[2] = 1.0 / den;
+        m[3] = cprev = (dr / 8.0) * m[2];
     }
-    return sum > 0.0 ? sum / A : 0.0;
+    return 0;
+}
+
+/* The solve of rows_mean_preserving on column c of a node field (stride nx), in place: the
+ * dual-cell averages in, the node values out, not below 0 (the radiance of a direction entering
+ * at a face rises from 0 there). */
+static void column_mean_preserving(const ppb_rte_grid *G, double *c, int nx)
+{
+    int ny = G->P.ny;
+    double prev = 0.0;
+    for (int k = 0; k < ny; k++) {
+        const double *m = G->ymp + 4 * k;
+        prev = c[(size_t)k * nx] = (m[1] * c[(size_t)k * nx] - m[0] * prev) * m[2];
+    }
+    for (int k = ny - 2; k >= 0; k--)
+        c[(size_t)k * nx] -= G->ymp[4 * k + 3] * c[(size_t)(k + 1) * nx];
+    for (int k = 0; k < ny; k++)
+        c[(size_t)k * nx] = fmax(c[(size_t)k * nx], 0.0);
 }
 
 void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad)
 {
     const ppb_rte_params *P = &G->P;
-    const double *fy = G->fedge + G->nfx + 1;
     size_t stride = (size_t)G->nf + G->nb;
     int nx = P->nx, ny = P->ny;
     double wx0 = nx > 2 ? node_width(G, 0) : 0.0, wx1 = nx > 2 ? node_width(G, 1) : 0.0;
     double wxn = nx > 2 ? node_width(G, nx - 1) : 0.0, wxm = nx > 2 ? node_width(G, nx - 2) : 0.0;
-    double hy0 = fy[0] - fy[1], hy1 = fy[1] - fy[2];
-    double hyn = fy[ny - 1] - fy[ny], hym = fy[ny - 2] - fy[ny - 1];
     for (int a = 0; a < G->nc; a++) {
         double *r = rad + (size_t)a * G->nnodes;
         for (int j = 0; j < ny; j++) {
@@ -327,26 +348,21 @@ void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad)
                     A += area[m];
                 }
                 row[G->fcol[k]] = sum / A;
-                if (P->ls && getenv("LSN") && j > 0 && j < ny - 1 && G->fcol[k] > 0 &&
-                    G->fcol[k] < nx - 1)
-                    row[G->fcol[k]] = ls_node(G, x, a, j, k, m);
             }
         }
-        /* On the faces a half cell's average sits a quarter cell inside: extrapolated to the
-         * face from the two regions next to it (S3, S4, then S1, S2, so the corners are both). */
+        /* In y, where the boundary layers put the nodes off their dual cells' centres (and S1's
+         * and S2's half cells' averages sit a quarter cell inside), the mean-preserving values:
+         * the bilinear field the exit march reads then has the regions' own averages
+         * (reference: Methods, `rte2d`). */
+        for (int i = 0; ny > 1 && i < nx; i++)
+            column_mean_preserving(G, r + i, nx);
+        /* In x, S3's and S4's half cells: extrapolated to the face from the two regions next
+         * to it (the mean-preserving values there made the sides converge slower at n > 1). */
         if (nx > 2)
             for (int j = 0; j < ny; j++) {
                 double *row = r + (size_t)j * nx, v0 = row[0], vn = row[nx - 1];
                 row[0] = face_value(v0, row[1], 0.5 * wx0, wx0 + 0.5 * wx1);
                 row[nx - 1] = face_value(vn, row[nx - 2], 0.5 * wxn, wxn + 0.5 * wxm);
-            }
-        if (ny > 2)
-            for (int i = 0; i < nx; i++) {
-                double *c = r + i;
-                double v0 = c[0], vn = c[(size_t)(ny - 1) * nx];
-                c[0] = face_value(v0, c[nx], 0.5 * hy0, hy0 + 0.5 * hy1);
-                c[(size_t)(ny - 1) * nx] =
-                    face_value(vn, c[(size_t)(ny - 2) * nx], 0.5 * hyn, hyn + 0.5 * hym);
             }
     }
 }
@@ -614,6 +630,8 @@ int ppb_rte_grid_make(const ppb_scene *sc, double spacing, int directions, doubl
     }
     grid_y(sc, spacing, P);
     G->nnodes = P->nx * P->ny;
+    if (rows_mean_preserving(G))
+        return ppb_fail(err, "rte2d: out of memory (grid rows)");
 
     pp_dirs_spec spec = ppb_rte_partition(sc, &G->phase, directions);
     if (pp_dirs_make_spec(directions, &spec, &G->dirs, err))
@@ -690,6 +708,7 @@ void ppb_rte_grid_free(ppb_rte_grid *G)
     free(G->falb);
     free(G->fcol);
     free(G->farea);
+    free(G->ymp);
     memset(G, 0, sizeof *G);
 }
 

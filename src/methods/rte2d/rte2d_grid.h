@@ -57,6 +57,7 @@ typedef struct ppb_rte_grid {
     int *fcol;       /* [nfx] the node column of each FSR column */
     double *farea;   /* [nf] areas (per unit z; slab: per unit area) */
     double dmin[2];  /* the least FSR width and height */
+    double *ymp;     /* [ny][4]: the rows' mean-preserving solve, eliminated (ppb_rte_to_nodes) */
     /* n > 1: refl[f][b][c], the share of what cell b carries out through face f that the wall
      * reflects into cell c (rows sum to 1; the mirror image of b's directions, over the cells
      * whose centres enter through f); NULL at n = 1. */
@@ -70,8 +71,10 @@ typedef struct ppb_rte_grid {
  * reflection at n > 1 is a linear map of bout, so the solve inverts it with the scattering. */
 size_t ppb_rte_nvec(const ppb_rte_grid *G);
 
-/* The node field rad[nc][nnodes] of the solve's unknown x: each node the area-weighted mean of
- * its FSRs (its dual cell's average), for the exit march's bilinear source. */
+/* The node field rad[nc][nnodes] of the solve's unknown x, for the exit march's bilinear
+ * source: each node column's values such that the field's average over every node's dual cell
+ * (its FSRs) in y is that cell's average (mean-preserving; the boundary layers put the nodes off
+ * their cells' centres), S3's and S4's nodes extrapolated to the face in x. */
 void ppb_rte_to_nodes(const ppb_rte_grid *G, const double *x, double *rad);
 
 /* The unknown of a node field (I_pp): every FSR its node's value, every edge the power that
