@@ -655,7 +655,7 @@ static void test_refinements_approach_converged(void **state)
 /* Grid convergence in the spacing, on the reduced tube (graded rows at S1 and S2, step =
  * spacing / 2): the summary cells' change from spacing 0.2 to 0.1 and from 0.1 to 0.05 (rms_rel
  * of the coarser against the finer run); a scheme of order p >= 1 must at least halve the change
- * per halving. Measured: 0.13-0.37 % then 0.044-0.13 %, ratios 2.6-3.3 (second order, as flat
+ * per halving. Measured: 0.10-0.24 % then 0.026-0.088 %, ratios 2.7-3.8 (second order, as flat
  * sources in regions that halve are). */
 static void test_grid_convergence(void **state)
 {

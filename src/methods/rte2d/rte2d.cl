@@ -8,8 +8,8 @@
  * along q = p - l w:
  *     I(p, w) = integral_0^l_far exp(-d(l)) sigma_s(q) [J(q, w) + C(w) E(q)] dl,
  * where J is the converged scattered-light source per unit scattering coefficient (bilinear in
- * the nodes, each node its dual region's average, rte2d_params.h) and C E the direct beam's
- * first scattering, exact: E = lit exp(-D) with D linear along each piece, C = p(w.w_L) (as
+ * the nodes, whose values keep each dual region's average, ppb_rte_to_nodes) and C E the direct
+ * beam's first scattering, exact: E = lit exp(-D) with D linear along each piece, C = p(w.w_L) (as
  * `ss`). Under delta-M (reference: Methods, `rte2d`) sigma_t, alpha and g are the scaled ones
  * and C = p_g(w.w_L) / (1 - f) with the medium's own g (P.ss_g, P.ss_w): the truncated phase's
  * first scattering replaced by the exact one's (Nakajima and Tanaka 1988, TMS).
