@@ -226,7 +226,7 @@ static int solver_init(rte_solver *s, ppb_ocl *ocl, const ppb_config *cfg, int m
     ppb_rte_grid *G = &s->G;
     if (ppb_rte_grid_make(&cfg->scene, r->spacing, r->directions, r->step, moment, ph, G, err))
         return -1;
-    G->P.ls = r->source == PPB_RTE_SOURCE_LINEAR && G->P.med.tube;
+    G->P.ls = ppb_rte_ls_applies(r->source, &cfg->scene);
     s->nvec = ppb_rte_nvec(G);
     size_t nq = (size_t)G->nc * G->nf, nb = (size_t)G->nc * G->nb;
     size_t nodes = (size_t)G->nc * G->nnodes;
@@ -420,7 +420,7 @@ static rte_sizes rte_sizes_of(const ppb_config *cfg, int study)
     z.source = 8.0 * z.planes * z.nodes;
     /* The field buffers: cells x regions and edges, the regions at most twice the nodes (a
      * column split at the step). */
-    int ls = r->source == PPB_RTE_SOURCE_LINEAR;
+    int ls = ppb_rte_ls_applies(r->source, &cfg->scene);
     z.largest = fmax(z.source, 8.0 * cells * 2.0 * z.nodes * (ls ? PPB_MOC_LS_ACC : 1));
     z.total = ppb_rte_bytes(&cfg->scene, r->spacing, r->directions, RTE_RESTART + 4 * study, ls) +
               2.0 * z.source + 8.0 * z.planes * cells + 16.0 * (double)lo.ncells;

@@ -436,7 +436,7 @@ __kernel void ppb_rte_moc(const ppb_rte_params P, __global const double *dirs,
     /* The linear source's slices: the emission's gradients, the tracks' sums, the fit. */
     __global const double *qg = QG + (P.ls ? 2L * c * nf : 0L);
     __global double *acc = lsc + (P.ls ? (long)PPB_MOC_LS_ACC * c * nf : 0L);
-    __global double *grad = out + (long)P.ncell * (nf + nb) + 2L * c * nf;
+    __global double *grad = P.ls ? out + (long)P.ncell * (nf + nb) + 2L * c * nf : out;
     for (int f = 0; f < nf; f++)
         tal[f] = 0.0;
     for (long k = 0; P.ls && k < (long)PPB_MOC_LS_ACC * nf; k++)

@@ -405,9 +405,10 @@ void ppb_rte_from_nodes(const ppb_rte_grid *G, const double *rad, double *x)
         memset(x + (size_t)G->nc * stride, 0, sizeof(double) * 2 * (size_t)G->nc * G->nf);
 }
 
-/* Strips an FSR is cut into, along x and along y, for the beam source's first moments: the
- * strips' exact integrals at their centres, exact for a linear density and within O(h^2 / 48)
- * of the curvature term for e^{-sigma y / mu} (ppb_rte_beam_sources). */
+/* Strips an FSR is cut into, along x and along y, for the beam source's first moments: each
+ * strip's exact integral placed at its centre, exact for a density linear across the strips;
+ * a curved one (e^{-sigma y / mu} under S1) leaves an error of order the strip's width squared
+ * (ppb_rte_beam_sources). */
 #define RTE_LS_STRIPS 4
 
 /* The first moments about the rectangle's centre, x then y, of each beam pass's collision
@@ -526,8 +527,7 @@ double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int re
     /* Krylov vectors, the solve's work arrays (x, b, J, out x 2 for host and device) and the
      * phase matrix; the linear source triples the unknown and adds its gradients' arrays and
      * the tracks' sums. */
-    int tube = sc->geometry == PPB_GEOM_TUBE;
-    double per = ls && tube ? 3.0 * (restart + 8) + 6.0 + PPB_MOC_LS_ACC : restart + 8;
+    double per = ls ? 3.0 * (restart + 8) + 6.0 + PPB_MOC_LS_ACC : restart + 8;
     return 8.0 * (nodes * nc * per + 4.0 * directions * directions);
 }
 
@@ -567,6 +567,11 @@ double ppb_rte_delta_m_series(const ppb_scene *sc, int L, ppb_scene *out, pp_pha
     ph->chi[0] = 1.0;
     out->g = ph->chi[1];
     return f;
+}
+
+int ppb_rte_ls_applies(int source, const ppb_scene *sc)
+{
+    return source == PPB_RTE_SOURCE_LINEAR && sc->geometry == PPB_GEOM_TUBE;
 }
 
 int ppb_rte_moment_applies(int mode, const ppb_scene *sc, const pp_dirs *d)

@@ -146,8 +146,12 @@ pp_dirs_spec ppb_rte_partition(const ppb_scene *sc, const pp_phase_fn *ph, int d
 double ppb_rte_nodes(const ppb_scene *sc, double spacing);
 
 /* Bytes the grid's arrays and a solve with `restart` Krylov vectors take, before building; ls:
- * with the linear source (`[rte2d] source`). */
+ * with the linear source (ppb_rte_ls_applies). */
 double ppb_rte_bytes(const ppb_scene *sc, double spacing, int directions, int restart, int ls);
+
+/* Whether the sweep's source is linear in each region: `[rte2d] source = linear` (source, a
+ * ppb_rte_source) in the tube; the slab keeps `ppslab`'s flat discrete-ordinates system. */
+int ppb_rte_ls_applies(int source, const ppb_scene *sc);
 
 /* J = Pf psi, the scattered light's source per unit sigma_s in every FSR: [nc][nf] from the
  * unknown x; with the linear source (P.ls) and Jg not NULL, its gradients Jg [nc][nf][2] from
